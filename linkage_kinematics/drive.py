@@ -16,6 +16,11 @@ import math
 from dataclasses import dataclass
 
 
+# Below this |k·t| (or |k·Δα/ω_s|) e^{k t} − 1 equals k·t to double precision: the linear law
+# is then exact, and it avoids dividing a subnormal k·t, whose few bits would spoil the result.
+_LINEAR_LIMIT = 1e-17
+
+
 class DriveError(ValueError):
     """The drive law cannot take the crank where it was asked to go."""
 
@@ -44,7 +49,7 @@ class DriveLaw:
     def alpha_at(self, alpha_start: float, elapsed: float) -> float:
         """Crank angle (rad) ``elapsed`` seconds after it was at ``alpha_start``."""
         omega_start = self.angular_velocity(alpha_start)
-        if self.k == 0.0:
+        if self.k == 0.0 or abs(self.k * elapsed) < _LINEAR_LIMIT:
             return alpha_start + omega_start * elapsed
         try:
             growth = math.expm1(self.k * elapsed)
@@ -72,10 +77,10 @@ class DriveLaw:
                 f"the crank is at rest at α = {math.degrees(alpha_start):.6g}° (ω0 + k·α = 0) "
                 "and never moves"
             )
-        if self.k == 0.0:
+        scaled = self.k * travel / omega_start
+        if abs(scaled) < _LINEAR_LIMIT:
             elapsed = travel / omega_start
         else:
-            scaled = self.k * travel / omega_start
             elapsed = math.log1p(scaled) / self.k if scaled > -1.0 else -1.0
         if elapsed < 0.0:
             direction = "counterclockwise" if omega_start > 0.0 else "clockwise"
