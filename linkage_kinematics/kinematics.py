@@ -18,15 +18,14 @@ turned by +90° and S = e_AB × e_BC (= σ·h·d/(AB·BC), the sine of the trans
 
 which is Cramer's rule on the 2×2 velocity and acceleration systems. One function serves the
 scalar path (``math`` on floats, the node's hot path) and the vectorised path (``numpy`` on
-arrays, sweeps and benchmarks).
+arrays, sweeps and benchmarks; long arrays go through it in cache-sized pieces).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
-from types import SimpleNamespace
-from typing import Union
+from typing import Callable, Union
 
 import numpy as np
 
@@ -35,16 +34,17 @@ from linkage_kinematics.geometry import ANGLE_TOLERANCE, TWO_PI, FourBar, Unreac
 
 FloatOrArray = Union[float, np.ndarray]
 
-# Below this |sin μ| (μ the transmission angle) the rates' relative error, about 1e-16/sin²μ,
-# would pass 1e-2: such a configuration is reported as a dead point instead.
-SINGULAR_SINE = 1e-7
+# Below this |sin μ| (μ the transmission angle) the results are reported as a dead point: the
+# measured errors (docs/kinematics.md) are ≤ 1e-15/sin²μ for rates and, near a change point,
+# up to 3e-15/sin³μ for accelerations, so they stay below ~1e-7 and ~3e-3 above it.
+SINGULAR_SINE = 1e-4
 
 
 class DeadPointError(ValueError):
     """Coupler and rocker are collinear: the crank cannot drive the rates there."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class LinkageState:
     """Everything the seed tabulates and plots, for one configuration or an array of them.
 
@@ -91,42 +91,63 @@ class LinkageState:
         return LinkageState(*(float(getattr(self, f.name)[index]) for f in fields(self)))
 
 
-_SCALAR_MATH = SimpleNamespace(sin=math.sin, cos=math.cos, sqrt=math.sqrt, atan2=math.atan2)
-_ARRAY_MATH = SimpleNamespace(sin=np.sin, cos=np.cos, sqrt=np.sqrt, atan2=np.arctan2)
+class _StateBuilder:
+    """Storage laid out like LinkageState, filled by plain slot stores, then turned into one.
+
+    A frozen dataclass sets each field through object.__setattr__, which for 22 fields costs
+    more than the closed form's arithmetic; ``solve`` builds its result this way instead.
+    """
+
+    __slots__ = LinkageState.__slots__
+
+
+MathFunctions = tuple[Callable, Callable, Callable, Callable]
+_SCALAR_MATH: MathFunctions = (math.sin, math.cos, math.sqrt, math.atan2)
+_ARRAY_MATH: MathFunctions = (np.sin, np.cos, np.sqrt, np.arctan2)
+# Arrays longer than this are solved in pieces of this many angles, so that the closed form's
+# temporaries stay in cache instead of streaming whole arrays through memory.
+_CHUNK = 8192
 
 
 def _closed_form(
-    linkage: FourBar, branch: int, alpha: FloatOrArray, drive: DriveLaw, xp: SimpleNamespace
-) -> tuple[LinkageState, FloatOrArray]:
-    """Evaluate the closed form; returns the state and the signed sine S (see module doc).
+    linkage: FourBar, branch: int, alpha: FloatOrArray, drive: DriveLaw, xp: MathFunctions
+) -> tuple[FloatOrArray, ...]:
+    """Evaluate the closed form: the 22 LinkageState fields in order, then the signed sine S.
 
-    The caller has checked that every α is reachable; h² is clamped at 0 so that an α on an
-    interval end (rounding may put it a hair outside) lands exactly on the dead point.
+    ``xp`` is (sin, cos, sqrt, atan2) from ``math`` or ``numpy``. The caller has checked that
+    every α is reachable; h² is clamped at 0 so that an α on an interval end (rounding may put
+    it a hair outside) lands exactly on the dead point.
     """
+    sin, cos, sqrt, atan2 = xp
     crank = linkage.crank_length
     coupler = linkage.coupler_length
     rocker = linkage.rocker_length
-    sin_alpha = xp.sin(alpha)
-    cos_alpha = xp.cos(alpha)
+    ground_x = linkage.ground_x
+    ground_y = linkage.ground_y
+    sin_alpha = sin(alpha)
+    cos_alpha = cos(alpha)
     pin_a_x = crank * sin_alpha
     pin_a_y = -crank * cos_alpha
-    to_c_x = linkage.ground_x - pin_a_x
-    to_c_y = linkage.ground_y - pin_a_y
-    distance = xp.sqrt(to_c_x * to_c_x + to_c_y * to_c_y)
+    to_c_x = ground_x - pin_a_x
+    to_c_y = ground_y - pin_a_y
+    distance = sqrt(to_c_x * to_c_x + to_c_y * to_c_y)
     u_x = to_c_x / distance
     u_y = to_c_y / distance
-    along = (coupler * coupler - rocker * rocker + distance * distance) / (2.0 * distance)
+    two_distance = 2.0 * distance
+    along = (coupler * coupler - rocker * rocker + distance * distance) / two_distance
+    reach = coupler + rocker
     heron = (
-        (coupler + rocker - distance)
+        (reach - distance)
         * (rocker + distance - coupler)
         * (coupler + distance - rocker)
-        * (coupler + rocker + distance)
+        * (reach + distance)
     )
-    height = branch * xp.sqrt(heron * (heron > 0.0)) / (2.0 * distance)
+    height = branch * sqrt(heron * (heron > 0.0)) / two_distance
+    rocker_along = along - distance
     coupler_x = along * u_x - height * u_y
     coupler_y = along * u_y + height * u_x
-    rocker_x = (along - distance) * u_x - height * u_y
-    rocker_y = (along - distance) * u_y + height * u_x
+    rocker_x = rocker_along * u_x - height * u_y
+    rocker_y = rocker_along * u_y + height * u_x
     e_ab_x = coupler_x / coupler
     e_ab_y = coupler_y / coupler
     e_bc_x = rocker_x / rocker
@@ -137,10 +158,12 @@ def _closed_form(
     omega = drive.omega0 + drive.k * alpha
     omega_dot = drive.k * omega
     # v_A = OA·ω·(cos α, sin α); a_A = OA·ω̇·(cos α, sin α) − OA·ω²·(sin α, −cos α)
-    velocity_a_x = crank * omega * cos_alpha
-    velocity_a_y = crank * omega * sin_alpha
-    acceleration_a_x = crank * (omega_dot * cos_alpha - omega * omega * sin_alpha)
-    acceleration_a_y = crank * (omega_dot * sin_alpha + omega * omega * cos_alpha)
+    crank_omega = crank * omega
+    omega_squared = omega * omega
+    velocity_a_x = crank_omega * cos_alpha
+    velocity_a_y = crank_omega * sin_alpha
+    acceleration_a_x = crank * (omega_dot * cos_alpha - omega_squared * sin_alpha)
+    acceleration_a_y = crank * (omega_dot * sin_alpha + omega_squared * cos_alpha)
 
     coupler_sine = coupler * sine
     rocker_sine = rocker * sine
@@ -154,31 +177,31 @@ def _closed_form(
     omega_dot_bc = -(w_x * e_ab_x + w_y * e_ab_y) / rocker_sine
 
     rocker_tangential = rocker * omega_dot_bc
-    state = LinkageState(
-        alpha=alpha,
-        beta=xp.atan2(rocker_y, -rocker_x),
-        gamma=xp.atan2(coupler_y, coupler_x),
-        omega=omega,
-        omega_dot=omega_dot,
-        omega_ab=omega_ab,
-        omega_bc=omega_bc,
-        omega_dot_ab=omega_dot_ab,
-        omega_dot_bc=omega_dot_bc,
-        pin_a_x=pin_a_x,
-        pin_a_y=pin_a_y,
-        pin_b_x=linkage.ground_x + rocker_x,
-        pin_b_y=linkage.ground_y + rocker_y,
-        velocity_a_x=velocity_a_x,
-        velocity_a_y=velocity_a_y,
-        velocity_b_x=-omega_bc * rocker_y,
-        velocity_b_y=omega_bc * rocker_x,
-        acceleration_a_x=acceleration_a_x,
-        acceleration_a_y=acceleration_a_y,
-        acceleration_b_x=-rocker_tangential * e_bc_y - rocker_centripetal * e_bc_x,
-        acceleration_b_y=rocker_tangential * e_bc_x - rocker_centripetal * e_bc_y,
-        transmission_angle=xp.atan2(abs(sine), cosine),
+    return (
+        alpha,
+        atan2(rocker_y, -rocker_x),
+        atan2(coupler_y, coupler_x),
+        omega,
+        omega_dot,
+        omega_ab,
+        omega_bc,
+        omega_dot_ab,
+        omega_dot_bc,
+        pin_a_x,
+        pin_a_y,
+        ground_x + rocker_x,
+        ground_y + rocker_y,
+        velocity_a_x,
+        velocity_a_y,
+        -omega_bc * rocker_y,
+        omega_bc * rocker_x,
+        acceleration_a_x,
+        acceleration_a_y,
+        -rocker_tangential * e_bc_y - rocker_centripetal * e_bc_x,
+        rocker_tangential * e_bc_x - rocker_centripetal * e_bc_y,
+        atan2(abs(sine), cosine),
+        sine,
     )
-    return state, sine
 
 
 def _check_branch(branch: int) -> None:
@@ -203,9 +226,41 @@ def solve(linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1) -> L
         raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
     _check_branch(branch)
     linkage.reachability.require(alpha)
-    state, sine = _closed_form(linkage, branch, alpha, drive, _SCALAR_MATH)
+    try:
+        values = _closed_form(linkage, branch, alpha, drive, _SCALAR_MATH)
+    except ZeroDivisionError:
+        # Exactly on a dead or change point S rounds to 0 and the rates divide by it.
+        raise DeadPointError(_dead_point_message(alpha, 0.0)) from None
+    sine = values[-1]
     if abs(sine) < SINGULAR_SINE:
         raise DeadPointError(_dead_point_message(alpha, sine))
+    state = _StateBuilder()
+    (
+        state.alpha,
+        state.beta,
+        state.gamma,
+        state.omega,
+        state.omega_dot,
+        state.omega_ab,
+        state.omega_bc,
+        state.omega_dot_ab,
+        state.omega_dot_bc,
+        state.pin_a_x,
+        state.pin_a_y,
+        state.pin_b_x,
+        state.pin_b_y,
+        state.velocity_a_x,
+        state.velocity_a_y,
+        state.velocity_b_x,
+        state.velocity_b_y,
+        state.acceleration_a_x,
+        state.acceleration_a_y,
+        state.acceleration_b_x,
+        state.acceleration_b_y,
+        state.transmission_angle,
+        _,
+    ) = values
+    object.__setattr__(state, "__class__", LinkageState)
     return state
 
 
@@ -220,16 +275,48 @@ def solve_many(
     if not np.all(np.isfinite(alpha)):
         raise UnreachableError("crank angles must be finite")
     _check_branch(branch)
-    reachable = reachable_mask(linkage, alpha)
-    if not np.all(reachable):
-        linkage.reachability.require(float(alpha[np.argmin(reachable)]))
+    if not _within_one_interval(linkage, alpha):
+        reachable = reachable_mask(linkage, alpha)
+        if not np.all(reachable):
+            linkage.reachability.require(float(alpha[np.argmin(reachable)]))
     with np.errstate(divide="ignore", invalid="ignore"):
-        state, sine = _closed_form(linkage, branch, alpha, drive, _ARRAY_MATH)
+        if alpha.size <= _CHUNK:
+            *values, sine = _closed_form(linkage, branch, alpha, drive, _ARRAY_MATH)
+            _raise_at_first_dead_point(alpha, sine)
+            return LinkageState(*values)
+        flat_alpha = alpha.reshape(-1)
+        columns = [np.empty(flat_alpha.size) for _ in range(len(fields(LinkageState)) - 1)]
+        for start in range(0, flat_alpha.size, _CHUNK):
+            piece = slice(start, start + _CHUNK)
+            _, *values, sine = _closed_form(linkage, branch, flat_alpha[piece], drive, _ARRAY_MATH)
+            _raise_at_first_dead_point(flat_alpha[piece], sine)
+            for column, value in zip(columns, values):
+                column[piece] = value
+    return LinkageState(alpha, *(column.reshape(alpha.shape) for column in columns))
+
+
+def _raise_at_first_dead_point(alpha: np.ndarray, sine: np.ndarray) -> None:
+    """DeadPointError naming the first α whose |S| is below SINGULAR_SINE, if any."""
     singular = np.abs(sine) < SINGULAR_SINE
     if np.any(singular):
         first = int(np.argmax(singular))
         raise DeadPointError(_dead_point_message(float(alpha[first]), float(sine[first])))
-    return state
+
+
+def _within_one_interval(linkage: FourBar, alpha: np.ndarray) -> bool:
+    """True if every α lies in one reachable interval [low, high] without wrapping.
+
+    Then reachable_mask is all True: α − low rounds monotonically in α, so its extremes are
+    those of min(α) − low and max(α) − low. This costs two reductions instead of a float mod.
+    """
+    if alpha.size == 0:
+        return True
+    lowest = float(alpha.min())
+    highest = float(alpha.max())
+    return any(
+        lowest - low >= 0.0 and highest - low <= high - low + ANGLE_TOLERANCE
+        for low, high in linkage.reachability.intervals
+    )
 
 
 def reachable_mask(linkage: FourBar, alpha: np.ndarray) -> np.ndarray:
