@@ -26,6 +26,8 @@ setup(
         "console_scripts": [
             "linkage_node = linkage_kinematics.node:main",
             "linkage-sweep = linkage_kinematics.sweep:main",
+            "linkage-replay = linkage_kinematics.replay:main",
+            "linkage-demo = linkage_kinematics.demo:main",
         ],
     },
 )
