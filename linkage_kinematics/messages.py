@@ -1,0 +1,212 @@
+"""ROS messages built from a LinkageState: the node's topics, reusable by benchmarks and tools.
+
+Each builder is a plain function of the library's state (plus a stamp); none computes any
+kinematics. The per-tick builders take an optional ``out`` message that they fill in place, so
+the node's hot path reuses one message per topic instead of constructing a new one every tick
+(publishing and recording serialise the message before the builder runs again).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+
+from builtin_interfaces.msg import Duration, Time
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Point
+from sensor_msgs.msg import JointState
+from std_msgs.msg import ColorRGBA
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+from visualization_msgs.msg import Marker, MarkerArray
+
+from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.kinematics import LinkageState, unwrap_near
+
+JOINT_NAMES = ("crank_joint", "coupler_joint", "rocker_joint")
+STATE_NAMES = ("alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y")
+MARKER_NAMESPACE = "linkage"
+# Marker ids are fixed so that every MarkerArray updates the same markers in place.
+DISK_ID, BARS_ID, PIN_A_ID, PIN_B_ID, PIVOT_O_ID, PIVOT_C_ID = range(6)
+
+_DISK_THICKNESS = 0.01  # m; the disk is drawn just below the plane of the bars
+_BAR_WIDTH = 0.02  # m
+_PIN_DIAMETER = 0.05  # m
+_PIVOT_SIZE = 0.07  # m
+
+
+def _color(red: float, green: float, blue: float, alpha: float = 1.0) -> ColorRGBA:
+    return ColorRGBA(r=red, g=green, b=blue, a=alpha)
+
+
+DISK_COLOR = _color(0.55, 0.6, 0.7, 0.6)
+CRANK_COLOR = _color(0.2, 0.3, 0.9)
+COUPLER_COLOR = _color(0.95, 0.55, 0.1)
+ROCKER_COLOR = _color(0.15, 0.7, 0.3)
+PIN_COLOR = _color(0.85, 0.1, 0.1)
+PIVOT_COLOR = _color(0.15, 0.15, 0.15)
+
+
+def time_msg(nanoseconds: int) -> Time:
+    """A builtin_interfaces/Time from integer nanoseconds."""
+    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def duration_msg(seconds: float) -> Duration:
+    """A builtin_interfaces/Duration from (non-negative) seconds."""
+    nanoseconds = round(seconds * 1e9)
+    return Duration(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def joint_positions(
+    state: LinkageState, previous: Sequence[float] = (0.0, 0.0, 0.0)
+) -> tuple[float, float, float]:
+    """URDF joint positions (crank, coupler, rocker) = (α, γ − α, −β − γ) in rad.
+
+    The coupler and rocker positions are shifted by whole turns to lie within π of
+    ``previous`` (the last published positions), so a stream of them is continuous.
+    """
+    return (
+        state.alpha,
+        unwrap_near(state.gamma - state.alpha, previous[1]),
+        unwrap_near(-state.beta - state.gamma, previous[2]),
+    )
+
+
+def joint_velocities(state: LinkageState) -> tuple[float, float, float]:
+    """URDF joint velocities (ω, ω_AB − ω, ω_BC − ω_AB) in rad/s."""
+    return (state.omega, state.omega_ab - state.omega, state.omega_bc - state.omega_ab)
+
+
+def joint_state(
+    state: LinkageState,
+    stamp: Time,
+    previous_positions: Sequence[float] = (0.0, 0.0, 0.0),
+    out: JointState | None = None,
+) -> JointState:
+    """/joint_states: the URDF's three joints; frame_id stays empty as joint_state_publisher's."""
+    message = out if out is not None else JointState(name=list(JOINT_NAMES))
+    message.header.stamp = stamp
+    message.position = joint_positions(state, previous_positions)
+    message.velocity = joint_velocities(state)
+    return message
+
+
+def linkage_state(
+    state: LinkageState,
+    stamp: Time,
+    motion_time: float,
+    frame_id: str,
+    out: JointTrajectory | None = None,
+) -> JointTrajectory:
+    """/linkage/state: the full state as one trajectory point (see README, "Topics").
+
+    ``positions``, ``velocities`` and ``accelerations`` hold each of α, β, γ, A_x, A_y, B_x, B_y
+    and its first and second time derivatives; dβ/dt = −ω_BC. ``motion_time`` (s) is the
+    drive-law time since the motion left alpha_start.
+    """
+    if out is None:
+        out = JointTrajectory(joint_names=list(STATE_NAMES), points=[JointTrajectoryPoint()])
+    out.header.stamp = stamp
+    out.header.frame_id = frame_id
+    point = out.points[0]
+    point.positions = (
+        state.alpha, state.beta, state.gamma,
+        state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y,
+    )
+    point.velocities = (
+        state.omega, -state.omega_bc, state.omega_ab,
+        state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
+    )
+    point.accelerations = (
+        state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
+        state.acceleration_a_x, state.acceleration_a_y,
+        state.acceleration_b_x, state.acceleration_b_y,
+    )
+    point.time_from_start = duration_msg(motion_time)
+    return out
+
+
+def _marker(marker_id: int, marker_type: int, frame_id: str, color: ColorRGBA) -> Marker:
+    marker = Marker(ns=MARKER_NAMESPACE, id=marker_id, type=marker_type, action=Marker.ADD)
+    marker.header.frame_id = frame_id
+    marker.pose.orientation.w = 1.0
+    marker.color = color
+    return marker
+
+
+def marker_array(
+    linkage: FourBar,
+    state: LinkageState,
+    stamp: Time,
+    frame_id: str,
+    out: MarkerArray | None = None,
+) -> MarkerArray:
+    """/linkage/markers: disk (CYLINDER at O), the three bars (one LINE_LIST coloured per bar),
+    pins A and B (SPHEREs) and the ground pivots O and C (CUBEs), in namespace ``linkage``."""
+    if out is None:
+        out = _new_marker_array(linkage, frame_id)
+    disk, bars, pin_a, pin_b, pivot_o, pivot_c = out.markers
+    pin_a_point = Point(x=state.pin_a_x, y=state.pin_a_y)
+    pin_b_point = Point(x=state.pin_b_x, y=state.pin_b_y)
+    bars.points[1] = pin_a_point
+    bars.points[2] = pin_a_point
+    bars.points[3] = pin_b_point
+    bars.points[4] = pin_b_point
+    pin_a.pose.position = pin_a_point
+    pin_b.pose.position = pin_b_point
+    # The disk is symmetric about O; turning it shows the crank angle on the disk itself.
+    disk.pose.orientation.z = math.sin(0.5 * state.alpha)
+    disk.pose.orientation.w = math.cos(0.5 * state.alpha)
+    for marker in out.markers:
+        marker.header.stamp = stamp
+    return out
+
+
+def _new_marker_array(linkage: FourBar, frame_id: str) -> MarkerArray:
+    disk = _marker(DISK_ID, Marker.CYLINDER, frame_id, DISK_COLOR)
+    disk.pose.position.z = -_DISK_THICKNESS
+    disk.scale.x = disk.scale.y = 2.0 * linkage.crank_length
+    disk.scale.z = _DISK_THICKNESS
+
+    bars = _marker(BARS_ID, Marker.LINE_LIST, frame_id, CRANK_COLOR)
+    bars.scale.x = _BAR_WIDTH
+    ground_c = Point(x=linkage.ground_x, y=linkage.ground_y)
+    # O→A, A→B, B→C; points 1–4 are replaced with A and B on every update.
+    bars.points = [Point(), Point(), Point(), Point(), Point(), ground_c]
+    bars.colors = [CRANK_COLOR, CRANK_COLOR, COUPLER_COLOR, COUPLER_COLOR,
+                   ROCKER_COLOR, ROCKER_COLOR]
+
+    pins = []
+    for marker_id in (PIN_A_ID, PIN_B_ID):
+        pin = _marker(marker_id, Marker.SPHERE, frame_id, PIN_COLOR)
+        pin.scale.x = pin.scale.y = pin.scale.z = _PIN_DIAMETER
+        pins.append(pin)
+
+    pivots = []
+    for marker_id, position in ((PIVOT_O_ID, Point()), (PIVOT_C_ID, ground_c)):
+        pivot = _marker(marker_id, Marker.CUBE, frame_id, PIVOT_COLOR)
+        pivot.pose.position = position
+        pivot.scale.x = pivot.scale.y = pivot.scale.z = _PIVOT_SIZE
+        pivots.append(pivot)
+    return MarkerArray(markers=[disk, bars, *pins, *pivots])
+
+
+def diagnostic_array(
+    stamp: Time,
+    name: str,
+    hardware_id: str,
+    level: bytes,
+    message: str,
+    values: Mapping[str, str],
+) -> DiagnosticArray:
+    """/diagnostics with one status, in diagnostic_updater's layout (name "<node>: <task>")."""
+    status = DiagnosticStatus(
+        level=level,
+        name=name,
+        message=message,
+        hardware_id=hardware_id,
+        values=[KeyValue(key=key, value=value) for key, value in values.items()],
+    )
+    array = DiagnosticArray(status=[status])
+    array.header.stamp = stamp
+    return array

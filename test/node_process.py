@@ -1,0 +1,156 @@
+"""Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
+
+Every test module that starts nodes uses its own ROS_DOMAIN_ID (from 10–29) so that tests
+running at the same time never see each other's nodes.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import rclpy
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+
+from linkage_kinematics.node import parameter_specs
+
+REPOSITORY = Path(__file__).resolve().parent.parent
+PROCESS_TIMEOUT = 30.0  # s; a generous bound on any one node run in these tests
+
+
+def ros_environment(domain_id: int) -> dict[str, str]:
+    """The environment a node process (and the test's own rclpy) runs in."""
+    environment = dict(os.environ)
+    environment["ROS_DOMAIN_ID"] = str(domain_id)
+    environment["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    environment.setdefault("AMENT_PREFIX_PATH", sys.prefix)
+    environment["PYTHONUNBUFFERED"] = "1"
+    return environment
+
+
+def parameter_argument(name: str, value: Any) -> str:
+    """``name:=value`` for ``--ros-args -p`` (floats exactly, strings as YAML strings)."""
+    if isinstance(value, bool):
+        text = "true" if value else "false"
+    elif isinstance(value, float):
+        text = ".nan" if math.isnan(value) else repr(value).replace("inf", ".inf")
+    elif isinstance(value, str):
+        text = "'" + value.replace("'", "''") + "'"
+    else:
+        text = str(value)
+    return f"{name}:={text}"
+
+
+def node_command(parameters: Mapping[str, Any], executable: list[str] | None = None) -> list[str]:
+    """The command line of a node with ``parameters``."""
+    command = executable or [sys.executable, "-m", "linkage_kinematics.node"]
+    arguments = ["--ros-args"]
+    for name, value in parameters.items():
+        arguments += ["-p", parameter_argument(name, value)]
+    return command + arguments
+
+
+def start_node(
+    parameters: Mapping[str, Any],
+    domain_id: int,
+    output: Path,
+    executable: list[str] | None = None,
+    environment: Mapping[str, str] | None = None,
+    cwd: Path = REPOSITORY,
+    preexec_fn: Callable[[], None] | None = None,
+) -> subprocess.Popen:
+    """Start a node process (by default the working tree's, from the repository root); its
+    stdout and stderr go to the file ``output``; ``preexec_fn`` runs in the child first."""
+    with open(output, "w") as log:
+        return subprocess.Popen(
+            node_command(parameters, executable),
+            cwd=cwd,
+            env=dict(environment) if environment is not None else ros_environment(domain_id),
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            preexec_fn=preexec_fn,
+        )
+
+
+def stop_process(process: subprocess.Popen) -> None:
+    """Make sure a node process has ended (for test teardown)."""
+    if process.poll() is None:
+        process.kill()
+        process.wait(timeout=PROCESS_TIMEOUT)
+
+
+def run_node(parameters: Mapping[str, Any], domain_id: int, output: Path) -> tuple[int, str]:
+    """Run a node to its end; return its exit status and output."""
+    process = start_node(parameters, domain_id, output)
+    try:
+        status = process.wait(timeout=PROCESS_TIMEOUT)
+    finally:
+        stop_process(process)
+    return status, output.read_text()
+
+
+class Listener:
+    """A node in the test process that keeps every message it receives, per topic."""
+
+    def __init__(self, name: str, context: rclpy.Context) -> None:
+        self.node = Node(name, context=context)
+        self.executor = SingleThreadedExecutor(context=context)
+        self.executor.add_node(self.node)
+        self.received: dict[str, list[Any]] = {}
+
+    def subscribe(self, topic: str, msg_type: type, transient_local: bool = False) -> None:
+        self.received.setdefault(topic, [])
+        qos = QoSProfile(depth=1000)
+        if transient_local:
+            qos = QoSProfile(
+                depth=1,
+                durability=DurabilityPolicy.TRANSIENT_LOCAL,
+                reliability=ReliabilityPolicy.RELIABLE,
+            )
+        self.node.create_subscription(msg_type, topic, self.received[topic].append, qos)
+
+    def spin_until(self, done: Callable[[], bool], timeout: float = PROCESS_TIMEOUT) -> bool:
+        """Spin until ``done()`` or the timeout; return ``done()``."""
+        deadline = time.monotonic() + timeout
+        while not done() and time.monotonic() < deadline:
+            self.executor.spin_once(timeout_sec=0.05)
+        return done()
+
+    def wait_for_publisher(self, topic: str, timeout: float = PROCESS_TIMEOUT) -> bool:
+        return self.spin_until(lambda: self.node.count_publishers(topic) > 0, timeout)
+
+    def destroy(self) -> None:
+        self.executor.shutdown()
+        self.node.destroy_node()
+
+
+@contextmanager
+def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
+    """A private rclpy context in the test process on ``domain_id``, loopback only."""
+    previous = os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE")
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id)
+    try:
+        yield context
+    finally:
+        rclpy.shutdown(context=context)
+        if previous is None:
+            os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
+        else:
+            os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = previous
+
+
+def configuration_values(**overrides: Any) -> dict[str, Any]:
+    """The node's default parameter values (preset 'paper') with ``overrides``, by name; dotted
+    names are passed as ``**{"log.enabled": False}``."""
+    return {**{spec.name: spec.default for spec in parameter_specs("paper")}, **overrides}
