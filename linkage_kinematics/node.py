@@ -67,6 +67,12 @@ MODES = ("real_time", "fixed_step")
 GEOMETRY_PARAMETERS = ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")
 MAX_RATE_HZ = 10000.0
 MAX_DISPLAY_RATE_HZ = 1000.0
+MAX_LENGTH = 1e6  # m; lengths and ground coordinates, far beyond any mechanism
+MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
+MAX_OMEGA0 = 1e4  # rad/s
+MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
+# s; shorter passes would fall between clock ticks, and elapsed / pass duration could overflow.
+MIN_PASS_DURATION = 1e-6
 DIAGNOSTICS_PERIOD = 1.0  # s
 
 EXIT_OK = 0
@@ -265,10 +271,12 @@ def _positive(values: Mapping[str, Any], name: str, unit: str, upper: float = ma
     return value
 
 
-def _within(values: Mapping[str, Any], name: str, low: float, high: float) -> float:
+def _within(
+    values: Mapping[str, Any], name: str, low: float, high: float, unit: str = "rad"
+) -> float:
     value = _real(values, name)
     if not low <= value <= high:
-        raise ConfigurationError(name, f"must lie in [{low:g}, {high:g}] rad, got {value!r}")
+        raise ConfigurationError(name, f"must lie in [{low:g}, {high:g}] {unit}, got {value!r}")
     return value
 
 
@@ -304,9 +312,9 @@ def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
             raise ConfigurationError(name, "has no value: with preset '' all five of "
                                      f"{', '.join(GEOMETRY_PARAMETERS)} must be given")
     for name in ("crank_length", "coupler_length", "rocker_length"):
-        _positive(values, name, "m")
+        _positive(values, name, "m", MAX_LENGTH)
     for name in ("ground_x", "ground_y"):
-        _real(values, name)
+        _within(values, name, -MAX_LENGTH, MAX_LENGTH, "m")
     try:
         linkage = FourBar(*(_real(values, name) for name in GEOMETRY_PARAMETERS))
     except GeometryError as error:
@@ -361,7 +369,15 @@ def _motion(
         except DeadPointError:
             blocked_at = alpha_end
     segment_end = alpha_end if blocked_at is None else blocked_at
-    return blocked_at, drive.time_to(alpha_start, segment_end)
+    duration = drive.time_to(alpha_start, segment_end)
+    if duration < MIN_PASS_DURATION:
+        raise ConfigurationError(
+            "alpha_end",
+            f"a pass from alpha_start to {math.degrees(segment_end):.6g}° would last only "
+            f"{duration:.3g} s under this drive law; it must last at least "
+            f"{MIN_PASS_DURATION:g} s",
+        )
+    return blocked_at, duration
 
 
 def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
@@ -372,11 +388,11 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     """
     preset_name, linkage = _geometry(values)
     branch = _branch(values)
-    omega0 = _real(values, "omega0")
-    k = _real(values, "k")
+    omega0 = _within(values, "omega0", -MAX_OMEGA0, MAX_OMEGA0, "rad/s")
+    k = _within(values, "k", -MAX_DRIVE_GAIN, MAX_DRIVE_GAIN, "1/s")
     drive = DriveLaw(omega0, k)
-    alpha_start = _real(values, "alpha_start")
-    alpha_end = _real(values, "alpha_end")
+    alpha_start = _within(values, "alpha_start", -MAX_ANGLE, MAX_ANGLE)
+    alpha_end = _within(values, "alpha_end", -MAX_ANGLE, MAX_ANGLE)
     end_behavior = _text(values, "end_behavior", END_BEHAVIORS)
     mode = _text(values, "mode", MODES)
     alpha_step = _positive(values, "alpha_step", "rad", TWO_PI)
@@ -392,7 +408,10 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
     segment_end = alpha_end if blocked_at is None else blocked_at
     travel = abs(segment_end - alpha_start)
-    step_count = max(1, math.ceil(travel / alpha_step - _STEP_COUNT_TOLERANCE))
+    steps = travel / alpha_step
+    if not math.isfinite(steps):
+        raise ConfigurationError("alpha_step", f"is too small for a pass of {travel!r} rad")
+    step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     return RunConfiguration(
         preset=preset_name,
         linkage=linkage,
@@ -429,14 +448,16 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
 class MotionSample:
     """Where the motion is: the crank angle of the first pass to solve at, whether that pass
     plays backwards (bounce), the whole turns to add to the published α (loop over whole turns),
-    the drive-law time since the motion left alpha_start (s), and whether this is the final
-    state of a 'stop' motion."""
+    the drive-law time since the motion left alpha_start (s), whether this is the final
+    state of a 'stop' motion, and how many passes have ended before this one (for bounce the
+    forward passes are the even ones)."""
 
     alpha: float
     reversed: bool = False
     turn_offset: float = 0.0
     motion_time: float = 0.0
     final: bool = False
+    pass_index: int = 0
 
 
 def _clamp_to_segment(config: RunConfiguration, alpha: float) -> float:
@@ -469,14 +490,17 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
             turn_offset=passes * (config.alpha_end - config.alpha_start) if config.whole_turns
             else 0.0,
             motion_time=elapsed,
+            pass_index=passes,
         )
-    in_cycle = elapsed - math.floor(elapsed / (2.0 * duration)) * 2.0 * duration
+    cycles = math.floor(elapsed / (2.0 * duration))
+    in_cycle = elapsed - cycles * 2.0 * duration
     backwards = in_cycle > duration
     in_pass = 2.0 * duration - in_cycle if backwards else in_cycle
     return MotionSample(
         _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, in_pass)),
         reversed=backwards,
         motion_time=elapsed,
+        pass_index=2 * cycles + backwards,
     )
 
 
@@ -514,15 +538,18 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
             turn_offset=passes * (config.alpha_end - config.alpha_start) if config.whole_turns
             else 0.0,
             motion_time=passes * duration + time_of(alpha),
+            pass_index=passes,
         )
     per_cycle = max(2 * (points - 1), 1)
     cycles, index = divmod(step, per_cycle)
     if index < points:
         alpha = _step_alpha(config, index)
-        return MotionSample(alpha, motion_time=cycles * 2.0 * duration + time_of(alpha))
+        return MotionSample(alpha, motion_time=cycles * 2.0 * duration + time_of(alpha),
+                            pass_index=2 * cycles)
     alpha = _step_alpha(config, per_cycle - index)
     return MotionSample(
-        alpha, reversed=True, motion_time=(cycles + 1) * 2.0 * duration - time_of(alpha)
+        alpha, reversed=True, motion_time=(cycles + 1) * 2.0 * duration - time_of(alpha),
+        pass_index=2 * cycles + 1,
     )
 
 
@@ -547,6 +574,30 @@ def blocked_note(config: RunConfiguration) -> str | None:
     return (
         f"dead point at {math.degrees(config.blocked_at):.6f}° before alpha_end = "
         f"{math.degrees(config.alpha_end):.6f}°: {outcome}"
+    )
+
+
+def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: int) -> bool:
+    """Whether the crank met the dead point that cuts a pass short (``blocked_at``) between a
+    sample of pass ``previous_pass`` and one of pass ``current_pass``: 'loop' meets it at the
+    end of every pass, 'bounce' at the end of every forward (even) pass."""
+    if config.blocked_at is None or current_pass <= previous_pass:
+        return False
+    if config.end_behavior == "bounce":
+        return previous_pass % 2 == 0 or current_pass - previous_pass >= 2
+    return True
+
+
+def dead_point_problem(config: RunConfiguration) -> str:
+    """The ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
+    outcome = {
+        "stop": "stops; the run cannot go on",
+        "loop": "restarts from alpha_start",
+        "bounce": "reverses",
+    }[config.end_behavior]
+    return (
+        f"the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° "
+        f"before alpha_end = {math.degrees(config.alpha_end):.6f}°: it {outcome}"
     )
 
 
@@ -750,6 +801,7 @@ class LinkageNode(Node):
         self._motion_start: Time | None = None
         self._step = 0
         self._ticks = 0
+        self._pass_index = 0
         # Missed deadlines count over the whole run, across restarts.
         self._missed_before_restart = self._missed_deadlines
 
@@ -772,6 +824,10 @@ class LinkageNode(Node):
         if sample is None:
             self._cannot_go_on(None)
             return
+        if met_dead_point(config, self._pass_index, sample.pass_index):
+            # Stamped with the tick's time, like the state that follows, so log times never fall.
+            self._publish_diagnostics(dead_point_problem(config), now)
+        self._pass_index = sample.pass_index
         try:
             state = solve_sample(config, sample)
         except (DeadPointError, UnreachableError) as error:
@@ -819,10 +875,7 @@ class LinkageNode(Node):
     def _cannot_go_on(self, detail: str | None) -> None:
         config = self.config
         if config.blocked_at is not None:
-            problem = (
-                f"the crank cannot go on: dead point at {math.degrees(config.blocked_at):.6f}° "
-                f"before alpha_end = {math.degrees(config.alpha_end):.6f}°"
-            )
+            problem = dead_point_problem(config)
         else:
             problem = f"the crank cannot go on: {detail}"
         self._problem = problem
@@ -846,15 +899,18 @@ class LinkageNode(Node):
         )
         self._publish("/linkage/markers", self._markers, now.nanoseconds)
 
-    def _publish_diagnostics(self) -> None:
-        now = self.get_clock().now()
+    def _publish_diagnostics(self, event: str | None = None, now: Time | None = None) -> None:
+        """Publish the status (at ``now``, by default the clock's); ``event``, a problem of this
+        moment only, makes it ERROR."""
+        if now is None:
+            now = self.get_clock().now()
         if self._window_start is not None:
             window = (now - self._window_start).nanoseconds * 1e-9
             if window > 0.0:
                 self._achieved_rate = self._window_ticks / window
         self._window_start = now
         self._window_ticks = 0
-        problem = self._problem or self._recording_error
+        problem = event or self._problem or self._recording_error
         level, text = assess(self.config, self._state, problem, self._activity)
         message = messages.diagnostic_array(
             now.to_msg(),

@@ -1,6 +1,6 @@
 """Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
 
-Every test module that starts nodes uses its own ROS_DOMAIN_ID (from 10–29) so that tests
+Every test module that starts nodes uses its own ROS_DOMAIN_ID so that tests
 running at the same time never see each other's nodes.
 """
 
@@ -20,6 +20,7 @@ import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.task import Future
 
 from linkage_kinematics.node import parameter_specs
 
@@ -128,6 +129,11 @@ class Listener:
     def wait_for_publisher(self, topic: str, timeout: float = PROCESS_TIMEOUT) -> bool:
         return self.spin_until(lambda: self.node.count_publishers(topic) > 0, timeout)
 
+    def result_of(self, future: Future, timeout: float = 10.0) -> Any:
+        """Spin until ``future`` (e.g. a parameter service call) is done; its result."""
+        assert self.spin_until(future.done, timeout), "no answer within the timeout"
+        return future.result()
+
     def destroy(self) -> None:
         self.executor.shutdown()
         self.node.destroy_node()
@@ -148,6 +154,11 @@ def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
             os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
         else:
             os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = previous
+
+
+def stamp_ns(message: Any) -> int:
+    """The header stamp of ``message`` in integer nanoseconds."""
+    return message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
 
 
 def configuration_values(**overrides: Any) -> dict[str, Any]:
