@@ -31,6 +31,10 @@ TWO_PI = 2.0 * math.pi
 _TOUCH_TOLERANCE = 1e-12
 # A crank angle this close outside a computed interval end is still taken as the end itself.
 ANGLE_TOLERANCE = 1e-14
+# Lengths and coordinates are kept within these magnitudes so that the products of four lengths
+# in the closed form (Heron's formula) neither overflow nor underflow in double precision.
+MAX_LENGTH = 1e60
+MIN_LENGTH = 1e-60
 
 
 class GeometryError(ValueError):
@@ -39,6 +43,11 @@ class GeometryError(ValueError):
 
 class UnreachableError(ValueError):
     """The loop cannot close at the requested crank angle."""
+
+
+def _is_real(value: object) -> bool:
+    """An int or float, but not a bool (which Python counts as an int)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
 def wrap_angle(angle: float) -> float:
@@ -120,12 +129,18 @@ class FourBar:
     def __post_init__(self) -> None:
         for name in ("crank_length", "coupler_length", "rocker_length"):
             value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0.0:
-                raise GeometryError(f"{name} must be a finite length > 0 m, got {value!r}")
+            if not _is_real(value) or not MIN_LENGTH <= value <= MAX_LENGTH:
+                raise GeometryError(
+                    f"{name} must be a length from {MIN_LENGTH:g} to {MAX_LENGTH:g} m, "
+                    f"got {value!r}"
+                )
         for name in ("ground_x", "ground_y"):
             value = getattr(self, name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise GeometryError(f"{name} must be a finite coordinate in m, got {value!r}")
+            if not _is_real(value) or not abs(value) <= MAX_LENGTH:
+                raise GeometryError(
+                    f"{name} must be a coordinate from {-MAX_LENGTH:g} to {MAX_LENGTH:g} m, "
+                    f"got {value!r}"
+                )
         object.__setattr__(self, "reachability", _reachability(self))
 
     @property

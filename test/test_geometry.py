@@ -21,7 +21,9 @@ from linkage_kinematics.kinematics import solve
 
 
 @pytest.mark.parametrize("name", ["crank_length", "coupler_length", "rocker_length"])
-@pytest.mark.parametrize("bad", [0.0, -0.3, math.nan, math.inf, -math.inf, "0.3", None])
+@pytest.mark.parametrize(
+    "bad", [0.0, -0.3, math.nan, math.inf, -math.inf, "0.3", None, True, 1e308, 1e-300]
+)
 def test_bad_lengths_are_rejected_by_name(name: str, bad) -> None:
     lengths = {"crank_length": 0.3, "coupler_length": 1.0, "rocker_length": 0.3}
     lengths[name] = bad
@@ -30,7 +32,7 @@ def test_bad_lengths_are_rejected_by_name(name: str, bad) -> None:
 
 
 @pytest.mark.parametrize("name", ["ground_x", "ground_y"])
-@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, "1.3"])
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, "1.3", True, 1e308, -1e308])
 def test_bad_ground_pivot_is_rejected_by_name(name: str, bad) -> None:
     pivot = {"ground_x": 1.3, "ground_y": 0.0}
     pivot[name] = bad
