@@ -1,0 +1,597 @@
+"""Logging to rosbag2 MCAP: BagWriter and Recorder on their own, a real node run read back by two
+independent readers (rosbags and mcap-ros2-support), linkage-replay, and the Foxglove layout.
+
+Nodes run and are listened to through node_process; the bag helpers here (reading a bag back
+with rosbags, its metadata.yaml) are shared with test_recording_faults.py and test_soak.py.
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+import signal
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pytest
+import rclpy
+import yaml
+from ament_index_python.packages import get_package_share_directory
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from mcap.reader import make_reader
+from mcap_ros2.reader import read_ros2_messages
+from rclpy.qos import QoSProfile
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import Stores, get_typestore
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from trajectory_msgs.msg import JointTrajectory
+from visualization_msgs.msg import MarkerArray
+
+from linkage_kinematics import bag_reader, messages
+from linkage_kinematics.bag_writer import (
+    DEFINITION_SEPARATOR,
+    BagExistsError,
+    BagWriter,
+    message_definition,
+    package_version,
+)
+from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.geometry import preset
+from linkage_kinematics.kinematics import solve
+from linkage_kinematics.recording import (
+    Recorder,
+    cdr_length,
+    offered_qos_profiles_yaml,
+    ros_type_name,
+    serialize_exact,
+)
+from linkage_kinematics.replay import main as replay_main
+from node_process import (
+    REPOSITORY,
+    Listener,
+    ros_context,
+    ros_environment,
+    start_node,
+    stamp_ns,
+    stop_process,
+)
+
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+NODE_TOPICS = {
+    "/joint_states": JointState,
+    "/linkage/state": JointTrajectory,
+    "/robot_description": String,
+    "/linkage/markers": MarkerArray,
+    "/diagnostics": DiagnosticArray,
+}
+RATE_HZ = 200.0
+# 90° at this constant ω takes 0.3 s: a short run.
+SHORT_RUN_OMEGA = (math.pi / 2) / 0.3
+DOMAIN_ID = 30
+
+
+# --- shared helpers ----------------------------------------------------------------------------
+
+
+def listen_to_node_topics(context: rclpy.Context, name: str) -> Listener:
+    listener = Listener(name, context)
+    for topic, msg_type in NODE_TOPICS.items():
+        listener.subscribe(topic, msg_type, transient_local=topic == "/robot_description")
+    return listener
+
+
+def stopped(process: subprocess.Popen) -> Callable[[], bool]:
+    return lambda: process.poll() is not None
+
+
+def only_bag(folder: Path) -> Path:
+    bags = [path for path in folder.iterdir() if path.is_dir()]
+    assert len(bags) == 1, f"expected one bag in {folder}, found {bags}"
+    return bags[0]
+
+
+def read_with_rosbags(bag: Path) -> dict[str, list[tuple[int, Any, bytes]]]:
+    """topic -> [(log time ns, decoded message, raw CDR)] read with rosbags (needs the summary)."""
+    logged: dict[str, list[tuple[int, Any, bytes]]] = defaultdict(list)
+    with Reader(bag) as reader:
+        for connection, log_time, raw in reader.messages():
+            logged[connection.topic].append(
+                (log_time, TYPESTORE.deserialize_cdr(raw, connection.msgtype), bytes(raw))
+            )
+    return logged
+
+
+def bag_information(bag: Path) -> dict[str, Any]:
+    return yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+
+
+def topic_counts(information: dict[str, Any]) -> dict[str, int]:
+    """topic -> message count, as metadata.yaml states them."""
+    return {
+        entry["topic_metadata"]["name"]: entry["message_count"]
+        for entry in information["topics_with_message_count"]
+    }
+
+
+def message_stamp_ns(message: Any) -> int:
+    """Header stamp; a MarkerArray's is that of its (equally stamped) markers."""
+    return stamp_ns(message.markers[0] if hasattr(message, "markers") else message)
+
+
+# --- BagWriter and Recorder on their own ---------------------------------------------------------
+
+
+def sample_messages() -> list[Any]:
+    """One message of every type the node logs, built by the node's own message builders."""
+    paper = preset("paper")
+    state = solve(paper.geometry, 0.3, DriveLaw(2.0, 0.0))
+    stamp = messages.time_msg(1_234_567_890_123)
+    return [
+        messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
+        messages.linkage_state(state, stamp, 0.1, "linkage_base"),
+        messages.marker_array(paper.geometry, state, stamp, "linkage_base"),
+        messages.diagnostic_array(
+            stamp, "linkage_node: crank motion", "four-bar", DiagnosticStatus.WARN,
+            "1.2° from a dead point", {"α (deg)": "12.5", "empty": ""},
+        ),
+        String(data="<robot name='ü'/>"),
+        String(data=""),
+    ]
+
+
+@pytest.mark.parametrize("message", sample_messages(), ids=lambda m: type(m).__name__)
+def test_logged_cdr_has_exactly_the_length_independent_serializers_produce(message: Any) -> None:
+    type_name = ros_type_name(type(message))
+    logged = serialize_exact(message)
+    decoded = TYPESTORE.deserialize_cdr(logged, type_name)
+    assert len(logged) == cdr_length(message) == len(TYPESTORE.serialize_cdr(decoded, type_name))
+    if type_name == "std_msgs/msg/String":
+        assert decoded.data == message.data
+    elif type_name == "visualization_msgs/msg/MarkerArray":
+        assert len(decoded.markers) == len(message.markers)
+    else:
+        assert message_stamp_ns(decoded) == 1_234_567_890_123
+
+
+def test_joint_state_values_survive_exact_serialization() -> None:
+    message = sample_messages()[0]
+    decoded = TYPESTORE.deserialize_cdr(serialize_exact(message), "sensor_msgs/msg/JointState")
+    assert list(decoded.name) == list(message.name)
+    assert list(decoded.position) == list(message.position)
+    assert list(decoded.velocity) == list(message.velocity)
+    assert len(decoded.effort) == 0
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+ros_text = st.text(st.characters(codec="utf-8", exclude_characters="\x00"), max_size=7)  # no NUL
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    names=st.lists(ros_text, max_size=4),
+    position=st.lists(finite, max_size=4),
+    velocity=st.lists(finite, max_size=4),
+    effort=st.lists(finite, max_size=4),
+    frame_id=ros_text,
+)
+def test_exact_length_holds_for_any_sequence_and_string_lengths(
+    names: list[str], position: list[float], velocity: list[float], effort: list[float],
+    frame_id: str,
+) -> None:
+    message = JointState(name=names, position=position, velocity=velocity, effort=effort)
+    message.header.frame_id = frame_id
+    logged = serialize_exact(message)
+    decoded = TYPESTORE.deserialize_cdr(logged, "sensor_msgs/msg/JointState")
+    assert len(logged) == len(TYPESTORE.serialize_cdr(decoded, "sensor_msgs/msg/JointState"))
+    assert (list(decoded.name), decoded.header.frame_id) == (names, frame_id)
+    assert list(decoded.effort) == effort
+
+
+def test_schema_names_dependencies_as_the_referencing_field_spells_them() -> None:
+    text = message_definition("sensor_msgs/msg/JointState")
+    msg_file = Path(get_package_share_directory("sensor_msgs")) / "msg" / "JointState.msg"
+    assert text.startswith(msg_file.read_text().rstrip("\n"))
+    sections = text.split(DEFINITION_SEPARATOR + "\n")
+    assert [section.splitlines()[0] for section in sections[1:]] == [
+        "MSG: std_msgs/Header",
+        "MSG: builtin_interfaces/Time",
+    ]
+    assert "std_msgs/msg/Header" not in text
+    markers = message_definition("visualization_msgs/msg/MarkerArray")
+    dependency_names = re.findall(r"^MSG: (\S+)$", markers, flags=re.MULTILINE)
+    assert len(dependency_names) == len(set(dependency_names))
+    # bare names in a .msg file (``Marker[] markers``) get the package of that file
+    assert {"visualization_msgs/Marker", "geometry_msgs/Point", "std_msgs/Header"} <= set(
+        dependency_names
+    )
+
+
+def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: Path) -> None:
+    bag = tmp_path / "unit_bag"
+    writer = BagWriter(bag, metadata={"rate_hz": "200"}, flush_interval=0.05)
+    assert (bag / "metadata.yaml").is_file(), "a killed run's folder must already be a bag"
+    channel = writer.add_topic(
+        "/chatter",
+        "std_msgs/msg/String",
+        message_definition("std_msgs/msg/String"),
+        offered_qos_profiles_yaml(QoSProfile(depth=7)),
+    )
+    payload = serialize_exact(String(data="hello"))
+    writer.write(channel, payload, 1_000, 1_000)
+    time.sleep(0.06)
+    writer.write(channel, payload, 2_000, 2_000)  # the interval has passed: the chunk is flushed
+    flushed = list(bag_reader.iter_messages(bag))
+    assert [m.log_time_ns for m in flushed] == [1_000, 2_000]
+    for index in range(3, 2_000):
+        writer.write(channel, payload, index * 1_000, index * 1_000)
+    writer.close()
+    writer.close()
+
+    with open(writer.mcap_path, "rb") as stream:
+        reader = make_reader(stream)
+        header = reader.get_header()
+        summary = reader.get_summary()
+        assert header.profile == "ros2"
+        assert header.library.startswith(f"linkage_kinematics/{package_version()} mcap-python/")
+        assert summary.statistics.message_count == 1_999
+        assert {index.compression for index in summary.chunk_indexes} == {"zstd"}
+        assert len(summary.chunk_indexes) >= 2
+        (schema,) = summary.schemas.values()
+        (channel_record,) = summary.channels.values()
+        assert (schema.name, schema.encoding) == ("std_msgs/msg/String", "ros2msg")
+        assert channel_record.message_encoding == "cdr"
+        assert yaml.safe_load(channel_record.metadata["offered_qos_profiles"])[0]["depth"] == 7
+        assert channel_record.metadata["topic_type_hash"].startswith("RIHS01_")
+        records = {record.name: record.metadata for record in reader.iter_metadata()}
+    assert records["linkage_kinematics"] == {"package_version": package_version(), "rate_hz": "200"}
+    rosbag2_record = yaml.safe_load(records["rosbag2"]["serialized_metadata"])
+    assert rosbag2_record["version"] == 9 and rosbag2_record["message_count"] == 1_999
+    information = bag_information(bag)
+    assert information["message_count"] == 1_999
+    assert information["custom_data"]["rate_hz"] == "200"
+
+
+def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
+    bag = tmp_path / "taken"
+    bag.mkdir()
+    (bag / "keep.txt").write_text("untouched")
+    with pytest.raises(BagExistsError, match=re.escape(str(bag))):
+        BagWriter(bag, metadata={})
+    assert [p.name for p in bag.iterdir()] == ["keep.txt"]
+    assert (bag / "keep.txt").read_text() == "untouched"
+
+
+def test_recorder_refuses_a_log_folder_under_a_regular_file(tmp_path: Path) -> None:
+    blocker = tmp_path / "afile"
+    blocker.write_text("")
+    with pytest.raises(OSError, match=re.escape(str(blocker / "bags"))):
+        Recorder(blocker / "bags", metadata={})
+
+
+# --- a real node run, read back by two independent readers ------------------------------------
+
+
+@pytest.fixture(scope="module")
+def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    run_folder = tmp_path_factory.mktemp("node_run")
+    folder = run_folder / "bags"
+    with ros_context(DOMAIN_ID) as context:
+        listener = listen_to_node_topics(context, "bag_test_listener")
+        process = start_node(
+            {"log.folder": str(folder), "rate_hz": RATE_HZ, "omega0": SHORT_RUN_OMEGA},
+            DOMAIN_ID,
+            run_folder / "node.log",
+        )
+        try:
+            assert listener.spin_until(stopped(process))
+            assert process.returncode == 0, (run_folder / "node.log").read_text()
+            listener.spin_until(lambda: len(listener.received["/diagnostics"]) >= 2, timeout=2.0)
+        finally:
+            stop_process(process)
+            listener.destroy()
+    return {"bag": only_bag(folder), "received": listener.received}
+
+
+def test_every_published_topic_is_logged_with_its_type(node_run: dict[str, Any]) -> None:
+    logged = read_with_rosbags(node_run["bag"])
+    assert set(logged) == set(NODE_TOPICS)
+    with Reader(node_run["bag"]) as reader:
+        types = {connection.topic: connection.msgtype for connection in reader.connections}
+    assert types == {topic: ros_type_name(msg_type) for topic, msg_type in NODE_TOPICS.items()}
+    assert len(logged["/linkage/state"]) == len(logged["/joint_states"]) >= 0.3 * RATE_HZ
+    assert len(logged["/robot_description"]) == 1
+
+
+def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any]) -> None:
+    logged = read_with_rosbags(node_run["bag"])
+    received = node_run["received"]
+    for topic in ("/linkage/state", "/joint_states", "/linkage/markers", "/diagnostics"):
+        assert received.get(topic), f"the listener received nothing on {topic}"
+        by_stamp = {message_stamp_ns(message): message for _, message, _ in logged[topic]}
+        for message in received[topic]:
+            logged_message = by_stamp[message_stamp_ns(message)]
+            if topic == "/linkage/state":
+                (point,) = message.points
+                (logged_point,) = logged_message.points
+                assert list(logged_message.joint_names) == list(message.joint_names)
+                for field in ("positions", "velocities", "accelerations"):
+                    assert list(getattr(logged_point, field)) == list(getattr(point, field))
+            elif topic == "/joint_states":
+                assert list(logged_message.position) == list(message.position)
+                assert list(logged_message.velocity) == list(message.velocity)
+            elif topic == "/linkage/markers":
+                assert [m.id for m in logged_message.markers] == [m.id for m in message.markers]
+                assert [(p.x, p.y) for m in logged_message.markers for p in m.points] == [
+                    (p.x, p.y) for m in message.markers for p in m.points
+                ]
+            else:
+                (status,) = message.status
+                (logged_status,) = logged_message.status
+                assert (logged_status.level, logged_status.message) == (
+                    int.from_bytes(status.level, "little"), status.message
+                )
+                assert {kv.key: kv.value for kv in logged_status.values} == {
+                    kv.key: kv.value for kv in status.values
+                }
+    (description,) = received["/robot_description"]
+    assert logged["/robot_description"][0][1].data == description.data
+
+
+def test_logged_states_are_the_library_solution_at_the_logged_alpha(
+    node_run: dict[str, Any],
+) -> None:
+    paper = preset("paper")
+    drive = DriveLaw(SHORT_RUN_OMEGA, 0.0)
+    states = read_with_rosbags(node_run["bag"])["/linkage/state"]
+    for _, message, _ in states:
+        (point,) = message.points
+        state = solve(paper.geometry, point.positions[0], drive)
+        expected_positions = [state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y,
+                              state.pin_b_x, state.pin_b_y]
+        expected_velocities = [state.omega, -state.omega_bc, state.omega_ab, state.velocity_a_x,
+                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y]
+        assert list(point.positions) == pytest.approx(expected_positions, rel=1e-12, abs=1e-12)
+        assert list(point.velocities) == pytest.approx(expected_velocities, rel=1e-12, abs=1e-12)
+    assert states[-1][1].points[0].positions[0] == pytest.approx(math.pi / 2, abs=1e-9)
+
+
+def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(
+    node_run: dict[str, Any],
+) -> None:
+    bag = node_run["bag"]
+    log_times = [message.log_time_ns for message in bag_reader.iter_messages(bag)]
+    assert log_times == sorted(log_times)
+    for topic, entries in read_with_rosbags(bag).items():
+        type_name = ros_type_name(NODE_TOPICS[topic])
+        for _, decoded, raw in entries:
+            assert len(raw) == len(TYPESTORE.serialize_cdr(decoded, type_name)), topic
+
+
+def test_mcap_ros2_decodes_every_message_with_the_logged_schemas(node_run: dict[str, Any]) -> None:
+    bag = node_run["bag"]
+    (mcap_path,) = bag.glob("*.mcap")
+    counts: dict[str, int] = defaultdict(int)
+    for decoded in read_ros2_messages(str(mcap_path)):
+        counts[decoded.channel.topic] += 1
+        assert decoded.schema.encoding == "ros2msg"
+        assert decoded.channel.message_encoding == "cdr"
+        assert decoded.schema.name == ros_type_name(NODE_TOPICS[decoded.channel.topic])
+        assert "offered_qos_profiles" in decoded.channel.metadata
+    assert dict(counts) == topic_counts(bag_information(bag))
+
+
+def test_run_metadata_holds_parameters_and_version(node_run: dict[str, Any]) -> None:
+    bag = node_run["bag"]
+    (mcap_path,) = bag.glob("*.mcap")
+    with open(mcap_path, "rb") as stream:
+        reader = make_reader(stream)
+        assert reader.get_header().profile == "ros2"
+        records = {record.name: record.metadata for record in reader.iter_metadata()}
+    run = records["linkage_kinematics"]
+    parameters = json.loads(run["parameters"])
+    assert parameters["rate_hz"] == RATE_HZ
+    assert parameters["omega0"] == SHORT_RUN_OMEGA
+    assert run["package_version"] == package_version()
+    assert bag_information(bag)["custom_data"] == run
+
+
+def test_metadata_yaml_is_rosbag2_jazzy_format(node_run: dict[str, Any]) -> None:
+    bag = node_run["bag"]
+    information = bag_information(bag)
+    (mcap_path,) = bag.glob("*.mcap")
+    assert information["version"] == 9
+    assert information["storage_identifier"] == "mcap"
+    assert information["relative_file_paths"] == [mcap_path.name]
+    assert information["compression_format"] == information["compression_mode"] == ""
+    assert information["ros_distro"] == "jazzy"
+    logged = read_with_rosbags(bag)
+    total = sum(len(entries) for entries in logged.values())
+    assert information["message_count"] == total
+    (file_entry,) = information["files"]
+    assert file_entry["path"] == mcap_path.name and file_entry["message_count"] == total
+    log_times = sorted(t for entries in logged.values() for t, _, _ in entries)
+    assert information["starting_time"]["nanoseconds_since_epoch"] == log_times[0]
+    assert information["duration"]["nanoseconds"] == log_times[-1] - log_times[0]
+    for entry in information["topics_with_message_count"]:
+        topic = entry["topic_metadata"]
+        assert topic["serialization_format"] == "cdr"
+        assert topic["type_description_hash"].startswith("RIHS01_")
+        (profile,) = topic["offered_qos_profiles"]
+        assert set(profile) == {
+            "history", "depth", "reliability", "durability", "deadline", "lifespan",
+            "liveliness", "liveliness_lease_duration", "avoid_ros_namespace_conventions",
+        }
+        expected_durability = (
+            "transient_local" if topic["name"] == "/robot_description" else "volatile"
+        )
+        assert (profile["reliability"], profile["durability"]) == ("reliable", expected_durability)
+        assert entry["message_count"] == len(logged[topic["name"]])
+
+
+# --- linkage-replay ---------------------------------------------------------------------------
+
+
+def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: Path) -> None:
+    bag = node_run["bag"]
+    logged = read_with_rosbags(bag)
+    with ros_context(DOMAIN_ID + 1) as context:
+        listener = listen_to_node_topics(context, "replay_test_listener")
+        with open(tmp_path / "replay.log", "w") as output:
+            replay = subprocess.Popen(
+                [sys.executable, "-m", "linkage_kinematics.replay", str(bag), "--rate", "10"],
+                cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 1), stdout=output,
+                stderr=subprocess.STDOUT,
+            )
+        try:
+            assert listener.spin_until(stopped(replay))
+            assert replay.returncode == 0, (tmp_path / "replay.log").read_text()
+            listener.spin_until(
+                lambda: len(listener.received["/linkage/state"]) == len(logged["/linkage/state"]),
+                timeout=2.0,
+            )
+        finally:
+            stop_process(replay)
+            listener.destroy()
+    received = listener.received
+    assert all(received[topic] for topic in NODE_TOPICS)
+    replayed_states = [
+        (stamp_ns(m), list(m.points[0].positions), list(m.points[0].accelerations))
+        for m in received["/linkage/state"]
+    ]
+    logged_states = [
+        (stamp_ns(m), list(m.points[0].positions), list(m.points[0].accelerations))
+        for _, m, _ in logged["/linkage/state"]
+    ]
+    assert replayed_states == logged_states
+    assert [list(m.position) for m in received["/joint_states"]] == [
+        list(m.position) for _, m, _ in logged["/joint_states"]
+    ]
+    assert received["/robot_description"][0].data == logged["/robot_description"][0][1].data
+
+
+def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path) -> None:
+    bag = node_run["bag"]
+    logged_states = len(read_with_rosbags(bag)["/linkage/state"])
+    with ros_context(DOMAIN_ID + 2) as context:
+        listener = Listener("replay_loop_listener", context)
+        listener.subscribe("/linkage/state", JointTrajectory)
+        with open(tmp_path / "replay.log", "w") as output:
+            replay = subprocess.Popen(
+                [sys.executable, "-m", "linkage_kinematics.replay", str(bag), "--loop",
+                 "--rate", "4", "--topics", "/linkage/state"],
+                cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 2), stdout=output,
+                stderr=subprocess.STDOUT,
+            )
+        try:
+            assert listener.spin_until(
+                lambda: len(listener.received["/linkage/state"]) > 2 * logged_states
+            )
+            replay.send_signal(signal.SIGINT)
+            assert replay.wait(timeout=10) == 0
+        finally:
+            stop_process(replay)
+            listener.destroy()
+    output_text = (tmp_path / "replay.log").read_text()
+    assert "Traceback" not in output_text and "published" in output_text
+    alphas = [message.points[0].positions[0] for message in listener.received["/linkage/state"]]
+    assert alphas.count(alphas[0]) >= 2  # the run started over
+
+
+def test_replay_rejects_bad_input_with_a_clear_message(
+    tmp_path: Path, node_run: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    not_mcap = tmp_path / "notes.mcap"
+    not_mcap.write_text("just text")
+    assert replay_main([str(tmp_path / "missing")]) == 1
+    assert "no bag at" in capsys.readouterr().err
+    assert replay_main([str(not_mcap)]) == 1
+    assert "not an MCAP file" in capsys.readouterr().err
+
+    cut = tmp_path / "cut"
+    cut.mkdir()
+    (source,) = node_run["bag"].glob("*.mcap")
+    (cut / source.name).write_bytes(source.read_bytes()[: source.stat().st_size // 2])
+    assert replay_main([str(cut / source.name)]) == 1
+    assert "--recover" in capsys.readouterr().err
+
+    foreign = tmp_path / "foreign"
+    writer = BagWriter(foreign, metadata={})
+    channel = writer.add_topic("/thing", "foreign_msgs/msg/Thing", "int32 x\n", "")
+    writer.write(channel, b"\x00\x01\x00\x00\x05\x00\x00\x00", 1, 1)
+    writer.close()
+    assert replay_main([str(foreign)]) == 1
+    error = capsys.readouterr().err
+    assert "foreign_msgs/msg/Thing" in error and "nothing to replay" in error
+
+    assert replay_main([str(node_run["bag"]), "--topics", "/nope"]) == 1
+    assert "/nope" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_info:
+        replay_main([str(node_run["bag"]), "--rate", "-2"])
+    assert exit_info.value.code == 2
+    assert "positive factor" in capsys.readouterr().err
+
+
+# --- the Foxglove layout --------------------------------------------------------------------
+
+
+def readme_topics() -> set[str]:
+    readme = (REPOSITORY / "README.md").read_text(encoding="utf-8")
+    return set(re.findall(r"^\| `(/[^`]+)` \|", readme, re.MULTILINE))
+
+
+def resolve_message_path(message: Any, path: str) -> float:
+    """Evaluate a Foxglove message path (after the topic) such as ``.points[0].positions[1]``."""
+    value = message
+    negate = False
+    for name, index in re.findall(r"\.(@?\w+)(?:\[(\d+)\])?", path):
+        if name == "@negative":
+            negate = True
+            continue
+        value = getattr(value, name)
+        if index:
+            value = value[int(index)]
+    return -value if negate else value
+
+
+def test_foxglove_layout_uses_only_contract_topics_and_valid_paths() -> None:
+    layout = json.loads((REPOSITORY / "foxglove/linkage_layout.json").read_text(encoding="utf-8"))
+    topics = readme_topics()
+    assert {"/linkage/state", "/linkage/markers", "/diagnostics"} <= topics
+    panels = layout["configById"]
+
+    def panel_ids(node: Any) -> list[str]:
+        if isinstance(node, str):
+            return [node]
+        return panel_ids(node["first"]) + panel_ids(node["second"])
+
+    assert sorted(panel_ids(layout["layout"])) == sorted(panels)
+    three_d = next(config for key, config in panels.items() if key.startswith("3D!"))
+    assert three_d["followTf"] == "linkage_base"
+    assert set(three_d["topics"]) == {"/linkage/markers"} <= topics
+    diagnostics = [c for key, c in panels.items() if key.startswith("Diagnostic")]
+    assert diagnostics and all(c["topicToRender"] == "/diagnostics" for c in diagnostics)
+
+    paper = preset("paper")
+    state = solve(paper.geometry, 0.4, DriveLaw(2.0, 2.3))
+    trajectory = messages.linkage_state(state, messages.time_msg(0), 0.0, "linkage_base")
+    plotted = {}
+    for key, config in panels.items():
+        if not key.startswith("Plot!"):
+            continue
+        for entry in config["paths"]:
+            topic, _, rest = entry["value"].partition(".")
+            assert topic in topics, entry["value"]
+            plotted[entry["label"]] = resolve_message_path(trajectory, "." + rest)
+    assert plotted == {
+        "α": state.alpha, "β": state.beta, "γ": state.gamma,
+        "ω": state.omega, "ω_AB": state.omega_ab, "ω_BC": state.omega_bc,
+        "ω̇": state.omega_dot, "ω̇_AB": state.omega_dot_ab, "ω̇_BC": state.omega_dot_bc,
+    }

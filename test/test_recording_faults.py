@@ -1,0 +1,240 @@
+"""What the node's log survives: SIGKILL (and the documented recovery), SIGINT/SIGTERM, a log
+folder that cannot be created, a bag name already taken, and a disk that fills during the run."""
+from __future__ import annotations
+
+import hashlib
+import resource
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from diagnostic_msgs.msg import DiagnosticStatus
+from mcap.exceptions import EndOfFile
+from mcap.reader import make_reader
+from mcap.records import Message
+from mcap.stream_reader import StreamReader
+from rosbags.rosbag2 import Reader
+
+from linkage_kinematics import bag_reader
+from node_process import (
+    REPOSITORY,
+    ros_context,
+    ros_environment,
+    run_node,
+    start_node,
+    stop_process,
+)
+from test_bag_writer import (
+    NODE_TOPICS,
+    TYPESTORE,
+    bag_information,
+    listen_to_node_topics,
+    only_bag,
+    read_with_rosbags,
+    stopped,
+    topic_counts,
+)
+
+LOOP_PARAMETERS = {"rate_hz": 200.0, "end_behavior": "loop"}
+# Flush interval (1 s) plus one tick and scheduling slack.
+MAX_LOSS_AT_KILL_NS = 1_500_000_000
+FILE_SIZE_LIMIT_BYTES = 256 * 1024
+
+
+def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0) -> Path:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        mcap_files = list(folder.glob("*/*.mcap"))
+        if mcap_files:
+            return mcap_files[0].parent
+        assert process.poll() is None, f"the node ended with status {process.returncode}"
+        time.sleep(0.05)
+    raise AssertionError(f"no bag appeared in {folder}")
+
+
+def stream_message_count(mcap_path: Path) -> int:
+    """Messages an mcap streaming reader (no summary needed) gets from a file cut at a chunk end."""
+    count = 0
+    with open(mcap_path, "rb") as stream:
+        try:
+            for record in StreamReader(stream, validate_crcs=True).records:
+                count += isinstance(record, Message)
+        except EndOfFile:
+            pass  # a killed recorder's file ends after its last complete chunk, without footer
+    return count
+
+
+def recover(bag: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "linkage_kinematics.replay", "--recover", str(bag)],
+        cwd=REPOSITORY, env=ros_environment(35), capture_output=True, text=True, timeout=60,
+    )
+
+
+def test_sigkill_keeps_complete_chunks_and_recovery_completes_the_bag(tmp_path: Path) -> None:
+    folder = tmp_path / "bags"
+    process = start_node({**LOOP_PARAMETERS, "log.folder": str(folder)}, 35, tmp_path / "node.log")
+    try:
+        bag = wait_for_bag(folder, process)
+        time.sleep(2.5)
+        killed_at_ns = time.time_ns()
+        process.kill()
+        process.wait(timeout=10)
+    finally:
+        stop_process(process)
+
+    (mcap_file,) = bag_reader.bag_files(bag)
+    assert mcap_file.truncated
+    survivors = list(bag_reader.iter_messages(bag))
+    assert len(survivors) == stream_message_count(mcap_file.path)
+    assert {message.topic for message in survivors} == set(NODE_TOPICS)
+    for message in survivors:
+        TYPESTORE.deserialize_cdr(message.data, message.schema_name)
+    assert 0 <= killed_at_ns - survivors[-1].log_time_ns < MAX_LOSS_AT_KILL_NS
+
+    recovery = recover(bag)
+    assert recovery.returncode == 0, recovery.stderr
+    assert f"({len(survivors)} messages)" in recovery.stdout
+    with open(mcap_file.path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics.message_count == len(survivors)
+    logged = read_with_rosbags(bag)
+    assert sum(len(entries) for entries in logged.values()) == len(survivors)
+    information = bag_information(bag)
+    assert information["message_count"] == len(survivors)
+    assert topic_counts(information) == {topic: len(entries) for topic, entries in logged.items()}
+    assert [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(bag)] == [
+        (m.topic, m.data, m.log_time_ns) for m in survivors
+    ]
+    assert information["custom_data"]["parameters"]
+
+
+@pytest.mark.parametrize("stop_signal", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal.Signals) -> None:
+    folder = tmp_path / "bags"
+    process = start_node({**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log")
+    try:
+        bag = wait_for_bag(folder, process)
+        time.sleep(1.0)
+        process.send_signal(stop_signal)
+        assert process.wait(timeout=20) == 0, (tmp_path / "node.log").read_text()
+    finally:
+        stop_process(process)
+
+    (mcap_file,) = bag_reader.bag_files(bag)
+    assert mcap_file.complete
+    with open(mcap_file.path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    logged = read_with_rosbags(bag)
+    information = bag_information(bag)
+    total = sum(len(entries) for entries in logged.values())
+    assert summary.statistics.message_count == information["message_count"] == total > 0
+    counts = topic_counts(information)
+    assert counts == {topic: len(entries) for topic, entries in logged.items()}
+    assert set(counts) == set(NODE_TOPICS)
+
+
+def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(tmp_path: Path) -> None:
+    # chmod does not stop root; a path under a regular file fails for everyone.
+    blocker = tmp_path / "afile"
+    blocker.write_text("not a folder")
+    folder = blocker / "bags"
+    with ros_context(37) as context:
+        listener = listen_to_node_topics(context, "unwritable_folder_listener")
+        process = start_node(
+            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 37, tmp_path / "node.log"
+        )
+        try:
+            assert listener.spin_until(stopped(process))
+            listener.spin_until(lambda: False, timeout=1.0)  # anything published arrives by now
+        finally:
+            stop_process(process)
+            listener.destroy()
+    output = (tmp_path / "node.log").read_text()
+    assert process.returncode != 0
+    assert str(folder) in output
+    assert "Traceback" not in output
+    assert all(not messages for messages in listener.received.values())
+    assert blocker.read_text() == "not a folder"
+
+
+def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_path: Path) -> None:
+    folder = tmp_path / "bags"
+    folder.mkdir()
+    now = time.time()
+    taken = {}
+    # Every name the node could pick in the next seconds is already a bag.
+    for offset in range(-2, 30):
+        name = time.strftime("rosbag2_%Y_%m_%d-%H_%M_%S", time.localtime(now + offset))
+        bag = folder / name
+        bag.mkdir(exist_ok=True)
+        (bag / f"{name}_0.mcap").write_bytes(hashlib.sha256(name.encode()).digest() * 64)
+        (bag / "metadata.yaml").write_text(f"old run {name}\n")
+        taken[name] = {p.name: p.read_bytes() for p in bag.iterdir()}
+    status, output = run_node(
+        {"log.folder": str(folder), "rate_hz": 200.0, "omega0": 10.0}, 38, tmp_path / "node.log"
+    )
+    assert status == 0, output
+
+    new_bags = [path for path in folder.iterdir() if path.name not in taken]
+    assert len(new_bags) == 1
+    (new_bag,) = new_bags
+    assert new_bag.name.removesuffix("_1") in taken and new_bag.name.endswith("_1")
+    assert read_with_rosbags(new_bag)["/linkage/state"]
+    for name, files in taken.items():
+        assert {p.name: p.read_bytes() for p in (folder / name).iterdir()} == files
+
+
+def _limit_file_size() -> None:
+    # Writes past the limit then fail with EFBIG instead of killing the process with SIGXFSZ.
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_SIZE_LIMIT_BYTES, FILE_SIZE_LIMIT_BYTES))
+
+
+def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path: Path) -> None:
+    folder = tmp_path / "bags"
+
+    def recording_failed(got: dict) -> bool:
+        return any(
+            status.level == DiagnosticStatus.ERROR and "recording" in status.message
+            for array in got.get("/diagnostics", [])
+            for status in array.status
+        )
+
+    with ros_context(39) as context:
+        listener = listen_to_node_topics(context, "full_disk_listener")
+        process = start_node(
+            {"log.folder": str(folder), "rate_hz": 1000.0, "end_behavior": "loop"},
+            39,
+            tmp_path / "node.log",
+            preexec_fn=_limit_file_size,
+        )
+        try:
+            assert listener.spin_until(lambda: recording_failed(listener.received))
+            states_at_failure = len(listener.received["/linkage/state"])
+            assert listener.spin_until(
+                lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200,
+                timeout=10.0,
+            )
+            process.send_signal(signal.SIGINT)
+            process.wait(timeout=20)
+        finally:
+            stop_process(process)
+            listener.destroy()
+    output = (tmp_path / "node.log").read_text()
+    assert "File too large" in output and "Traceback" not in output
+
+    bag = only_bag(folder)
+    (mcap_file,) = bag_reader.bag_files(bag)
+    assert mcap_file.size <= FILE_SIZE_LIMIT_BYTES
+    kept = list(bag_reader.iter_messages(bag))
+    assert len(kept) == bag_information(bag)["message_count"] > 0
+    for message in kept:
+        TYPESTORE.deserialize_cdr(message.data, message.schema_name)
+    recovery = recover(bag)
+    assert recovery.returncode == 0, recovery.stderr
+    with Reader(bag) as reader:
+        assert reader.message_count == len(kept)
