@@ -1,0 +1,362 @@
+"""Section 3: the node: cost per tick, sustained rate, jitter, latency, log size, memory.
+
+Nodes run as the tests run them (``python -m linkage_kinematics.node --ros-args ...`` in their
+own process, real Fast DDS over loopback, real MCAP logs); the cost split runs the node's own
+objects in this process so each part can be timed alone, next to a bare rclpy publisher.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import pathlib
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from typing import Any
+
+from timing import format_seconds, interleaved_medians, markdown_table
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+LISTENER = pathlib.Path(__file__).resolve().parent / "listener.py"
+# ROS_DOMAIN_IDs of this benchmark (50–59), one per kind of run so none sees another's nodes.
+DOMAIN_SPLIT, DOMAIN_RATE, DOMAIN_TIMING, DOMAIN_LOG, DOMAIN_MEMORY = 50, 51, 52, 53, 54
+STARTUP_S = 4.0  # time for a node process to start, discover and settle before measuring
+
+
+def ros_environment(domain: int) -> dict[str, str]:
+    environment = dict(os.environ)
+    environment.update({
+        "ROS_DOMAIN_ID": str(domain),
+        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+        "AMENT_PREFIX_PATH": str(ROOT / ".venv"),
+    })
+    return environment
+
+
+def start_node(parameters: dict[str, str], domain: int) -> subprocess.Popen:
+    arguments = [sys.executable, "-m", "linkage_kinematics.node", "--ros-args"]
+    for name, value in parameters.items():
+        arguments += ["-p", f"{name}:={value}"]
+    return subprocess.Popen(arguments, cwd=ROOT, env=ros_environment(domain),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+
+
+def stop(process: subprocess.Popen) -> None:
+    """SIGINT (the node finalizes its log), then wait; kill only if it hangs."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+    try:
+        process.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+
+
+def listen(seconds: float, topics: list[str], domain: int) -> tuple[subprocess.Popen, str]:
+    output = tempfile.mktemp(suffix=".json", prefix="linkage_bench_")
+    process = subprocess.Popen([sys.executable, str(LISTENER), output, str(seconds), *topics],
+                               cwd=ROOT, env=ros_environment(domain),
+                               stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    process.stdout.readline()  # "listening"
+    return process, output
+
+
+def collect(process: subprocess.Popen, output: str) -> dict[str, Any]:
+    process.wait(timeout=120)
+    with open(output, encoding="utf-8") as file:
+        data = json.load(file)
+    os.unlink(output)
+    return data
+
+
+def rss_mib(pid: int) -> float:
+    with open(f"/proc/{pid}/status", encoding="utf-8") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    raise RuntimeError(f"no VmRSS for process {pid}")
+
+
+def bag_figures(folder: pathlib.Path) -> tuple[int, int]:
+    """(bytes of every file of the one bag in ``folder``, messages it holds)."""
+    from mcap.reader import make_reader
+
+    bags = [path for path in folder.iterdir() if path.is_dir()]
+    if len(bags) != 1:
+        raise RuntimeError(f"expected one bag in {folder}, found {len(bags)}")
+    size = sum(path.stat().st_size for path in bags[0].iterdir())
+    messages = 0
+    for path in bags[0].glob("*.mcap"):
+        with open(path, "rb") as file:
+            summary = make_reader(file).get_summary()
+            messages += summary.statistics.message_count
+    return size, messages
+
+
+# --- memory ---------------------------------------------------------------------------------
+
+def memory_run(minutes: float) -> str:
+    """Resident memory of a 1 kHz node, logging on, from start to ``minutes`` later."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_memory_") as folder:
+        node = start_node({"rate_hz": "1000.0", "end_behavior": "loop",
+                           "log.folder": folder}, DOMAIN_MEMORY)
+        try:
+            time.sleep(STARTUP_S)
+            start = time.monotonic()
+            samples = [(0.0, rss_mib(node.pid))]
+            interval = min(30.0, minutes * 60.0 / 10.0)
+            while time.monotonic() - start < minutes * 60.0:
+                time.sleep(interval)
+                if node.poll() is not None:
+                    raise RuntimeError(f"the node exited early: {node.stderr.read()}")
+                samples.append((time.monotonic() - start, rss_mib(node.pid)))
+        finally:
+            stop(node)
+        size, messages = bag_figures(pathlib.Path(folder))
+    elapsed = samples[-1][0]
+    half = [rss for seconds, rss in samples if seconds >= elapsed / 2.0]
+    rows = [[f"{seconds:.0f} s", f"{rss:.1f} MiB"] for seconds, rss in samples]
+    table = markdown_table(["time since start (after {:.0f} s warm-up)".format(STARTUP_S),
+                            "resident memory"], rows)
+    return (
+        f"{table}\n\nResident memory: {samples[0][1]:.1f} MiB at start, {samples[-1][1]:.1f} MiB "
+        f"after {elapsed / 60.0:.1f} min (growth {samples[-1][1] - samples[0][1]:+.1f} MiB; "
+        f"{max(half) - min(half):.1f} MiB spread over the second half). The run's log: "
+        f"{size / 1e6:.1f} MB, {messages} messages, {size / (elapsed + STARTUP_S) / 1e3:.0f} kB/s."
+    )
+
+
+# --- cost per tick, in this process ---------------------------------------------------------
+
+def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
+    """Median time of each part of the node's tick and of a bare rclpy publish, side by side.
+
+    A listener in another process subscribes to /joint_states and to the bare publisher's
+    topic, so both publishes really send over loopback.
+    """
+    os.environ.update(ros_environment(DOMAIN_SPLIT))
+    import rclpy
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
+
+    from linkage_kinematics import messages
+    from linkage_kinematics.kinematics import solve
+    from linkage_kinematics.node import LinkageNode, sample_at_time, solve_sample
+
+    count = 300 if quick else 1500
+    listener, output = listen(60.0, ["/joint_states", "/bench/joint_states"], DOMAIN_SPLIT)
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_split_") as folder:
+        rclpy.init()
+        nodes = []
+        try:
+            logging_node = LinkageNode(parameter_overrides=[
+                Parameter("rate_hz", value=1000.0), Parameter("end_behavior", value="loop"),
+                Parameter("log.folder", value=folder)])
+            nodes.append(logging_node)
+            quiet_node = LinkageNode(parameter_overrides=[
+                Parameter("rate_hz", value=1000.0), Parameter("end_behavior", value="loop"),
+                Parameter("log.enabled", value=False)])
+            nodes.append(quiet_node)
+            bare_node = rclpy.create_node("bench_bare_publisher")
+            nodes.append(bare_node)
+            bare_publisher = bare_node.create_publisher(JointState, "/bench/joint_states", 10)
+            config = logging_node.config
+            recorder = logging_node._recorder
+            publishers = logging_node._topic_publishers
+            clock = logging_node.get_clock()
+            elapsed = [i * 1e-3 for i in range(count)]
+            samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
+            state = solve_sample(config, samples[0])
+            stamp = clock.now().to_msg()
+            joint_state = messages.joint_state(state, stamp)
+            trajectory = messages.linkage_state(state, stamp, 0.0, config.frame_id)
+            bare_message = messages.joint_state(state, stamp)
+            time.sleep(STARTUP_S)  # let the listener match both publishers
+
+            def compute() -> int:
+                for sample in samples:
+                    solve_sample(config, sample)
+                return count
+
+            def solve_only() -> int:
+                for sample in samples:
+                    solve(config.linkage, sample.alpha, config.drive, config.branch)
+                return count
+
+            def build() -> int:
+                nonlocal joint_state, trajectory
+                for _ in range(count):
+                    now = clock.now()
+                    stamp = now.to_msg()
+                    joint_state = messages.joint_state(state, stamp, joint_state.position,
+                                                       out=joint_state)
+                    trajectory = messages.linkage_state(state, stamp, 0.0, config.frame_id,
+                                                        out=trajectory)
+                return count
+
+            def publish() -> int:
+                for _ in range(count):
+                    publishers["/joint_states"].publish(joint_state)
+                    publishers["/linkage/state"].publish(trajectory)
+                return count
+
+            def record() -> int:
+                for index in range(count):
+                    recorder.record("/joint_states", joint_state, index)
+                    recorder.record("/linkage/state", trajectory, index)
+                return count
+
+            def tick(node: LinkageNode) -> int:
+                for _ in range(count):
+                    node._tick()
+                return count
+
+            def bare() -> int:
+                for _ in range(count):
+                    bare_publisher.publish(bare_message)
+                return count
+
+            parts = {
+                "compute: sample_at_time + solve_sample (kinematics.solve)": compute,
+                "  of which kinematics.solve alone": solve_only,
+                "build: messages.joint_state + messages.linkage_state": build,
+                "publish: /joint_states + /linkage/state": publish,
+                "log: Recorder.record of both messages": record,
+                "whole tick, logging on (LinkageNode._tick)": lambda: tick(logging_node),
+                "whole tick, logging off (LinkageNode._tick)": lambda: tick(quiet_node),
+                "bare rclpy publish of the same JointState": bare,
+            }
+            times = interleaved_medians(parts, repetitions)
+        finally:
+            for node in nodes:
+                if isinstance(node, LinkageNode):
+                    node.close_log()
+                node.destroy_node()
+            rclpy.try_shutdown()
+    stop(listener)
+    if os.path.exists(output):
+        os.unlink(output)
+    bare_time = times["bare rclpy publish of the same JointState"]
+    rows = [[name, format_seconds(seconds), f"{seconds / bare_time:.2f}×"]
+            for name, seconds in times.items()]
+    table = markdown_table(["part of a tick", "time (median)", "× bare publish"], rows)
+    return table, times
+
+
+# --- rates, jitter, latency and log size from node processes --------------------------------
+
+def _percentile(values: list[float], fraction: float) -> float:
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
+
+
+def observe(parameters: dict[str, str], seconds: float, domain: int) -> dict[str, Any]:
+    """Run a node with ``parameters`` and a listener on /joint_states for ``seconds``."""
+    node = start_node({"end_behavior": "loop", **parameters}, domain)
+    try:
+        time.sleep(STARTUP_S)
+        listener, output = listen(seconds, ["/joint_states"], domain)
+        data = collect(listener, output)
+    finally:
+        stop(node)
+    return data
+
+
+def sustained_rate(rate: float, logging: bool, seconds: float) -> tuple[float, int]:
+    """Fraction of ticks missed (1 − achieved/requested over the node's diagnostics windows
+    after the first) and the node's missed-deadline count."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_rate_") as folder:
+        data = observe({"rate_hz": f"{rate:.1f}", "log.enabled": str(logging).lower(),
+                        "log.folder": folder}, seconds, DOMAIN_RATE)
+    # the first window may still hold the listener's start-up
+    windows = [float(d["achieved rate (Hz)"]) for d in data["diagnostics"]
+               if "achieved rate (Hz)" in d][1:]
+    missed = max((int(d["missed deadlines"]) for d in data["diagnostics"]
+                  if "missed deadlines" in d), default=-1)
+    if not windows:
+        return math.nan, missed
+    return max(0.0, 1.0 - statistics.mean(windows) / rate), missed
+
+
+def timing_figures(rate: float, seconds: float) -> dict[str, float]:
+    """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_timing_") as folder:
+        data = observe({"rate_hz": f"{rate:.1f}", "log.folder": folder}, seconds,
+                       DOMAIN_TIMING)
+    samples = data["received"]["/joint_states"]
+    stamps = [stamp for stamp, _ in samples]
+    period_ns = 1e9 / rate
+    jitter = [abs((later - earlier) - period_ns) * 1e-9
+              for earlier, later in zip(stamps, stamps[1:])]
+    latency = [(arrival - stamp) * 1e-9 for stamp, arrival in samples]
+    expected = (stamps[-1] - stamps[0]) / period_ns + 1
+    return {
+        "received": len(samples), "expected": expected,
+        "jitter_p50": _percentile(jitter, 0.5), "jitter_p99": _percentile(jitter, 0.99),
+        "latency_p50": _percentile(latency, 0.5), "latency_p99": _percentile(latency, 0.99),
+    }
+
+
+def log_size(seconds: float) -> tuple[float, float, int]:
+    """(bytes per second, bytes per message, messages) of a run at the default settings."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_log_") as folder:
+        node = start_node({"end_behavior": "loop", "log.folder": folder}, DOMAIN_LOG)
+        started = time.monotonic()
+        time.sleep(seconds)
+        stop(node)
+        elapsed = time.monotonic() - started
+        size, messages = bag_figures(pathlib.Path(folder))
+    return size / elapsed, size / messages, messages
+
+
+def _rate_text(rate: float | None) -> str:
+    return "none of the rates tried" if rate is None else f"{rate:g} Hz"
+
+
+def run(quick: bool, repetitions: int) -> str:
+    """The node section as markdown."""
+    split, times = tick_split(quick, repetitions)
+    ratio = (times["whole tick, logging on (LinkageNode._tick)"]
+             / times["bare rclpy publish of the same JointState"])
+    lines = ["Cost per tick (one process; a listener in another process subscribes to "
+             "/joint_states and the bare topic):", "", split, "",
+             f"- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: "
+             f"{'met' if ratio <= 2.0 else 'missed'})", ""]
+    seconds = 4.0 if quick else 8.0
+    rates = (100.0, 500.0, 1000.0) if quick else (100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0)
+    rows = []
+    sustained: dict[bool, float | None] = {True: None, False: None}
+    for logging in (True, False):
+        for rate in rates:
+            fraction, missed = sustained_rate(rate, logging, seconds)
+            rows.append([f"{rate:g} Hz", "on" if logging else "off",
+                         f"{100.0 * fraction:.2f} %", str(missed)])
+            if fraction < 0.01:
+                sustained[logging] = max(sustained[logging] or 0.0, rate)
+    lines += [f"Sustained rate ({seconds:g} s per run, missed share from the node's "
+              "/diagnostics achieved rate):", "",
+              markdown_table(["timer rate", "logging", "ticks missed", "missed deadlines "
+                              "(node's count)"], rows), "",
+              f"- highest rate tried with < 1 % missed: {_rate_text(sustained[True])} with "
+              f"logging, {_rate_text(sustained[False])} without", ""]
+    rows = []
+    for rate in (100.0, 1000.0):
+        figures = timing_figures(rate, seconds)
+        rows.append([f"{rate:g} Hz", format_seconds(figures["jitter_p50"]),
+                     format_seconds(figures["jitter_p99"]), format_seconds(figures["latency_p50"]),
+                     format_seconds(figures["latency_p99"]),
+                     f"{figures['received']} of {figures['expected']:.0f}"])
+    lines += ["Timer jitter (|interval between header stamps − period|) and latency (listener "
+              "receive time − header stamp, another process), logging on:", "",
+              markdown_table(["rate", "jitter p50", "jitter p99", "latency p50", "latency p99",
+                              "messages received"], rows), ""]
+    per_second, per_message, messages = log_size(seconds + 2.0)
+    lines.append(f"Log at the default settings (100 Hz state, 30 Hz markers, 1 Hz "
+                 f"diagnostics): {per_second / 1e3:.1f} kB/s, {per_message:.0f} B per message "
+                 f"({messages} messages in {seconds + 2.0:g} s).")
+    return "\n".join(lines)

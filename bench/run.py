@@ -1,0 +1,79 @@
+"""The benchmark report: ``./dev bench`` (= ``python bench/run.py``) from the repository root.
+
+Sections: kinematics (cost per configuration against error), drive (the drive law in time),
+node (the ROS node's tick, rates, jitter, latency and log size) and memory (the node's resident
+memory over a long 1 kHz run). Every section prints markdown tables for docs/benchmarks.md;
+the kinematics section also draws docs/benchmark_speed_error.png.
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+# The high-precision reference lives with the tests; the library is imported from the tree.
+sys.path[1:1] = [str(ROOT), str(ROOT / "test")]
+
+from timing import machine_description  # noqa: E402
+
+SECTIONS = ("kinematics", "drive", "node", "memory")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true",
+                        help="fewer angles, shorter timings and node runs (about a minute)")
+    parser.add_argument("--repetitions", type=int, default=None,
+                        help="timing repetitions per method (default 7, 5 with --quick)")
+    parser.add_argument("--only", choices=SECTIONS, action="append",
+                        help="run only this section (may be repeated)")
+    parser.add_argument("--plot", default=str(ROOT / "docs" / "benchmark_speed_error.png"),
+                        help="where to write the speed-against-error plot")
+    parser.add_argument("--memory-minutes", type=float, default=None,
+                        help="length of the node's resident-memory run at 1 kHz "
+                             "(default 10, 0.5 with --quick)")
+    arguments = parser.parse_args(argv)
+    if arguments.repetitions is not None and arguments.repetitions < 1:
+        parser.error("--repetitions must be at least 1")
+    repetitions = arguments.repetitions or (5 if arguments.quick else 7)
+    sections = arguments.only or SECTIONS
+    started = time.perf_counter()
+    print(f"machine: {machine_description()}")
+    print(f"command: python bench/run.py {' '.join(sys.argv[1:])}".rstrip())
+    if "kinematics" in sections:
+        import kinematics_bench
+
+        table, results = kinematics_bench.run(arguments.quick, repetitions)
+        print("\n## Kinematics: time per configuration and largest error\n")
+        print(table)
+        print()
+        print(kinematics_bench.goals(results))
+        kinematics_bench.plot(results, arguments.plot)
+        print(f"\nplot written to {arguments.plot}")
+    if "drive" in sections:
+        import drive_bench
+
+        print("\n## Drive law in time\n")
+        print(drive_bench.run(arguments.quick, repetitions))
+    if "node" in sections:
+        import node_bench
+
+        print("\n## Node\n")
+        print(node_bench.run(arguments.quick, repetitions))
+    if "memory" in sections:
+        import node_bench
+
+        minutes = arguments.memory_minutes
+        if minutes is None:
+            minutes = 0.5 if arguments.quick else 10.0
+        print(f"\n## Node memory over {minutes:g} min at 1 kHz\n")
+        print(node_bench.memory_run(minutes))
+    print(f"\nbenchmark took {time.perf_counter() - started:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
