@@ -109,27 +109,25 @@ _ARRAY_MATH: MathFunctions = (np.sin, np.cos, np.sqrt, np.arctan2)
 _CHUNK = 8192
 
 
-def _closed_form(
-    linkage: FourBar, branch: int, alpha: FloatOrArray, drive: DriveLaw, xp: MathFunctions
+def _loop_closure(
+    linkage: FourBar, branch: int, alpha: FloatOrArray, xp: MathFunctions
 ) -> tuple[FloatOrArray, ...]:
-    """Evaluate the closed form: the 22 LinkageState fields in order, then the signed sine S.
+    """Positions by loop closure: sin α, cos α, pin A, the vectors A→B and C→B, and S.
 
     ``xp`` is (sin, cos, sqrt, atan2) from ``math`` or ``numpy``. The caller has checked that
     every α is reachable; h² is clamped at 0 so that an α on an interval end (rounding may put
     it a hair outside) lands exactly on the dead point.
     """
-    sin, cos, sqrt, atan2 = xp
+    sin, cos, sqrt, _ = xp
     crank = linkage.crank_length
     coupler = linkage.coupler_length
     rocker = linkage.rocker_length
-    ground_x = linkage.ground_x
-    ground_y = linkage.ground_y
     sin_alpha = sin(alpha)
     cos_alpha = cos(alpha)
     pin_a_x = crank * sin_alpha
     pin_a_y = -crank * cos_alpha
-    to_c_x = ground_x - pin_a_x
-    to_c_y = ground_y - pin_a_y
+    to_c_x = linkage.ground_x - pin_a_x
+    to_c_y = linkage.ground_y - pin_a_y
     distance = sqrt(to_c_x * to_c_x + to_c_y * to_c_y)
     u_x = to_c_x / distance
     u_y = to_c_y / distance
@@ -148,11 +146,25 @@ def _closed_form(
     coupler_y = along * u_y + height * u_x
     rocker_x = rocker_along * u_x - height * u_y
     rocker_y = rocker_along * u_y + height * u_x
+    sine = height * distance / (coupler * rocker)
+    return sin_alpha, cos_alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y, sine
+
+
+def _closed_form(
+    linkage: FourBar, branch: int, alpha: FloatOrArray, drive: DriveLaw, xp: MathFunctions
+) -> tuple[FloatOrArray, ...]:
+    """Evaluate the closed form: the 22 LinkageState fields in order, then the signed sine S."""
+    atan2 = xp[3]
+    crank = linkage.crank_length
+    coupler = linkage.coupler_length
+    rocker = linkage.rocker_length
+    (
+        sin_alpha, cos_alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y, sine
+    ) = _loop_closure(linkage, branch, alpha, xp)
     e_ab_x = coupler_x / coupler
     e_ab_y = coupler_y / coupler
     e_bc_x = rocker_x / rocker
     e_bc_y = rocker_y / rocker
-    sine = height * distance / (coupler * rocker)
     cosine = e_ab_x * e_bc_x + e_ab_y * e_bc_y
 
     omega = drive.omega0 + drive.k * alpha
@@ -189,8 +201,8 @@ def _closed_form(
         omega_dot_bc,
         pin_a_x,
         pin_a_y,
-        ground_x + rocker_x,
-        ground_y + rocker_y,
+        linkage.ground_x + rocker_x,
+        linkage.ground_y + rocker_y,
         velocity_a_x,
         velocity_a_y,
         -omega_bc * rocker_y,
@@ -219,8 +231,8 @@ def _dead_point_message(alpha: float, sine: float) -> str:
 def solve(linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1) -> LinkageState:
     """The exact state at one crank angle (the node's hot path).
 
-    Raises UnreachableError outside the reachable set and DeadPointError at a dead point; the
-    state returned never holds NaN or inf.
+    Raises UnreachableError outside the reachable set and DeadPointError at a dead point (where
+    ``solve_pose`` still gives the positions); the state returned never holds NaN or inf.
     """
     if not math.isfinite(alpha):
         raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
@@ -262,6 +274,50 @@ def solve(linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1) -> L
     ) = values
     object.__setattr__(state, "__class__", LinkageState)
     return state
+
+
+@dataclass(frozen=True, slots=True)
+class LinkagePose:
+    """Where the links are at one crank angle: what is still defined at a dead point."""
+
+    alpha: float
+    beta: float
+    gamma: float
+    pin_a_x: float
+    pin_a_y: float
+    pin_b_x: float
+    pin_b_y: float
+    transmission_angle: float
+
+
+def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
+    """The positions alone at one crank angle, at a dead point too (where ``solve`` raises).
+
+    Raises UnreachableError outside the reachable set. Near a dead point the angles keep the
+    accuracy docs/kinematics.md gives (their error grows as 1/√δ, δ the distance from it).
+    """
+    if not math.isfinite(alpha):
+        raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
+    _check_branch(branch)
+    linkage.reachability.require(alpha)
+    (
+        _, _, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y, sine
+    ) = _loop_closure(linkage, branch, alpha, _SCALAR_MATH)
+    coupler = linkage.coupler_length
+    rocker = linkage.rocker_length
+    cosine = (
+        (coupler_x / coupler) * (rocker_x / rocker) + (coupler_y / coupler) * (rocker_y / rocker)
+    )
+    return LinkagePose(
+        alpha=alpha,
+        beta=math.atan2(rocker_y, -rocker_x),
+        gamma=math.atan2(coupler_y, coupler_x),
+        pin_a_x=pin_a_x,
+        pin_a_y=pin_a_y,
+        pin_b_x=linkage.ground_x + rocker_x,
+        pin_b_y=linkage.ground_y + rocker_y,
+        transmission_angle=math.atan2(abs(sine), cosine),
+    )
 
 
 def solve_many(

@@ -23,6 +23,7 @@ from linkage_kinematics.kinematics import (
     LinkageState,
     solve,
     solve_many,
+    solve_pose,
 )
 
 # Near a dead point (measured worst: 5.7e-16/√δ, 4.7e-16/δ, 1.4e-15/δ).
@@ -254,3 +255,49 @@ def test_unwrapped_sweep_is_continuous() -> None:
         assert np.max(jumps) <= 1.01 * largest_slope * step, name
     # β of a crank-rocker stays inside its swing: no wrap, so no jump at all
     assert np.max(np.abs(np.diff(states.beta))) <= 1.01 * np.max(np.abs(states.omega_bc / 2)) * step
+
+
+POSE_FIELDS = ("alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y",
+               "transmission_angle")
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.3, 1.0, math.pi / 2, 3.0])
+@pytest.mark.parametrize("branch", [1, -1])
+def test_pose_is_the_full_state_s_positions(alpha: float, branch: int) -> None:
+    pose = solve_pose(PAPER, alpha, branch)
+    state = solve(PAPER, alpha, CONSTANT, branch)
+    for name in POSE_FIELDS:
+        assert getattr(pose, name) == getattr(state, name), name
+
+
+@pytest.mark.parametrize("offset", [0.0, 1e-15, 1e-12, 1e-9])
+def test_positions_stay_exact_where_the_rates_are_singular(offset: float) -> None:
+    """Where solve() reports a dead point, solve_pose() still places the links: the loop
+    closes, the branch is kept, and the angles meet the documented 1/√δ bound."""
+    for dead, side in paper_dead_points():
+        alpha = float(dead + side * offset)
+        with pytest.raises(DeadPointError):
+            solve(PAPER, alpha, CONSTANT)
+        pose = solve_pose(PAPER, alpha)
+        for name in POSE_FIELDS:
+            assert math.isfinite(getattr(pose, name)), name
+        assert kinematics.loop_closure_residual(PAPER, pose) <= 1e-12
+        delta = abs(float(mpf(alpha) - dead))
+        # Coupler and rocker collinear: μ is 0 (folded) or π (stretched) up to ~√(2.5·δ), plus
+        # what rounding leaves at δ ≈ 0 (S ≈ 1e-8 from a 2e-16 error in |C − A|).
+        deviation = min(pose.transmission_angle, math.pi - pose.transmission_angle)
+        assert deviation <= 2.0 * math.sqrt(delta) + 1e-7, deviation
+        if offset >= 1e-12:
+            # Closer, the branches coincide to rounding, B's side is not defined, and the float
+            # α may lie a hair past the true dead point, where solve_pose takes the dead point.
+            assert branch_side(PAPER, pose) == 1
+            reference = reference_state(PAPER, alpha, CONSTANT)
+            for name in ("beta", "gamma"):
+                error = abs(math.remainder(getattr(pose, name) - float(reference[name]),
+                                           2 * math.pi))
+                assert error <= DEAD_POINT_ANGLE / math.sqrt(delta), (name, error)
+
+
+def test_pose_outside_the_reachable_set_names_the_interval() -> None:
+    with pytest.raises(UnreachableError, match=r"\[-1\.941°, 181\.941°\]"):
+        solve_pose(PAPER, math.radians(-5.0))
