@@ -23,8 +23,9 @@ from timing import format_seconds, interleaved_medians, markdown_table
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 LISTENER = pathlib.Path(__file__).resolve().parent / "listener.py"
-# ROS_DOMAIN_IDs of this benchmark (50–59), one per kind of run so none sees another's nodes.
-DOMAIN_SPLIT, DOMAIN_RATE, DOMAIN_TIMING, DOMAIN_LOG, DOMAIN_MEMORY = 50, 51, 52, 53, 54
+# Each kind of run has its own ROS_DOMAIN_ID (the base given to run() plus this offset), so that
+# none sees another's nodes.
+DOMAIN_SPLIT, DOMAIN_RATE, DOMAIN_TIMING, DOMAIN_LOG, DOMAIN_MEMORY = range(5)
 STARTUP_S = 4.0  # time for a node process to start, discover and settle before measuring
 
 
@@ -100,11 +101,11 @@ def bag_figures(folder: pathlib.Path) -> tuple[int, int]:
 
 # --- memory ---------------------------------------------------------------------------------
 
-def memory_run(minutes: float) -> str:
+def memory_run(minutes: float, domain_base: int) -> str:
     """Resident memory of a 1 kHz node, logging on, from start to ``minutes`` later."""
     with tempfile.TemporaryDirectory(prefix="linkage_bench_memory_") as folder:
         node = start_node({"rate_hz": "1000.0", "end_behavior": "loop",
-                           "log.folder": folder}, DOMAIN_MEMORY)
+                           "log.folder": folder}, domain_base + DOMAIN_MEMORY)
         try:
             time.sleep(STARTUP_S)
             start = time.monotonic()
@@ -133,13 +134,13 @@ def memory_run(minutes: float) -> str:
 
 # --- cost per tick, in this process ---------------------------------------------------------
 
-def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
+def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, dict[str, float]]:
     """Median time of each part of the node's tick and of a bare rclpy publish, side by side.
 
     A listener in another process subscribes to /joint_states and to the bare publisher's
     topic, so both publishes really send over loopback.
     """
-    os.environ.update(ros_environment(DOMAIN_SPLIT))
+    os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
     import rclpy
     from rclpy.parameter import Parameter
     from sensor_msgs.msg import JointState
@@ -149,7 +150,8 @@ def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
     from linkage_kinematics.node import LinkageNode, sample_at_time, solve_sample
 
     count = 300 if quick else 1500
-    listener, output = listen(60.0, ["/joint_states", "/bench/joint_states"], DOMAIN_SPLIT)
+    listener, output = listen(60.0, ["/joint_states", "/bench/joint_states"],
+                              domain_base + DOMAIN_SPLIT)
     with tempfile.TemporaryDirectory(prefix="linkage_bench_split_") as folder:
         rclpy.init()
         nodes = []
@@ -176,6 +178,8 @@ def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
             joint_state = messages.joint_state(state, stamp)
             trajectory = messages.linkage_state(state, stamp, 0.0, config.frame_id)
             bare_message = messages.joint_state(state, stamp)
+            joint_state_data = recorder.serialize("/joint_states", joint_state)
+            trajectory_data = recorder.serialize("/linkage/state", trajectory)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 
             def compute() -> int:
@@ -199,7 +203,19 @@ def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
                                                         out=trajectory)
                 return count
 
-            def publish() -> int:
+            def serialize() -> int:
+                for _ in range(count):
+                    recorder.serialize("/joint_states", joint_state)
+                    recorder.serialize("/linkage/state", trajectory)
+                return count
+
+            def publish_serialized() -> int:
+                for _ in range(count):
+                    publishers["/joint_states"].publish(joint_state_data)
+                    publishers["/linkage/state"].publish(trajectory_data)
+                return count
+
+            def publish_messages() -> int:
                 for _ in range(count):
                     publishers["/joint_states"].publish(joint_state)
                     publishers["/linkage/state"].publish(trajectory)
@@ -207,8 +223,8 @@ def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
 
             def record() -> int:
                 for index in range(count):
-                    recorder.record("/joint_states", joint_state, index)
-                    recorder.record("/linkage/state", trajectory, index)
+                    recorder.record("/joint_states", joint_state_data, index)
+                    recorder.record("/linkage/state", trajectory_data, index)
                 return count
 
             def tick(node: LinkageNode) -> int:
@@ -225,8 +241,10 @@ def tick_split(quick: bool, repetitions: int) -> tuple[str, dict[str, float]]:
                 "compute: sample_at_time + solve_sample (kinematics.solve)": compute,
                 "  of which kinematics.solve alone": solve_only,
                 "build: messages.joint_state + messages.linkage_state": build,
-                "publish: /joint_states + /linkage/state": publish,
-                "log: Recorder.record of both messages": record,
+                "serialize: Recorder.serialize of both messages": serialize,
+                "publish: both serialized messages (logging on)": publish_serialized,
+                "log: Recorder.record of both serialized messages": record,
+                "publish: both messages as objects (logging off)": publish_messages,
                 "whole tick, logging on (LinkageNode._tick)": lambda: tick(logging_node),
                 "whole tick, logging off (LinkageNode._tick)": lambda: tick(quiet_node),
                 "bare rclpy publish of the same JointState": bare,
@@ -267,12 +285,14 @@ def observe(parameters: dict[str, str], seconds: float, domain: int) -> dict[str
     return data
 
 
-def sustained_rate(rate: float, logging: bool, seconds: float) -> tuple[float, int]:
+def sustained_rate(
+    rate: float, logging: bool, seconds: float, domain_base: int
+) -> tuple[float, int]:
     """Fraction of ticks missed (1 − achieved/requested over the node's diagnostics windows
     after the first) and the node's missed-deadline count."""
     with tempfile.TemporaryDirectory(prefix="linkage_bench_rate_") as folder:
         data = observe({"rate_hz": f"{rate:.1f}", "log.enabled": str(logging).lower(),
-                        "log.folder": folder}, seconds, DOMAIN_RATE)
+                        "log.folder": folder}, seconds, domain_base + DOMAIN_RATE)
     # the first window may still hold the listener's start-up
     windows = [float(d["achieved rate (Hz)"]) for d in data["diagnostics"]
                if "achieved rate (Hz)" in d][1:]
@@ -283,11 +303,11 @@ def sustained_rate(rate: float, logging: bool, seconds: float) -> tuple[float, i
     return max(0.0, 1.0 - statistics.mean(windows) / rate), missed
 
 
-def timing_figures(rate: float, seconds: float) -> dict[str, float]:
+def timing_figures(rate: float, seconds: float, domain_base: int) -> dict[str, float]:
     """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99."""
     with tempfile.TemporaryDirectory(prefix="linkage_bench_timing_") as folder:
         data = observe({"rate_hz": f"{rate:.1f}", "log.folder": folder}, seconds,
-                       DOMAIN_TIMING)
+                       domain_base + DOMAIN_TIMING)
     samples = data["received"]["/joint_states"]
     stamps = [stamp for stamp, _ in samples]
     period_ns = 1e9 / rate
@@ -302,10 +322,11 @@ def timing_figures(rate: float, seconds: float) -> dict[str, float]:
     }
 
 
-def log_size(seconds: float) -> tuple[float, float, int]:
+def log_size(seconds: float, domain_base: int) -> tuple[float, float, int]:
     """(bytes per second, bytes per message, messages) of a run at the default settings."""
     with tempfile.TemporaryDirectory(prefix="linkage_bench_log_") as folder:
-        node = start_node({"end_behavior": "loop", "log.folder": folder}, DOMAIN_LOG)
+        node = start_node({"end_behavior": "loop", "log.folder": folder},
+                          domain_base + DOMAIN_LOG)
         started = time.monotonic()
         time.sleep(seconds)
         stop(node)
@@ -318,22 +339,24 @@ def _rate_text(rate: float | None) -> str:
     return "none of the rates tried" if rate is None else f"{rate:g} Hz"
 
 
-def run(quick: bool, repetitions: int) -> str:
+def run(quick: bool, repetitions: int, domain_base: int) -> str:
     """The node section as markdown."""
-    split, times = tick_split(quick, repetitions)
-    ratio = (times["whole tick, logging on (LinkageNode._tick)"]
-             / times["bare rclpy publish of the same JointState"])
+    split, times = tick_split(quick, repetitions, domain_base)
+    with_logging = times["whole tick, logging on (LinkageNode._tick)"]
+    ratio = with_logging / times["bare rclpy publish of the same JointState"]
+    logging_share = with_logging / times["whole tick, logging off (LinkageNode._tick)"]
     lines = ["Cost per tick (one process; a listener in another process subscribes to "
              "/joint_states and the bare topic):", "", split, "",
              f"- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: "
-             f"{'met' if ratio <= 2.0 else 'missed'})", ""]
+             f"{'met' if ratio <= 2.0 else 'missed'})",
+             f"- whole tick with logging / without = {logging_share:.2f}×", ""]
     seconds = 4.0 if quick else 8.0
     rates = (100.0, 500.0, 1000.0) if quick else (100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0)
     rows = []
     sustained: dict[bool, float | None] = {True: None, False: None}
     for logging in (True, False):
         for rate in rates:
-            fraction, missed = sustained_rate(rate, logging, seconds)
+            fraction, missed = sustained_rate(rate, logging, seconds, domain_base)
             rows.append([f"{rate:g} Hz", "on" if logging else "off",
                          f"{100.0 * fraction:.2f} %", str(missed)])
             if fraction < 0.01:
@@ -346,7 +369,7 @@ def run(quick: bool, repetitions: int) -> str:
               f"logging, {_rate_text(sustained[False])} without", ""]
     rows = []
     for rate in (100.0, 1000.0):
-        figures = timing_figures(rate, seconds)
+        figures = timing_figures(rate, seconds, domain_base)
         rows.append([f"{rate:g} Hz", format_seconds(figures["jitter_p50"]),
                      format_seconds(figures["jitter_p99"]), format_seconds(figures["latency_p50"]),
                      format_seconds(figures["latency_p99"]),
@@ -355,7 +378,7 @@ def run(quick: bool, repetitions: int) -> str:
               "receive time − header stamp, another process), logging on:", "",
               markdown_table(["rate", "jitter p50", "jitter p99", "latency p50", "latency p99",
                               "messages received"], rows), ""]
-    per_second, per_message, messages = log_size(seconds + 2.0)
+    per_second, per_message, messages = log_size(seconds + 2.0, domain_base)
     lines.append(f"Log at the default settings (100 Hz state, 30 Hz markers, 1 Hz "
                  f"diagnostics): {per_second / 1e3:.1f} kB/s, {per_message:.0f} B per message "
                  f"({messages} messages in {seconds + 2.0:g} s).")

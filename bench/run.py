@@ -35,9 +35,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--memory-minutes", type=float, default=None,
                         help="length of the node's resident-memory run at 1 kHz "
                              "(default 10, 0.5 with --quick)")
+    parser.add_argument("--ros-domain", type=int, default=50,
+                        help="first of the five ROS_DOMAIN_IDs the node and memory sections use "
+                             "(default 50, so 50–54)")
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
         parser.error("--repetitions must be at least 1")
+    if not 0 <= arguments.ros_domain <= 228:
+        parser.error("--ros-domain must be between 0 and 228 (five IDs up to 232)")
     repetitions = arguments.repetitions or (5 if arguments.quick else 7)
     sections = arguments.only or SECTIONS
     started = time.perf_counter()
@@ -62,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
         import node_bench
 
         print("\n## Node\n")
-        print(node_bench.run(arguments.quick, repetitions))
+        print(node_bench.run(arguments.quick, repetitions, arguments.ros_domain))
     if "memory" in sections:
         import node_bench
 
@@ -70,7 +75,7 @@ def main(argv: list[str] | None = None) -> int:
         if minutes is None:
             minutes = 0.5 if arguments.quick else 10.0
         print(f"\n## Node memory over {minutes:g} min at 1 kHz\n")
-        print(node_bench.memory_run(minutes))
+        print(node_bench.memory_run(minutes, arguments.ros_domain))
     print(f"\nbenchmark took {time.perf_counter() - started:.0f} s")
     return 0
 

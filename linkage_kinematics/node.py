@@ -767,11 +767,14 @@ class LinkageNode(Node):
         return recorder
 
     def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
-        self._topic_publishers[topic].publish(message)
         if self._recorder is None or self._recording_error is not None:
+            self._topic_publishers[topic].publish(message)
             return
+        # Serialized once: subscribers get the very bytes that are logged.
+        data = self._recorder.serialize(topic, message)
+        self._topic_publishers[topic].publish(data)
         try:
-            self._recorder.record(topic, message, log_time_ns)
+            self._recorder.record(topic, data, log_time_ns)
         except OSError as error:
             # The data keep flowing; diagnostics report the lost log.
             self._recording_error = f"recording stopped: {error}"

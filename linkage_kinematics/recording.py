@@ -5,10 +5,18 @@ than the message's CDR encoding (e.g. after an empty ``effort`` in a JointState)
 readers such as rosbags reject such messages. ``cdr_length`` computes the exact XCDR1 length
 from the message's field types (cached per class, no copying), and only that many bytes are
 logged.
+
+The node serializes each message once (``Recorder.serialize``), publishes those bytes and logs
+the same bytes. Walking a message in Python for its length costs about as much as serializing
+it, so ``Recorder.serialize`` keeps each topic's last length together with the message's shape
+(``message_shape``: every string and every sequence length), and walks again only when the
+shape differs: for the per-tick topics, whose strings and arrays stay the same in a run, only
+on the first message.
 """
 from __future__ import annotations
 
 import functools
+import importlib
 import time
 from pathlib import Path
 from typing import Any
@@ -17,6 +25,7 @@ import yaml
 from rclpy.qos import QoSProfile
 from rclpy.serialization import serialize_message
 from rosidl_parser.definition import (
+    AbstractGenericString,
     AbstractNestedType,
     AbstractString,
     AbstractWString,
@@ -100,6 +109,71 @@ def serialize_exact(message: Any) -> bytes:
     return serialize_message(message)[: cdr_length(message)]
 
 
+# How message_shape reads a field: a string or a sequence of strings as its text (which fixes
+# its encoded length), a sequence of primitives or of fixed-size messages by its length, a
+# message by its own shape, a sequence of messages by its length and each element's shape.
+_TEXT, _TEXTS, _LENGTH, _MESSAGE, _MESSAGES = range(5)
+
+
+def _message_class(slot_type: NamespacedType) -> type:
+    return getattr(importlib.import_module(".".join(slot_type.namespaces)), slot_type.name)
+
+
+@functools.cache
+def _shape_fields(msg_type: type) -> tuple[tuple[str, int, type | None], ...]:
+    """The fields of ``msg_type`` whose encoded length can vary, each with how to read it;
+    fields of fixed encoded length (primitives, fixed arrays of them, such messages) are left
+    out."""
+    fields = []
+    for name, slot_type in _layout(msg_type):
+        if isinstance(slot_type, AbstractGenericString):
+            fields.append((name, _TEXT, None))
+        elif isinstance(slot_type, NamespacedType):
+            nested = _message_class(slot_type)
+            if _shape_fields(nested):
+                fields.append((name, _MESSAGE, nested))
+        elif isinstance(slot_type, AbstractNestedType):
+            element_type = slot_type.value_type
+            if isinstance(element_type, AbstractGenericString):
+                fields.append((name, _TEXTS, None))
+            elif isinstance(element_type, NamespacedType):
+                nested = _message_class(element_type)
+                if _shape_fields(nested):
+                    fields.append((name, _MESSAGES, nested))
+                elif not isinstance(slot_type, Array):
+                    fields.append((name, _LENGTH, None))
+            elif not isinstance(slot_type, Array):
+                fields.append((name, _LENGTH, None))
+    return tuple(fields)
+
+
+def _add_shape(message: Any, fields: tuple[tuple[str, int, type | None], ...],
+               shape: list[Any]) -> None:
+    for name, kind, nested in fields:
+        value = getattr(message, name)
+        if kind == _TEXT:
+            shape.append(value)
+        elif kind == _LENGTH:
+            shape.append(len(value))
+        elif kind == _TEXTS:
+            shape.append(tuple(value))
+        elif kind == _MESSAGE:
+            _add_shape(value, _shape_fields(nested), shape)
+        else:
+            shape.append(len(value))
+            nested_fields = _shape_fields(nested)
+            for element in value:
+                _add_shape(element, nested_fields, shape)
+
+
+def message_shape(message: Any) -> list[Any]:
+    """Everything ``cdr_length(message)`` depends on besides the message's type: equal shapes
+    of two messages of one type mean equal lengths."""
+    shape: list[Any] = []
+    _add_shape(message, _shape_fields(type(message)), shape)
+    return shape
+
+
 def _duration(nanoseconds: int) -> dict[str, int]:
     return {"sec": nanoseconds // 1_000_000_000, "nsec": nanoseconds % 1_000_000_000}
 
@@ -144,6 +218,7 @@ class Recorder:
                 raise RecordingError(f"cannot log into folder {folder}: {error}") from None
         self.bag_path: Path = self._writer.bag_path
         self._channels: dict[str, int] = {}
+        self._last_lengths: dict[str, tuple[type, list[Any], int]] = {}
 
     @property
     def size_bytes(self) -> int:
@@ -158,11 +233,20 @@ class Recorder:
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
 
-    def record(self, topic: str, message: Any, log_time_ns: int) -> None:
+    def serialize(self, topic: str, message: Any) -> bytes:
+        """``serialize_exact(message)``, with the length walk skipped while ``topic``'s messages
+        keep their shape; the bytes to publish and to ``record``."""
+        data = serialize_message(message)
+        shape = message_shape(message)
+        last = self._last_lengths.get(topic)
+        if last is None or last[0] is not type(message) or last[1] != shape:
+            last = self._last_lengths[topic] = (type(message), shape, cdr_length(message))
+        return data[: last[2]]
+
+    def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Logs ``data``, a message of ``topic`` serialized by ``serialize``."""
         try:
-            self._writer.write(
-                self._channels[topic], serialize_exact(message), log_time_ns, log_time_ns
-            )
+            self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
 

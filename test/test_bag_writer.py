@@ -12,6 +12,7 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from collections import defaultdict
 from collections.abc import Callable
@@ -23,7 +24,7 @@ import rclpy
 import yaml
 from ament_index_python.packages import get_package_share_directory
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
@@ -32,7 +33,7 @@ from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
-from trajectory_msgs.msg import JointTrajectory
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import MarkerArray
 
 from linkage_kinematics import bag_reader, messages
@@ -195,6 +196,86 @@ def test_exact_length_holds_for_any_sequence_and_string_lengths(
     assert list(decoded.effort) == effort
 
 
+def encoded_by_rosbags(data: bytes, type_name: str) -> bytes:
+    """``data`` decoded and encoded again by rosbags: exact length, alignment padding zeroed
+    (rclpy leaves padding bytes as it finds them, so two encodings of one message may differ
+    there)."""
+    return bytes(TYPESTORE.serialize_cdr(TYPESTORE.deserialize_cdr(data, type_name), type_name))
+
+
+def assert_exact_encoding(data: bytes, message: Any) -> None:
+    type_name = ros_type_name(type(message))
+    assert len(data) == len(serialize_exact(message))
+    assert encoded_by_rosbags(data, type_name) == encoded_by_rosbags(
+        serialize_exact(message), type_name
+    )
+    assert len(data) == len(encoded_by_rosbags(data, type_name))
+
+
+def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: Path) -> None:
+    recorder = Recorder(tmp_path, metadata={})
+    recorder.add_topic("/joint_states", JointState, QoSProfile(depth=10))
+    message = JointState(name=["abc", "c"], position=[1.0], velocity=[2.0])
+    message.header.frame_id = "aaa"
+    # Each step changes one field of the reused message, as a node would, and with it the exact
+    # length, so a length kept from the step before would be wrong. Two steps keep every Python
+    # length and change only the UTF-8 bytes.
+    steps: list[Callable[[JointState], None]] = [
+        lambda m: None,
+        lambda m: setattr(m, "name", ["übc", "c"]),
+        lambda m: setattr(m, "name", ["ab"]),
+        lambda m: setattr(m.header, "frame_id", "üaa"),
+        lambda m: setattr(m, "name", ["ab", "c"]),
+        lambda m: setattr(m, "effort", [3.0]),
+        lambda m: setattr(m, "effort", []),  # the case rclpy pads
+        lambda m: setattr(m, "position", [1.0, 4.0]),
+        lambda m: setattr(m.header, "frame_id", "the_base_link"),
+    ]
+    lengths = []
+    for step in steps:
+        step(message)
+        data = recorder.serialize("/joint_states", message)
+        assert_exact_encoding(data, message)
+        lengths.append(len(data))
+    assert all(before != after for before, after in zip(lengths, lengths[1:])), lengths
+    recorder.close()
+
+
+point_lengths = st.tuples(*[st.integers(0, 3)] * 4)  # positions, velocities, accelerations, effort
+# Few choices, so that consecutive messages often differ in one place only.
+few_texts = st.sampled_from(["", "base", "bäse", "the_base_link"])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    shapes=st.lists(
+        st.tuples(few_texts, st.lists(few_texts, max_size=2), st.lists(point_lengths, max_size=2)),
+        min_size=2, max_size=6,
+    )
+)
+@example(shapes=[("base", ["a"], [(1, 0, 0, 0)]), ("base", ["a"], [(2, 0, 0, 0)])])
+def test_recorder_serialize_never_returns_a_stale_length(
+    shapes: list[tuple[str, list[str], list[tuple[int, int, int, int]]]],
+) -> None:
+    """One JointTrajectory, reused and reshaped between calls, through one recorder topic."""
+    with tempfile.TemporaryDirectory(prefix="linkage_test_shapes_") as folder:
+        recorder = Recorder(Path(folder), metadata={})
+        recorder.add_topic("/linkage/state", JointTrajectory, QoSProfile(depth=10))
+        message = JointTrajectory()
+        for frame_id, joint_names, points in shapes:
+            message.header.frame_id = frame_id
+            message.joint_names = joint_names
+            message.points = [
+                JointTrajectoryPoint(
+                    positions=[0.5] * sizes[0], velocities=[1.5] * sizes[1],
+                    accelerations=[2.5] * sizes[2], effort=[3.5] * sizes[3],
+                )
+                for sizes in points
+            ]
+            assert_exact_encoding(recorder.serialize("/linkage/state", message), message)
+        recorder.close()
+
+
 def test_schema_names_dependencies_as_the_referencing_field_spells_them() -> None:
     text = message_definition("sensor_msgs/msg/JointState")
     msg_file = Path(get_package_share_directory("sensor_msgs")) / "msg" / "JointState.msg"
@@ -315,9 +396,14 @@ def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any
     received = node_run["received"]
     for topic in ("/linkage/state", "/joint_states", "/linkage/markers", "/diagnostics"):
         assert received.get(topic), f"the listener received nothing on {topic}"
+        type_name = ros_type_name(NODE_TOPICS[topic])
         by_stamp = {message_stamp_ns(message): message for _, message, _ in logged[topic]}
         for message in received[topic]:
             logged_message = by_stamp[message_stamp_ns(message)]
+            # every field equal, whatever the type
+            assert encoded_by_rosbags(serialize_exact(message), type_name) == bytes(
+                TYPESTORE.serialize_cdr(logged_message, type_name)
+            ), topic
             if topic == "/linkage/state":
                 (point,) = message.points
                 (logged_point,) = logged_message.points
