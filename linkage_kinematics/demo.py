@@ -9,9 +9,11 @@ Tables 1–4 from what was logged, and draws the four-panel figure beside each b
 from __future__ import annotations
 
 import argparse
+import math
 import subprocess
 import sys
 from pathlib import Path
+from typing import Callable
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 
@@ -22,6 +24,21 @@ SCENARIOS = (
     ("seed_constant.yaml", "Constant law, ω = 2 rad/s (the seed's Tables 1 and 2)"),
     ("seed_variable.yaml", "Variable law, ω = 0.10 + 2.3·α rad/s (the seed's Tables 3 and 4)"),
 )
+
+
+def _positive(kind: type, noun: str) -> Callable[[str], float]:
+    """An argparse type: a finite ``kind`` (``noun`` in messages) greater than zero."""
+
+    def convert(text: str) -> float:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"not {noun}: {text!r}") from None
+        if not math.isfinite(value) or value <= 0:
+            raise argparse.ArgumentTypeError(f"must be greater than zero, got {text}")
+        return value
+
+    return convert
 
 
 def _run_node(params_file: Path, log_folder: Path, rate_hz: float) -> Path:
@@ -48,16 +65,17 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="linkage-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--log-folder", type=Path, default=Path("bags"),
                         help="folder that receives one new bag per run (default: bags)")
-    parser.add_argument("--rate-hz", type=float, default=200.0,
+    parser.add_argument("--rate-hz", type=_positive(float, "a number"), default=200.0,
                         help="steps of 0.5° published per second (default: 200)")
-    parser.add_argument("--rows", type=int, default=2,
+    parser.add_argument("--rows", type=_positive(int, "a whole number"), default=2,
                         help="rows shown at the head and at the tail of each table (default: 2)")
     arguments = parser.parse_args(argv)
     try:
         config_folder = Path(get_package_share_directory("linkage_kinematics")) / "config"
-    except PackageNotFoundError:
-        print("linkage-demo: package linkage_kinematics is not installed where AMENT_PREFIX_PATH "
-              "points; run it through ./dev demo or a sourced colcon workspace", file=sys.stderr)
+    except (PackageNotFoundError, OSError) as error:
+        # OSError: AMENT_PREFIX_PATH is not set at all.
+        print(f"linkage-demo: cannot find the installed package ({error}); run it through "
+              "./dev demo or from a sourced colcon workspace", file=sys.stderr)
         return 1
     for params_name, title in SCENARIOS:
         try:

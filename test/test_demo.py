@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 import matplotlib.image
+import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -33,3 +34,40 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
     # exact variable law: ω = 0.1 at 0°, 3.713 at 90°, α̈ = 2.3·ω
     for value in ("0.1000", "3.713", "-0.3333", "0.0856", "-0.2852"):
         assert value in variable
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["--rows", "0"], "--rows: must be greater than zero"),
+        (["--rows", "two"], "--rows: not a whole number"),
+        (["--rate-hz", "nan"], "--rate-hz: must be greater than zero"),
+        (["--rate-hz", "fast"], "--rate-hz: not a number"),
+    ],
+)
+def test_bad_arguments_get_one_line_and_no_run(
+    arguments: list[str], message: str, tmp_path: Path
+) -> None:
+    completed = subprocess.run(
+        [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(tmp_path / "bags"),
+         *arguments],
+        cwd=REPO, capture_output=True, text=True, timeout=60,
+    )
+    assert completed.returncode == 2
+    assert message in completed.stderr
+    assert "Traceback" not in completed.stderr
+    assert not (tmp_path / "bags").exists()
+
+
+def test_unwritable_log_folder_is_reported_without_a_traceback(tmp_path: Path) -> None:
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    environment = dict(os.environ, ROS_DOMAIN_ID="91", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    completed = subprocess.run(
+        [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(blocker / "bags")],
+        cwd=REPO, env=environment, capture_output=True, text=True, timeout=60,
+    )
+    assert completed.returncode == 1
+    assert "invalid parameter log.folder" in completed.stderr
+    assert "linkage_node exited with status 2" in completed.stderr
+    assert "Traceback" not in completed.stderr
