@@ -9,36 +9,20 @@ Tables 1–4 from what was logged, and draws the four-panel figure beside each b
 from __future__ import annotations
 
 import argparse
-import math
 import subprocess
 import sys
 from pathlib import Path
-from typing import Callable
 
 from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
 
 from linkage_kinematics.bag_reader import BagError, read_states
+from linkage_kinematics.cli_types import number
 from linkage_kinematics.sweep import format_tables, write_plot
 
 SCENARIOS = (
     ("seed_constant.yaml", "Constant law, ω = 2 rad/s (the seed's Tables 1 and 2)"),
     ("seed_variable.yaml", "Variable law, ω = 0.10 + 2.3·α rad/s (the seed's Tables 3 and 4)"),
 )
-
-
-def _positive(kind: type, noun: str) -> Callable[[str], float]:
-    """An argparse type: a finite ``kind`` (``noun`` in messages) greater than zero."""
-
-    def convert(text: str) -> float:
-        try:
-            value = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"not {noun}: {text!r}") from None
-        if not math.isfinite(value) or value <= 0:
-            raise argparse.ArgumentTypeError(f"must be greater than zero, got {text}")
-        return value
-
-    return convert
 
 
 def _run_node(params_file: Path, log_folder: Path, rate_hz: float) -> Path:
@@ -65,9 +49,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="linkage-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--log-folder", type=Path, default=Path("bags"),
                         help="folder that receives one new bag per run (default: bags)")
-    parser.add_argument("--rate-hz", type=_positive(float, "a number"), default=200.0,
+    parser.add_argument("--rate-hz", type=number(above=0.0, rule="greater than zero"), default=200.0,
                         help="steps of 0.5° published per second (default: 200)")
-    parser.add_argument("--rows", type=_positive(int, "a whole number"), default=2,
+    parser.add_argument("--rows", type=number(int, at_least=1, rule="at least 1"), default=2,
                         help="rows shown at the head and at the tail of each table (default: 2)")
     arguments = parser.parse_args(argv)
     try:

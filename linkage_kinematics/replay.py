@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import math
 import signal
 import sys
 import time
@@ -31,6 +30,7 @@ from rclpy.signals import SignalHandlerOptions
 
 from linkage_kinematics import bag_reader
 from linkage_kinematics.bag_writer import BagWriteError, recover_bag
+from linkage_kinematics.cli_types import number
 
 TRANSIENT_LOCAL_TOPICS = frozenset({"/robot_description"})
 ACK_TIMEOUT_S = 2.0
@@ -48,24 +48,8 @@ class TopicPlan:
     offered_qos: dict[str, Any] | None
 
 
-def _positive_rate(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not math.isfinite(value) or value <= 0:
-        raise argparse.ArgumentTypeError(f"must be a positive factor, got {text}")
-    return value
-
-
-def _non_negative_seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"must be zero or more seconds, got {text}")
-    return value
+_positive_rate = number(above=0.0, rule="a positive factor")
+_non_negative_seconds = number(at_least=0.0, rule="zero or more seconds")
 
 
 def _parser() -> argparse.ArgumentParser:

@@ -22,6 +22,7 @@ from typing import Optional, TextIO
 import numpy as np
 
 from linkage_kinematics.bag_reader import BagError, bag_files, read_states
+from linkage_kinematics.cli_types import number
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import PRESETS, FourBar, GeometryError, UnreachableError, preset
 from linkage_kinematics.kinematics import DeadPointError, LinkageState, solve_many
@@ -304,9 +305,9 @@ def _table(
     ]
     widths = [max(_display_width(line[index]) for line in cells) for index in range(len(layout))]
     lines = [caption]
-    for number, line in enumerate(cells):
+    for row_index, line in enumerate(cells):
         lines.append("  ".join(_pad(cell, width) for cell, width in zip(line, widths)))
-        if number == 0:
+        if row_index == 0:
             lines.append("  ".join("-" * width for width in widths))
     return "\n".join(lines)
 
@@ -343,23 +344,6 @@ def _note(message: str) -> None:
     print(f"{PROGRAM}: note: {message}", file=sys.stderr)
 
 
-def _finite(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
-    return value
-
-
-def _length(text: str) -> float:
-    value = _finite(text)
-    if value <= 0.0:
-        raise argparse.ArgumentTypeError(f"must be a length > 0 m, got {text!r}")
-    return value
-
-
 def _png_path(text: str) -> Path:
     path = Path(text)
     if path.suffix.lower() != ".png":
@@ -369,14 +353,9 @@ def _png_path(text: str) -> Path:
     return path
 
 
-def _row_count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be at least 1, got {text!r}")
-    return value
+_finite = number()
+_length = number(above=0.0, rule="a length > 0 m")
+_row_count = number(int, at_least=1, rule="at least 1")
 
 
 def _parser() -> argparse.ArgumentParser:

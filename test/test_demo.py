@@ -39,9 +39,10 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("arguments", "message"),
     [
-        (["--rows", "0"], "--rows: must be greater than zero"),
+        (["--rows", "0"], "--rows: must be at least 1"),
         (["--rows", "two"], "--rows: not a whole number"),
-        (["--rate-hz", "nan"], "--rate-hz: must be greater than zero"),
+        (["--rate-hz", "nan"], "--rate-hz: must be a finite number"),
+        (["--rate-hz", "-1"], "--rate-hz: must be greater than zero"),
         (["--rate-hz", "fast"], "--rate-hz: not a number"),
     ],
 )
