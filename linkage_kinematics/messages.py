@@ -19,11 +19,11 @@ from std_msgs.msg import ColorRGBA
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
 
+from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
 
 JOINT_NAMES = ("crank_joint", "coupler_joint", "rocker_joint")
-STATE_NAMES = ("alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y")
 MARKER_NAMESPACE = "linkage"
 # Marker ids are fixed so that every MarkerArray updates the same markers in place.
 DISK_ID, BARS_ID, PIN_A_ID, PIN_B_ID, PIVOT_O_ID, PIVOT_C_ID = range(6)
@@ -105,7 +105,7 @@ def linkage_state(
     drive-law time since the motion left alpha_start.
     """
     if out is None:
-        out = JointTrajectory(joint_names=list(STATE_NAMES), points=[JointTrajectoryPoint()])
+        out = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[JointTrajectoryPoint()])
     out.header.stamp = stamp
     out.header.frame_id = frame_id
     point = out.points[0]

@@ -25,6 +25,7 @@ from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
 
 from linkage_kinematics import messages
+from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import TWO_PI, preset
 from linkage_kinematics.kinematics import solve
@@ -144,7 +145,7 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
     trajectories = listener.received["/linkage/state"]
     assert trajectories, "no /linkage/state received"
     for message in trajectories:
-        assert list(message.joint_names) == list(messages.STATE_NAMES)
+        assert list(message.joint_names) == list(STATE_JOINT_NAMES)
         point = message.points[0]
         state = solve(PAPER, point.positions[0], drive)
         assert tuple(point.positions) == (
