@@ -147,7 +147,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
 
     from linkage_kinematics import messages
     from linkage_kinematics.kinematics import solve
-    from linkage_kinematics.node import LinkageNode, sample_at_time, solve_sample
+    from linkage_kinematics.motion import sample_at_time, solve_sample
+    from linkage_kinematics.node import LinkageNode
 
     count = 300 if quick else 1500
     listener, output = listen(60.0, ["/joint_states", "/bench/joint_states"],

@@ -22,7 +22,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
-from linkage_kinematics.node import parameter_specs
+from linkage_kinematics.parameters import parameter_specs
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 PROCESS_TIMEOUT = 30.0  # s; a generous bound on any one node run in these tests

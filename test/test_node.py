@@ -29,12 +29,8 @@ from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import TWO_PI, preset
 from linkage_kinematics.kinematics import solve
-from linkage_kinematics.node import (
-    build_configuration,
-    sample_at_step,
-    sample_at_time,
-    solve_sample,
-)
+from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_sample
+from linkage_kinematics.parameters import build_configuration
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
     PROCESS_TIMEOUT,

@@ -24,15 +24,17 @@ from linkage_kinematics.bag_reader import bag_files, iter_messages, read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
-from linkage_kinematics.node import (
+from linkage_kinematics.motion import (
+    dead_point_problem,
+    met_dead_point,
+    sample_at_step,
+    sample_at_time,
+)
+from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
     ConfigurationError,
     build_configuration,
-    dead_point_problem,
-    met_dead_point,
     parameter_specs,
-    sample_at_step,
-    sample_at_time,
 )
 from node_process import (
     PROCESS_TIMEOUT,

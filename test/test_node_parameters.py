@@ -15,7 +15,7 @@ from trajectory_msgs.msg import JointTrajectory
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics import solve
-from linkage_kinematics.node import (
+from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
     ConfigurationError,
     build_configuration,

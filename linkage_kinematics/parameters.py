@@ -1,0 +1,375 @@
+"""The node's parameters: their specifications, and their validation into a RunConfiguration.
+
+Pure functions of parameter values (name → value), no ROS: ``build_configuration`` checks every
+value and the motion they imply and raises ConfigurationError naming the first bad parameter; the
+node, the demo and the tests all validate through it. README.md documents each parameter.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from linkage_kinematics.drive import DriveError, DriveLaw
+from linkage_kinematics.geometry import (
+    ANGLE_TOLERANCE,
+    TWO_PI,
+    FourBar,
+    GeometryError,
+    UnreachableError,
+    preset,
+)
+from linkage_kinematics.kinematics import DeadPointError, solve
+from linkage_kinematics.urdf import DEFAULT_FRAME_ID
+
+END_BEHAVIORS = ("stop", "loop", "bounce")
+MODES = ("real_time", "fixed_step")
+GEOMETRY_PARAMETERS = ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")
+MAX_RATE_HZ = 10000.0
+MAX_DISPLAY_RATE_HZ = 1000.0
+MAX_LENGTH = 1e6  # m; lengths and ground coordinates, far beyond any mechanism
+MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
+MAX_OMEGA0 = 1e4  # rad/s
+MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
+# s; shorter passes would fall between clock ticks, and elapsed / pass duration could overflow.
+MIN_PASS_DURATION = 1e-6
+
+# A step count within this fraction of a step of a whole number ends exactly on the segment
+# end, so 90° in 0.5° steps is 180 steps and not 180 plus a rounding-sized 181st.
+_STEP_COUNT_TOLERANCE = 1e-9
+# α − alpha_start within this of a whole number of turns is a whole-turn loop.
+_WHOLE_TURN_TOLERANCE = 1e-9
+
+
+class ConfigurationError(ValueError):
+    """A parameter value (or a combination of them) the node cannot run with."""
+
+    def __init__(self, parameter: str, reason: str) -> None:
+        super().__init__(f"{parameter}: {reason}")
+        self.parameter = parameter
+        self.reason = reason
+
+
+@dataclass(frozen=True)
+class RunConfiguration:
+    """Validated parameters plus the motion they imply; replaced as a whole, never mutated.
+
+    ``segment_end`` is where one pass of the motion ends: alpha_end, or ``blocked_at``, the
+    first dead (or change) point the crank meets on its way there. ``segment_duration`` is the
+    drive-law time of that pass (s), ``direction`` the sign of the crank's travel and
+    ``step_count`` the number of fixed steps strictly before ``segment_end``.
+    """
+
+    preset: str
+    linkage: FourBar
+    drive: DriveLaw
+    branch: int
+    alpha_start: float
+    alpha_end: float
+    end_behavior: str
+    mode: str
+    alpha_step: float
+    rate_hz: float
+    display_rate_hz: float
+    frame_id: str
+    min_transmission_angle: float
+    dead_point_warning: float
+    log_enabled: bool
+    log_folder: Path
+    direction: int
+    segment_end: float
+    blocked_at: float | None
+    segment_duration: float
+    whole_turns: bool
+    step_count: int
+
+    @property
+    def reverse_drive(self) -> DriveLaw:
+        """The drive law of the motion played backwards: ω and all rates negated, accelerations
+        unchanged."""
+        return DriveLaw(-self.drive.omega0, -self.drive.k)
+
+    def restarts_motion(self, other: RunConfiguration) -> bool:
+        """Whether switching from ``other`` to this configuration changes the motion itself."""
+        display_only = replace(
+            other,
+            min_transmission_angle=self.min_transmission_angle,
+            dead_point_warning=self.dead_point_warning,
+            display_rate_hz=self.display_rate_hz,
+        )
+        return display_only != self
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One node parameter: its default (None: no default), descriptor text and limits."""
+
+    name: str
+    default: Any
+    description: str
+    read_only: bool = False
+    floating_range: tuple[float, float] | None = None
+    integer_range: tuple[int, int, int] | None = None
+
+
+def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
+    """All parameters; the geometry defaults come from ``preset_name`` ('' → no defaults)."""
+    geometry = preset(preset_name).geometry if preset_name else None
+    geometry_specs = tuple(
+        ParameterSpec(
+            name,
+            getattr(geometry, name) if geometry is not None else None,
+            f"{text} (m); defaults to the preset's value, required when preset is ''",
+        )
+        for name, text in (
+            ("crank_length", "disk radius OA"),
+            ("coupler_length", "coupler length AB"),
+            ("rocker_length", "rocker length BC"),
+            ("ground_x", "x of the fixed pivot C relative to O"),
+            ("ground_y", "y of the fixed pivot C relative to O"),
+        )
+    )
+    return (
+        ParameterSpec(
+            "preset", "paper",
+            "mechanism whose dimensions are the geometry parameters' defaults: "
+            "paper, paper_full_turn, grashof_crank_rocker, or '' for none",
+            read_only=True,
+        ),
+        *geometry_specs,
+        ParameterSpec("branch", 1, "assembly branch: +1 (B left of A→C) or −1",
+                      integer_range=(-1, 1, 2)),
+        ParameterSpec("omega0", 2.0, "drive law ω = omega0 + k·α: omega0 (rad/s)"),
+        ParameterSpec("k", 0.0, "drive law ω = omega0 + k·α: k (1/s)"),
+        ParameterSpec("alpha_start", 0.0, "crank angle where the motion starts (rad)"),
+        ParameterSpec("alpha_end", math.pi / 2.0, "crank angle where one pass ends (rad)"),
+        ParameterSpec("end_behavior", "stop",
+                      "at the end of a pass: stop (and exit), loop or bounce"),
+        ParameterSpec("mode", "real_time",
+                      "real_time: α from node-clock time; fixed_step: one alpha_step per tick"),
+        ParameterSpec("alpha_step", math.radians(0.5), "crank step in fixed_step mode (rad)",
+                      floating_range=(0.0, TWO_PI)),
+        ParameterSpec("rate_hz", 100.0, "compute and publish rate of the state (Hz)",
+                      floating_range=(0.0, MAX_RATE_HZ)),
+        ParameterSpec("display_rate_hz", 30.0, "publish rate of /linkage/markers (Hz)",
+                      floating_range=(0.0, MAX_DISPLAY_RATE_HZ)),
+        ParameterSpec("frame_id", DEFAULT_FRAME_ID,
+                      "frame of markers and /linkage/state, root link of the URDF",
+                      read_only=True),
+        ParameterSpec("diagnostics.min_transmission_angle", math.radians(10.0),
+                      "WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)",
+                      floating_range=(0.0, math.pi / 2.0)),
+        ParameterSpec("diagnostics.dead_point_warning", math.radians(1.0),
+                      "WARN when the crank is closer than this to a dead point (rad)",
+                      floating_range=(0.0, math.pi)),
+        ParameterSpec("log.enabled", True, "record every published message to a bag",
+                      read_only=True),
+        ParameterSpec("log.folder", "bags",
+                      "folder that receives a new bag per run (relative to the working "
+                      "directory)", read_only=True),
+    )
+
+
+PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(""))
+
+
+# --- validation: pure functions from parameter values to a RunConfiguration ---------------
+
+
+def describe_value(value: object) -> str:
+    """A parameter value and its type, for error messages."""
+    if value is None:
+        return "no value"
+    return f"{type(value).__name__} {value!r}"
+
+
+def _real(values: Mapping[str, Any], name: str) -> float:
+    value = values.get(name)
+    # bool is an int in Python but a different parameter type in ROS.
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigurationError(name, f"must be a number, got {describe_value(value)}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ConfigurationError(name, f"must be finite, got {value!r}")
+    return value
+
+
+def _positive(values: Mapping[str, Any], name: str, unit: str, upper: float = math.inf) -> float:
+    value = _real(values, name)
+    if not 0.0 < value <= upper:
+        bound = f" and at most {upper:g} {unit}" if math.isfinite(upper) else ""
+        raise ConfigurationError(name, f"must be greater than 0 {unit}{bound}, got {value!r}")
+    return value
+
+
+def _within(
+    values: Mapping[str, Any], name: str, low: float, high: float, unit: str = "rad"
+) -> float:
+    value = _real(values, name)
+    if not low <= value <= high:
+        raise ConfigurationError(name, f"must lie in [{low:g}, {high:g}] {unit}, got {value!r}")
+    return value
+
+
+def _text(values: Mapping[str, Any], name: str, choices: tuple[str, ...] | None = None) -> str:
+    value = values.get(name)
+    if not isinstance(value, str):
+        raise ConfigurationError(name, f"must be a string, got {describe_value(value)}")
+    if choices is not None and value not in choices:
+        raise ConfigurationError(name, f"must be one of {', '.join(choices)}; got {value!r}")
+    if choices is None and not value:
+        raise ConfigurationError(name, "must not be empty")
+    return value
+
+
+def _flag(values: Mapping[str, Any], name: str) -> bool:
+    value = values.get(name)
+    if not isinstance(value, bool):
+        raise ConfigurationError(name, f"must be true or false, got {describe_value(value)}")
+    return value
+
+
+def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
+    preset_name = values.get("preset")
+    if not isinstance(preset_name, str):
+        raise ConfigurationError("preset", f"must be a string, got {describe_value(preset_name)}")
+    if preset_name:
+        try:
+            preset(preset_name)
+        except GeometryError as error:
+            raise ConfigurationError("preset", str(error)) from None
+    for name in GEOMETRY_PARAMETERS:
+        if values.get(name) is None:
+            raise ConfigurationError(name, "has no value: with preset '' all five of "
+                                     f"{', '.join(GEOMETRY_PARAMETERS)} must be given")
+    for name in ("crank_length", "coupler_length", "rocker_length"):
+        _positive(values, name, "m", MAX_LENGTH)
+    for name in ("ground_x", "ground_y"):
+        _within(values, name, -MAX_LENGTH, MAX_LENGTH, "m")
+    try:
+        linkage = FourBar(*(_real(values, name) for name in GEOMETRY_PARAMETERS))
+    except GeometryError as error:
+        raise ConfigurationError(", ".join(GEOMETRY_PARAMETERS), str(error)) from None
+    return preset_name, linkage
+
+
+def _branch(values: Mapping[str, Any]) -> int:
+    branch = values.get("branch")
+    if isinstance(branch, bool) or not isinstance(branch, int) or branch not in (1, -1):
+        raise ConfigurationError("branch", f"must be the integer 1 or -1, got {describe_value(branch)}")
+    return int(branch)
+
+
+def first_singular_point(linkage: FourBar, alpha_start: float, alpha_end: float) -> float | None:
+    """The first dead or change point the crank meets going from alpha_start to alpha_end
+    (inclusive of alpha_end), as an unwrapped crank angle; None if the way is clear."""
+    reachability = linkage.reachability
+    direction = 1.0 if alpha_end > alpha_start else -1.0
+    travel = abs(alpha_end - alpha_start)
+    nearest = None
+    for point in reachability.dead_points + reachability.change_points:
+        distance = (direction * (point - alpha_start)) % TWO_PI
+        if distance <= travel + ANGLE_TOLERANCE and (nearest is None or distance < nearest):
+            nearest = distance
+    return None if nearest is None else alpha_start + direction * nearest
+
+
+def _motion(
+    linkage: FourBar, drive: DriveLaw, branch: int, alpha_start: float, alpha_end: float
+) -> tuple[float | None, float]:
+    """Check the start and the end of one pass; return (blocked_at, pass duration in s)."""
+    try:
+        linkage.reachability.require(alpha_start)
+        solve(linkage, alpha_start, drive, branch)
+    except (UnreachableError, DeadPointError) as error:
+        raise ConfigurationError("alpha_start", str(error)) from None
+    if drive.angular_velocity(alpha_start) == 0.0:
+        raise ConfigurationError(
+            "omega0", "the crank is at rest at alpha_start (omega0 + k·alpha_start = 0 rad/s)"
+        )
+    if alpha_end == alpha_start:
+        raise ConfigurationError("alpha_end", "equals alpha_start, so a pass would be empty")
+    try:
+        drive.time_to(alpha_start, alpha_end)
+    except DriveError as error:
+        raise ConfigurationError("alpha_end", str(error)) from None
+    blocked_at = first_singular_point(linkage, alpha_start, alpha_end)
+    if blocked_at is None:
+        try:
+            solve(linkage, alpha_end, drive, branch)
+        except DeadPointError:
+            blocked_at = alpha_end
+    segment_end = alpha_end if blocked_at is None else blocked_at
+    duration = drive.time_to(alpha_start, segment_end)
+    if duration < MIN_PASS_DURATION:
+        raise ConfigurationError(
+            "alpha_end",
+            f"a pass from alpha_start to {math.degrees(segment_end):.6g}° would last only "
+            f"{duration:.3g} s under this drive law; it must last at least "
+            f"{MIN_PASS_DURATION:g} s",
+        )
+    return blocked_at, duration
+
+
+def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
+    """Validate parameter values (name → value) into a RunConfiguration.
+
+    Raises ConfigurationError naming the first offending parameter. Integers are accepted for
+    real-valued parameters; anything else of the wrong type is rejected.
+    """
+    preset_name, linkage = _geometry(values)
+    branch = _branch(values)
+    omega0 = _within(values, "omega0", -MAX_OMEGA0, MAX_OMEGA0, "rad/s")
+    k = _within(values, "k", -MAX_DRIVE_GAIN, MAX_DRIVE_GAIN, "1/s")
+    drive = DriveLaw(omega0, k)
+    alpha_start = _within(values, "alpha_start", -MAX_ANGLE, MAX_ANGLE)
+    alpha_end = _within(values, "alpha_end", -MAX_ANGLE, MAX_ANGLE)
+    end_behavior = _text(values, "end_behavior", END_BEHAVIORS)
+    mode = _text(values, "mode", MODES)
+    alpha_step = _positive(values, "alpha_step", "rad", TWO_PI)
+    rate_hz = _positive(values, "rate_hz", "Hz", MAX_RATE_HZ)
+    display_rate_hz = _positive(values, "display_rate_hz", "Hz", MAX_DISPLAY_RATE_HZ)
+    frame_id = _text(values, "frame_id")
+    min_transmission_angle = _within(
+        values, "diagnostics.min_transmission_angle", 0.0, math.pi / 2.0
+    )
+    dead_point_warning = _within(values, "diagnostics.dead_point_warning", 0.0, math.pi)
+    log_enabled = _flag(values, "log.enabled")
+    log_folder = Path(_text(values, "log.folder"))
+    blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
+    segment_end = alpha_end if blocked_at is None else blocked_at
+    travel = abs(segment_end - alpha_start)
+    steps = travel / alpha_step
+    if not math.isfinite(steps):
+        raise ConfigurationError("alpha_step", f"is too small for a pass of {travel!r} rad")
+    step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
+    return RunConfiguration(
+        preset=preset_name,
+        linkage=linkage,
+        drive=drive,
+        branch=branch,
+        alpha_start=alpha_start,
+        alpha_end=alpha_end,
+        end_behavior=end_behavior,
+        mode=mode,
+        alpha_step=alpha_step,
+        rate_hz=rate_hz,
+        display_rate_hz=display_rate_hz,
+        frame_id=frame_id,
+        min_transmission_angle=min_transmission_angle,
+        dead_point_warning=dead_point_warning,
+        log_enabled=log_enabled,
+        log_folder=log_folder,
+        direction=1 if segment_end > alpha_start else -1,
+        segment_end=segment_end,
+        blocked_at=blocked_at,
+        segment_duration=segment_duration,
+        whole_turns=(
+            blocked_at is None
+            and abs(math.remainder(alpha_end - alpha_start, TWO_PI)) <= _WHOLE_TURN_TOLERANCE
+        ),
+        step_count=step_count,
+    )
