@@ -25,7 +25,7 @@ from rclpy.task import Future
 from linkage_kinematics.parameters import parameter_specs
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-PROCESS_TIMEOUT = 30.0  # s; a generous bound on any one node run in these tests
+PROCESS_TIMEOUT = 60.0  # s; a generous bound on any one wait in these tests, also on a busy machine
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:
@@ -129,7 +129,25 @@ class Listener:
     def wait_for_publisher(self, topic: str, timeout: float = PROCESS_TIMEOUT) -> bool:
         return self.spin_until(lambda: self.node.count_publishers(topic) > 0, timeout)
 
-    def result_of(self, future: Future, timeout: float = 10.0) -> Any:
+    def heard_every_topic(self, count: int = 1) -> bool:
+        """Whether at least ``count`` messages arrived on every subscribed topic."""
+        return all(len(messages) >= count for messages in self.received.values())
+
+    def wait_for_every_topic(self, count: int = 1, timeout: float = PROCESS_TIMEOUT) -> bool:
+        """Spin until at least ``count`` messages arrived on every subscribed topic."""
+        return self.spin_until(lambda: self.heard_every_topic(count), timeout)
+
+    def drain(self) -> None:
+        """Take every message that has already arrived, e.g. after the node exited (it waits for
+        its subscribers' acknowledgements first): spin until three spins in a row bring
+        nothing new."""
+        idle = 0
+        while idle < 3:
+            before = sum(map(len, self.received.values()))
+            self.executor.spin_once(timeout_sec=0.05)
+            idle = idle + 1 if sum(map(len, self.received.values())) == before else 0
+
+    def result_of(self, future: Future, timeout: float = PROCESS_TIMEOUT) -> Any:
         """Spin until ``future`` (e.g. a parameter service call) is done; its result."""
         assert self.spin_until(future.done, timeout), "no answer within the timeout"
         return future.result()

@@ -17,7 +17,7 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
     completed = subprocess.run(
         [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(tmp_path / "bags"),
          "--rate-hz", "1000"],
-        cwd=REPO, env=environment, capture_output=True, text=True, timeout=120,
+        cwd=REPO, env=environment, capture_output=True, text=True, timeout=300,
     )
     assert completed.returncode == 0, completed.stderr
     bags = sorted(path for path in (tmp_path / "bags").iterdir() if path.is_dir())

@@ -353,7 +353,7 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
                 client.set_parameters([Parameter("end_behavior", value="stop")])).results
             assert result.successful
             assert listener.spin_until(lambda: process.poll() is not None)
-            listener.spin_until(lambda: False, timeout=0.3)
+            listener.drain()
             status = process.wait(timeout=PROCESS_TIMEOUT)
         finally:
             stop_process(process)

@@ -148,14 +148,14 @@ def test_unwritable_log_folder_is_a_start_up_error(tmp_path):
 
 def _set(client: AsyncParameterClient, listener: Listener, name: str, value) -> tuple[bool, str]:
     future = client.set_parameters([Parameter(name, value=value)])
-    assert listener.spin_until(future.done, timeout=10.0)
+    assert listener.spin_until(future.done)
     (result,) = future.result().results
     return result.successful, result.reason
 
 
 def _get(client: AsyncParameterClient, listener: Listener, name: str):
     future = client.get_parameters([name])
-    assert listener.spin_until(future.done, timeout=10.0)
+    assert listener.spin_until(future.done)
     (value,) = future.result().values
     return parameter_value_to_python(value)
 

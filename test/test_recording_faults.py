@@ -14,16 +14,18 @@ import pytest
 from diagnostic_msgs.msg import DiagnosticStatus
 from mcap.exceptions import EndOfFile
 from mcap.reader import make_reader
-from mcap.records import Message
+from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
 from rosbags.rosbag2 import Reader
 
 from linkage_kinematics import bag_reader
 from node_process import (
+    PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
     ros_environment,
     run_node,
+    stamp_ns,
     start_node,
     stop_process,
 )
@@ -55,16 +57,28 @@ def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0)
     raise AssertionError(f"no bag appeared in {folder}")
 
 
-def stream_message_count(mcap_path: Path) -> int:
-    """Messages an mcap streaming reader (no summary needed) gets from a file cut at a chunk end."""
-    count = 0
+def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
+    """Channel topics by id and the messages that an mcap streaming reader (no summary needed)
+    gets from the file as it is: a running or killed recorder's file ends after its last
+    complete chunk, without footer."""
+    topics: dict[int, str] = {}
+    messages: list[Message] = []
     with open(mcap_path, "rb") as stream:
         try:
             for record in StreamReader(stream, validate_crcs=True).records:
-                count += isinstance(record, Message)
+                if isinstance(record, Channel):
+                    topics[record.id] = record.topic
+                elif isinstance(record, Message):
+                    messages.append(record)
         except EndOfFile:
-            pass  # a killed recorder's file ends after its last complete chunk, without footer
-    return count
+            pass
+    return topics, messages
+
+
+def stream_topics(mcap_path: Path) -> set[str]:
+    """The topics of the messages in the complete chunks of a recorder's file so far."""
+    topics, messages = stream_records(mcap_path)
+    return {topics[message.channel_id] for message in messages}
 
 
 def recover(bag: Path) -> subprocess.CompletedProcess:
@@ -76,24 +90,36 @@ def recover(bag: Path) -> subprocess.CompletedProcess:
 
 def test_sigkill_keeps_complete_chunks_and_recovery_completes_the_bag(tmp_path: Path) -> None:
     folder = tmp_path / "bags"
-    process = start_node({**LOOP_PARAMETERS, "log.folder": str(folder)}, 35, tmp_path / "node.log")
-    try:
-        bag = wait_for_bag(folder, process)
-        time.sleep(2.5)
-        killed_at_ns = time.time_ns()
-        process.kill()
-        process.wait(timeout=10)
-    finally:
-        stop_process(process)
+    with ros_context(35) as context:
+        listener = listen_to_node_topics(context, "sigkill_listener")
+        process = start_node(
+            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 35, tmp_path / "node.log"
+        )
+        try:
+            bag = wait_for_bag(folder, process)
+            (mcap_path,) = bag.glob("*.mcap")
+            # Killed once complete chunks hold every topic and the listener has heard them all.
+            assert listener.spin_until(
+                lambda: listener.heard_every_topic()
+                and stream_topics(mcap_path) == set(NODE_TOPICS)
+            ), (tmp_path / "node.log").read_text()
+            last_heard_ns = stamp_ns(listener.received["/joint_states"][-1])
+            killed_at_ns = time.time_ns()
+            process.kill()
+            process.wait(timeout=PROCESS_TIMEOUT)
+        finally:
+            stop_process(process)
+            listener.destroy()
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.truncated
     survivors = list(bag_reader.iter_messages(bag))
-    assert len(survivors) == stream_message_count(mcap_file.path)
+    assert len(survivors) == len(stream_records(mcap_file.path)[1])
     assert {message.topic for message in survivors} == set(NODE_TOPICS)
     for message in survivors:
         TYPESTORE.deserialize_cdr(message.data, message.schema_name)
-    assert 0 <= killed_at_ns - survivors[-1].log_time_ns < MAX_LOSS_AT_KILL_NS
+    # What the node had recorded (and published) before the kill is kept up to the last chunk.
+    assert last_heard_ns - MAX_LOSS_AT_KILL_NS < survivors[-1].log_time_ns < killed_at_ns
 
     recovery = recover(bag)
     assert recovery.returncode == 0, recovery.stderr
@@ -115,14 +141,19 @@ def test_sigkill_keeps_complete_chunks_and_recovery_completes_the_bag(tmp_path: 
 @pytest.mark.parametrize("stop_signal", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal.Signals) -> None:
     folder = tmp_path / "bags"
-    process = start_node({**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log")
-    try:
-        bag = wait_for_bag(folder, process)
-        time.sleep(1.0)
-        process.send_signal(stop_signal)
-        assert process.wait(timeout=20) == 0, (tmp_path / "node.log").read_text()
-    finally:
-        stop_process(process)
+    with ros_context(36) as context:
+        listener = listen_to_node_topics(context, "signal_listener")
+        process = start_node(
+            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log"
+        )
+        try:
+            bag = wait_for_bag(folder, process)
+            assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+            process.send_signal(stop_signal)
+            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / "node.log").read_text()
+        finally:
+            stop_process(process)
+            listener.destroy()
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
@@ -216,11 +247,10 @@ def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path:
             assert listener.spin_until(lambda: recording_failed(listener.received))
             states_at_failure = len(listener.received["/linkage/state"])
             assert listener.spin_until(
-                lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200,
-                timeout=10.0,
+                lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200
             )
             process.send_signal(signal.SIGINT)
-            process.wait(timeout=20)
+            process.wait(timeout=PROCESS_TIMEOUT)
         finally:
             stop_process(process)
             listener.destroy()
