@@ -137,7 +137,7 @@ def sample_messages() -> list[Any]:
     stamp = messages.time_msg(1_234_567_890_123)
     return [
         messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
-        messages.linkage_state(state, stamp, 0.1, "linkage_base"),
+        messages.linkage_state(paper.geometry, state, stamp, 0.1, "linkage_base"),
         messages.marker_array(paper.geometry, state, stamp, "linkage_base"),
         messages.diagnostic_array(
             stamp, "linkage_node: crank motion", "four-bar", DiagnosticStatus.WARN,
