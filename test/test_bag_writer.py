@@ -441,10 +441,13 @@ def test_logged_states_are_the_library_solution_at_the_logged_alpha(
     for _, message, _ in states:
         (point,) = message.points
         state = solve(paper.geometry, point.positions[0], drive)
+        crank, rocker = paper.geometry.crank_length, paper.geometry.rocker_length
         expected_positions = [state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y,
-                              state.pin_b_x, state.pin_b_y]
+                              state.pin_b_x, state.pin_b_y, math.pi - state.beta,
+                              crank * state.alpha, rocker * state.beta]
         expected_velocities = [state.omega, -state.omega_bc, state.omega_ab, state.velocity_a_x,
-                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y]
+                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
+                               state.omega_bc, crank * state.omega, -rocker * state.omega_bc]
         assert list(point.positions) == pytest.approx(expected_positions, rel=1e-12, abs=1e-12)
         assert list(point.velocities) == pytest.approx(expected_velocities, rel=1e-12, abs=1e-12)
     assert states[-1][1].points[0].positions[0] == pytest.approx(math.pi / 2, abs=1e-9)
