@@ -315,8 +315,8 @@ def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
     # equal the library's speeds.
     assert read("V_A") == pytest.approx([state.v_a for state in library], rel=1e-12)
     assert read("V_B") == pytest.approx([state.v_b for state in library], rel=1e-12)
-    assert read("β") == [state.beta for state in library]
-    assert read("γ") == [state.gamma for state in library]
+    assert read("β") == pytest.approx([state.beta for state in library], rel=1e-12)
+    assert read("γ") == pytest.approx([state.gamma for state in library], rel=1e-12)
 
 
 # --- the paper's quantities as plain fields of /linkage/state ------------------------------------
