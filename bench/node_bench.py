@@ -177,7 +177,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             state = solve_sample(config, samples[0])
             stamp = clock.now().to_msg()
             joint_state = messages.joint_state(state, stamp)
-            trajectory = messages.linkage_state(state, stamp, 0.0, config.frame_id)
+            trajectory = messages.linkage_state(config.linkage, state, stamp, 0.0,
+                                                config.frame_id)
             bare_message = messages.joint_state(state, stamp)
             joint_state_data = recorder.serialize("/joint_states", joint_state)
             trajectory_data = recorder.serialize("/linkage/state", trajectory)
@@ -200,8 +201,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
                     stamp = now.to_msg()
                     joint_state = messages.joint_state(state, stamp, joint_state.position,
                                                        out=joint_state)
-                    trajectory = messages.linkage_state(state, stamp, 0.0, config.frame_id,
-                                                        out=trajectory)
+                    trajectory = messages.linkage_state(config.linkage, state, stamp, 0.0,
+                                                        config.frame_id, out=trajectory)
                 return count
 
             def serialize() -> int:

@@ -33,7 +33,14 @@ from linkage_kinematics.kinematics import LinkageState
 
 STATE_TOPIC = "/linkage/state"
 STATE_TYPE = "trajectory_msgs/msg/JointTrajectory"
-STATE_JOINT_NAMES = ("alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y")
+STATE_JOINT_NAMES = (
+    "alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y",
+    "rocker_angle", "pin_a_arc", "pin_b_arc",
+)
+# Bags logged before the rocker angle and the pin arcs were added hold only the first seven
+# coordinates; those map onto LinkageState in the same way, so both read alike.
+SEVEN_STATE_JOINT_NAMES = STATE_JOINT_NAMES[:7]
+_READ_COORDINATES = len(SEVEN_STATE_JOINT_NAMES)
 
 _MAGIC = b"\x89MCAP0\r\n"
 _RECORD_PREFIX = struct.Struct("<BQ")  # opcode, length of the record's content
@@ -142,9 +149,9 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
             )
         point = _state_point(trajectory, where)
         stamps.append(trajectory.header.stamp.sec * 1_000_000_000 + trajectory.header.stamp.nanosec)
-        positions.append(point.positions)
-        velocities.append(point.velocities)
-        accelerations.append(point.accelerations)
+        positions.append(point.positions[:_READ_COORDINATES])
+        velocities.append(point.velocities[:_READ_COORDINATES])
+        accelerations.append(point.accelerations[:_READ_COORDINATES])
     if not stamps:
         present = ", ".join(sorted(other_topics)) if other_topics else "none"
         raise BagError(f"{path} holds no {STATE_TOPIC} messages (topics present: {present})")
@@ -254,11 +261,13 @@ def _one_line(error: BaseException) -> str:
 
 
 def _state_point(trajectory: Any, where: str) -> Any:
-    """The one point of a decoded ``/linkage/state`` message, checked against the topic contract."""
+    """The one point of a decoded ``/linkage/state`` message, checked against the topic contract
+    (the current joint names, or the seven of earlier bags)."""
     names = tuple(trajectory.joint_names)
-    if names != STATE_JOINT_NAMES:
+    if names not in (STATE_JOINT_NAMES, SEVEN_STATE_JOINT_NAMES):
         raise BagError(
-            f"{where} has joint_names {list(names)}; expected {list(STATE_JOINT_NAMES)}"
+            f"{where} has joint_names {list(names)}; expected {list(STATE_JOINT_NAMES)} "
+            f"(or its first seven, as logged before the last three were added)"
         )
     points = trajectory.points
     if len(points) != 1:
@@ -266,9 +275,9 @@ def _state_point(trajectory: Any, where: str) -> Any:
     point = points[0]
     for field in ("positions", "velocities", "accelerations"):
         count = len(getattr(point, field))
-        if count != len(STATE_JOINT_NAMES):
+        if count != len(names):
             raise BagError(
-                f"{where} has {count} {field}; expected {len(STATE_JOINT_NAMES)} (one per joint)"
+                f"{where} has {count} {field}; expected {len(names)} (one per joint)"
             )
     return point
 
@@ -276,7 +285,8 @@ def _state_point(trajectory: Any, where: str) -> Any:
 def _state_from_columns(
     positions: np.ndarray, velocities: np.ndarray, accelerations: np.ndarray
 ) -> LinkageState:
-    """Map the message's coordinates (see README, topic ``/linkage/state``) onto LinkageState."""
+    """Map the message's first seven coordinates (see README, topic ``/linkage/state``) onto
+    LinkageState; the last three (rocker angle, pin arcs) restate them."""
     return LinkageState(
         alpha=positions[:, 0],
         beta=positions[:, 1],

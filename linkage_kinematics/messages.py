@@ -92,6 +92,7 @@ def joint_state(
 
 
 def linkage_state(
+    linkage: FourBar,
     state: LinkageState,
     stamp: Time,
     motion_time: float,
@@ -100,27 +101,35 @@ def linkage_state(
 ) -> JointTrajectory:
     """/linkage/state: the full state as one trajectory point (see README, "Topics").
 
-    ``positions``, ``velocities`` and ``accelerations`` hold each of α, β, γ, A_x, A_y, B_x, B_y
-    and its first and second time derivatives; dβ/dt = −ω_BC. ``motion_time`` (s) is the
-    drive-law time since the motion left alpha_start.
+    ``positions``, ``velocities`` and ``accelerations`` hold each coordinate of
+    ``STATE_JOINT_NAMES`` and its first and second time derivatives: α, β, γ, A_x, A_y, B_x,
+    B_y, then the rocker angle θ_BC = π − β (rates ω_BC, ω̇_BC) and the arc coordinates of the
+    pins along their circles, OA·α (rate V_A = OA·ω) and BC·β (rate V_B = −BC·ω_BC), so that
+    every quantity of the paper is one plain field. ``motion_time`` (s) is the drive-law time
+    since the motion left alpha_start.
     """
     if out is None:
         out = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[JointTrajectoryPoint()])
     out.header.stamp = stamp
     out.header.frame_id = frame_id
+    crank = linkage.crank_length
+    rocker = linkage.rocker_length
     point = out.points[0]
     point.positions = (
         state.alpha, state.beta, state.gamma,
         state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y,
+        math.pi - state.beta, crank * state.alpha, rocker * state.beta,
     )
     point.velocities = (
         state.omega, -state.omega_bc, state.omega_ab,
         state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
+        state.omega_bc, crank * state.omega, -rocker * state.omega_bc,
     )
     point.accelerations = (
         state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
         state.acceleration_a_x, state.acceleration_a_y,
         state.acceleration_b_x, state.acceleration_b_y,
+        state.omega_dot_bc, crank * state.omega_dot, -rocker * state.omega_dot_bc,
     )
     point.time_from_start = duration_msg(motion_time)
     return out

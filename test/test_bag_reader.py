@@ -27,6 +27,7 @@ from linkage_kinematics.kinematics import LinkageState, solve_many
 
 STATE_TYPE = "trajectory_msgs/msg/JointTrajectory"
 STRING_TYPE = "std_msgs/msg/String"
+PAPER = preset("paper").geometry
 START_NS = 1_700_000_000_000_000_000
 PERIOD_NS = 50_000_000
 _DEPENDENCIES = {
@@ -54,23 +55,33 @@ def message_definition(type_name: str) -> str:
     return "\n".join(parts)
 
 
-def state_message(state: LinkageState, index: int, stamp_ns: int, elapsed_s: float) -> dict:
-    """A /linkage/state JointTrajectory as the README's topic table defines it."""
+def state_message(
+    state: LinkageState, index: int, stamp_ns: int, elapsed_s: float, seven: bool = False
+) -> dict:
+    """A /linkage/state JointTrajectory as the README's topic table defines it for the paper's
+    geometry; ``seven`` writes only the first seven coordinates, as bags logged before the rocker
+    angle and the pin arcs were added hold."""
     row = state.at(index)
+    crank, rocker = PAPER.crank_length, PAPER.rocker_length
     seconds, nanoseconds = divmod(stamp_ns, 1_000_000_000)
     elapsed_ns = round(elapsed_s * 1e9)
+    count = 7 if seven else len(STATE_JOINT_NAMES)
     return {
         "header": {"stamp": {"sec": seconds, "nanosec": nanoseconds}, "frame_id": "o"},
-        "joint_names": list(STATE_JOINT_NAMES),
+        "joint_names": list(STATE_JOINT_NAMES[:count]),
         "points": [{
             "positions": [row.alpha, row.beta, row.gamma,
-                          row.pin_a_x, row.pin_a_y, row.pin_b_x, row.pin_b_y],
+                          row.pin_a_x, row.pin_a_y, row.pin_b_x, row.pin_b_y,
+                          math.pi - row.beta, crank * row.alpha, rocker * row.beta][:count],
             "velocities": [row.omega, -row.omega_bc, row.omega_ab,
                            row.velocity_a_x, row.velocity_a_y,
-                           row.velocity_b_x, row.velocity_b_y],
+                           row.velocity_b_x, row.velocity_b_y,
+                           row.omega_bc, crank * row.omega, -rocker * row.omega_bc][:count],
             "accelerations": [row.omega_dot, -row.omega_dot_bc, row.omega_dot_ab,
                               row.acceleration_a_x, row.acceleration_a_y,
-                              row.acceleration_b_x, row.acceleration_b_y],
+                              row.acceleration_b_x, row.acceleration_b_y,
+                              row.omega_dot_bc, crank * row.omega_dot,
+                              -rocker * row.omega_dot_bc][:count],
             "effort": [],
             "time_from_start": {"sec": elapsed_ns // 1_000_000_000,
                                 "nanosec": elapsed_ns % 1_000_000_000},
@@ -80,7 +91,7 @@ def state_message(state: LinkageState, index: int, stamp_ns: int, elapsed_s: flo
 
 def paper_states(step_deg: float = 5.0, drive: DriveLaw = DriveLaw(2.0)) -> LinkageState:
     alpha = np.radians(np.arange(0.0, 90.0 + step_deg / 2, step_deg))
-    return solve_many(preset("paper").geometry, alpha, drive)
+    return solve_many(PAPER, alpha, drive)
 
 
 def write_mcap(
@@ -90,11 +101,13 @@ def write_mcap(
     chunk_size: int = 1024 * 1024,
     compression: CompressionType = CompressionType.ZSTD,
     finish: bool = True,
+    seven: bool = False,
 ) -> list[int]:
     """Log ``state`` row by row on /linkage/state (with /chatter in between when ``foreign``).
 
     Returns the header stamps (ns). ``finish=False`` leaves the file as a killed recorder
-    would: complete chunks only, no summary, no footer.
+    would: complete chunks only, no summary, no footer. ``seven``: as logged before the rocker
+    angle and the pin arcs were added.
     """
     count = 0 if state is None else len(state.alpha)
     stamps = [START_NS + index * PERIOD_NS for index in range(count)]
@@ -110,7 +123,7 @@ def write_mcap(
         if index < count:
             writer.write_message(
                 STATE_TOPIC, state_schema,
-                state_message(state, index, stamps[index], index * PERIOD_NS / 1e9),
+                state_message(state, index, stamps[index], index * PERIOD_NS / 1e9, seven),
                 log_time=log_time, publish_time=stamps[index],
             )
     if finish:
@@ -156,6 +169,16 @@ def test_read_states_from_bag_folder_round_trips_every_field(tmp_path: Path) -> 
     assert_states_equal(logged, state, len(state.alpha))
     np.testing.assert_array_equal(logged.v_b, state.v_b)
     assert logged.omega_dot[-1] == pytest.approx(2.3 * (0.1 + 2.3 * math.pi / 2))
+
+
+def test_read_states_from_a_bag_logged_with_seven_joint_names(tmp_path: Path) -> None:
+    state = paper_states(drive=DriveLaw(0.1, 2.3))
+    stamps = write_mcap(tmp_path / "before.mcap", state, seven=True)
+    [first, *_] = iter_messages(tmp_path / "before.mcap", topics=[STATE_TOPIC])
+    assert list(_decoder(STATE_TYPE)(first.data).joint_names) == list(STATE_JOINT_NAMES[:7])
+    times, logged = read_states(tmp_path / "before.mcap")
+    assert times.tolist() == stamps
+    assert_states_equal(logged, state, len(state.alpha))
 
 
 def test_read_states_from_bare_mcap_file(tmp_path: Path) -> None:
@@ -343,6 +366,15 @@ def test_state_messages_off_contract_are_rejected(tmp_path: Path) -> None:
         writer.write_message(STATE_TOPIC, schema, message, log_time=START_NS)
         writer.finish()
     with pytest.raises(BagError, match=r"message 0 .* has joint_names \['crank_joint'"):
+        read_states(path)
+    with open(path, "wb") as stream:
+        writer = Writer(stream)
+        schema = writer.register_msgdef(STATE_TYPE, message_definition(STATE_TYPE))
+        message = state_message(state, 0, START_NS, 0.0)
+        message["points"][0]["velocities"] = message["points"][0]["velocities"][:7]
+        writer.write_message(STATE_TOPIC, schema, message, log_time=START_NS)
+        writer.finish()
+    with pytest.raises(BagError, match=r"message 0 .* has 7 velocities; expected 10 \(one per"):
         read_states(path)
     with open(path, "wb") as stream:
         writer = Writer(stream)

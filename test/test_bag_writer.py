@@ -1,5 +1,6 @@
 """Logging to rosbag2 MCAP: BagWriter and Recorder on their own, a real node run read back by two
-independent readers (rosbags and mcap-ros2-support), linkage-replay, and the Foxglove layout.
+independent readers (rosbags and mcap-ros2-support), and linkage-replay (the Foxglove layout's
+tests are in test_foxglove_layout.py).
 
 Nodes run and are listened to through node_process; the bag helpers here (reading a bag back
 with rosbags, its metadata.yaml) are shared with test_recording_faults.py and test_soak.py.
@@ -139,7 +140,7 @@ def sample_messages() -> list[Any]:
     stamp = messages.time_msg(1_234_567_890_123)
     return [
         messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
-        messages.linkage_state(state, stamp, 0.1, "linkage_base"),
+        messages.linkage_state(paper.geometry, state, stamp, 0.1, "linkage_base"),
         messages.marker_array(paper.geometry, state, stamp, "linkage_base"),
         messages.diagnostic_array(
             stamp, "linkage_node: crank motion", "four-bar", DiagnosticStatus.WARN,
@@ -452,10 +453,13 @@ def test_logged_states_are_the_library_solution_at_the_logged_alpha(
     for _, message, _ in states:
         (point,) = message.points
         state = solve(paper.geometry, point.positions[0], drive)
+        crank, rocker = paper.geometry.crank_length, paper.geometry.rocker_length
         expected_positions = [state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y,
-                              state.pin_b_x, state.pin_b_y]
+                              state.pin_b_x, state.pin_b_y, math.pi - state.beta,
+                              crank * state.alpha, rocker * state.beta]
         expected_velocities = [state.omega, -state.omega_bc, state.omega_ab, state.velocity_a_x,
-                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y]
+                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
+                               state.omega_bc, crank * state.omega, -rocker * state.omega_bc]
         assert list(point.positions) == pytest.approx(expected_positions, rel=1e-12, abs=1e-12)
         assert list(point.velocities) == pytest.approx(expected_velocities, rel=1e-12, abs=1e-12)
 
@@ -641,61 +645,3 @@ def test_replay_rejects_bad_input_with_a_clear_message(
         replay_main([str(node_run["bag"]), "--rate", "-2"])
     assert exit_info.value.code == 2
     assert "positive factor" in capsys.readouterr().err
-
-
-# --- the Foxglove layout --------------------------------------------------------------------
-
-
-def readme_topics() -> set[str]:
-    readme = (REPOSITORY / "README.md").read_text(encoding="utf-8")
-    return set(re.findall(r"^\| `(/[^`]+)` \|", readme, re.MULTILINE))
-
-
-def resolve_message_path(message: Any, path: str) -> float:
-    """Evaluate a Foxglove message path (after the topic) such as ``.points[0].positions[1]``."""
-    value = message
-    negate = False
-    for name, index in re.findall(r"\.(@?\w+)(?:\[(\d+)\])?", path):
-        if name == "@negative":
-            negate = True
-            continue
-        value = getattr(value, name)
-        if index:
-            value = value[int(index)]
-    return -value if negate else value
-
-
-def test_foxglove_layout_uses_only_contract_topics_and_valid_paths() -> None:
-    layout = json.loads((REPOSITORY / "foxglove/linkage_layout.json").read_text(encoding="utf-8"))
-    topics = readme_topics()
-    assert {"/linkage/state", "/linkage/markers", "/diagnostics"} <= topics
-    panels = layout["configById"]
-
-    def panel_ids(node: Any) -> list[str]:
-        if isinstance(node, str):
-            return [node]
-        return panel_ids(node["first"]) + panel_ids(node["second"])
-
-    assert sorted(panel_ids(layout["layout"])) == sorted(panels)
-    three_d = next(config for key, config in panels.items() if key.startswith("3D!"))
-    assert three_d["followTf"] == "linkage_base"
-    assert set(three_d["topics"]) == {"/linkage/markers"} <= topics
-    diagnostics = [c for key, c in panels.items() if key.startswith("Diagnostic")]
-    assert diagnostics and all(c["topicToRender"] == "/diagnostics" for c in diagnostics)
-
-    paper = preset("paper")
-    state = solve(paper.geometry, 0.4, DriveLaw(2.0, 2.3))
-    trajectory = messages.linkage_state(state, messages.time_msg(0), 0.0, "linkage_base")
-    plotted = {}
-    for key, config in panels.items():
-        if not key.startswith("Plot!"):
-            continue
-        for entry in config["paths"]:
-            topic, _, rest = entry["value"].partition(".")
-            assert topic in topics, entry["value"]
-            plotted[entry["label"]] = resolve_message_path(trajectory, "." + rest)
-    assert plotted == {
-        "α": state.alpha, "β": state.beta, "γ": state.gamma,
-        "ω": state.omega, "ω_AB": state.omega_ab, "ω_BC": state.omega_bc,
-        "ω̇": state.omega_dot, "ω̇_AB": state.omega_dot_ab, "ω̇_BC": state.omega_dot_bc,
-    }
