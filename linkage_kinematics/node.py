@@ -361,7 +361,8 @@ class LinkageNode(Node):
         )
         self._publish("/joint_states", joint_state, nanoseconds)
         self._linkage_state = messages.linkage_state(
-            state, stamp, motion_time, self.config.frame_id, out=self._linkage_state
+            self.config.linkage, state, stamp, motion_time, self.config.frame_id,
+            out=self._linkage_state,
         )
         self._publish("/linkage/state", self._linkage_state, nanoseconds)
 

@@ -22,6 +22,8 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
+from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.parameters import parameter_specs
 
 REPOSITORY = Path(__file__).resolve().parent.parent
@@ -177,6 +179,24 @@ def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
 def stamp_ns(message: Any) -> int:
     """The header stamp of ``message`` in integer nanoseconds."""
     return message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
+
+
+def expected_state_point(
+    linkage: FourBar, state: LinkageState
+) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """The positions, velocities and accelerations /linkage/state carries for a library state,
+    in its joint order (README): α, β, γ, pins A and B, θ_BC = π − β, OA·α, BC·β."""
+    crank, rocker = linkage.crank_length, linkage.rocker_length
+    return (
+        (state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y, state.pin_b_x,
+         state.pin_b_y, math.pi - state.beta, crank * state.alpha, rocker * state.beta),
+        (state.omega, -state.omega_bc, state.omega_ab, state.velocity_a_x, state.velocity_a_y,
+         state.velocity_b_x, state.velocity_b_y, state.omega_bc, crank * state.omega,
+         -rocker * state.omega_bc),
+        (state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab, state.acceleration_a_x,
+         state.acceleration_a_y, state.acceleration_b_x, state.acceleration_b_y,
+         state.omega_dot_bc, crank * state.omega_dot, -rocker * state.omega_dot_bc),
+    )
 
 
 def configuration_values(**overrides: Any) -> dict[str, Any]:

@@ -57,6 +57,7 @@ from linkage_kinematics.recording import (
 )
 from linkage_kinematics.replay import main as replay_main
 from node_process import (
+    expected_state_point,
     PROCESS_TIMEOUT,
     REPOSITORY,
     Listener,
@@ -453,15 +454,10 @@ def test_logged_states_are_the_library_solution_at_the_logged_alpha(
     for _, message, _ in states:
         (point,) = message.points
         state = solve(paper.geometry, point.positions[0], drive)
-        crank, rocker = paper.geometry.crank_length, paper.geometry.rocker_length
-        expected_positions = [state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y,
-                              state.pin_b_x, state.pin_b_y, math.pi - state.beta,
-                              crank * state.alpha, rocker * state.beta]
-        expected_velocities = [state.omega, -state.omega_bc, state.omega_ab, state.velocity_a_x,
-                               state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
-                               state.omega_bc, crank * state.omega, -rocker * state.omega_bc]
-        assert list(point.positions) == pytest.approx(expected_positions, rel=1e-12, abs=1e-12)
-        assert list(point.velocities) == pytest.approx(expected_velocities, rel=1e-12, abs=1e-12)
+        positions, velocities, accelerations = expected_state_point(paper.geometry, state)
+        assert tuple(point.positions) == positions
+        assert tuple(point.velocities) == velocities
+        assert tuple(point.accelerations) == accelerations
 
 
 def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(

@@ -33,6 +33,7 @@ from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_samp
 from linkage_kinematics.parameters import build_configuration
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
+    expected_state_point,
     PROCESS_TIMEOUT,
     REPOSITORY,
     Listener,
@@ -143,16 +144,8 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
         assert list(message.joint_names) == list(STATE_JOINT_NAMES)
         point = message.points[0]
         state = solve(PAPER, point.positions[0], drive)
-        assert tuple(point.positions) == (
-            state.alpha, state.beta, state.gamma,
-            state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y)
-        assert tuple(point.velocities) == (
-            state.omega, -state.omega_bc, state.omega_ab,
-            state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y)
-        assert tuple(point.accelerations) == (
-            state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
-            state.acceleration_a_x, state.acceleration_a_y,
-            state.acceleration_b_x, state.acceleration_b_y)
+        assert (tuple(point.positions), tuple(point.velocities), tuple(point.accelerations)) == (
+            expected_state_point(PAPER, state))
         assert _seconds(point.time_from_start) == pytest.approx(
             drive.time_to(0.0, state.alpha), abs=1e-9)
 
