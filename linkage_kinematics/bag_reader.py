@@ -116,7 +116,7 @@ def iter_messages(
 
 
 def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]:
-    """The states the node logged on ``/linkage/state``, in file order.
+    """The states the node logged on ``linkage/state`` (in any namespace), in file order.
 
     Returns each state's header stamp (int64 ns) and a LinkageState of arrays. The message does
     not carry the transmission angle, so ``transmission_angle`` is all NaN. Other topics are
@@ -130,7 +130,7 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
     velocities: list[list[float]] = []
     accelerations: list[list[float]] = []
     for schema, channel, message in _iter_records(files):
-        if channel.topic != STATE_TOPIC:
+        if not channel.topic.endswith(STATE_TOPIC):  # under any namespace
             other_topics.add(channel.topic)
             continue
         where = f"{STATE_TOPIC} message {len(stamps)} (log time {message.log_time} ns) in {path}"
@@ -160,6 +160,20 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
         np.array(velocities, dtype=float),
         np.array(accelerations, dtype=float),
     )
+
+
+def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
+    """The ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml."""
+    metadata_path = Path(folder) / "metadata.yaml"
+    try:
+        return yaml.safe_load(metadata_path.read_text(encoding="utf-8"))[
+            "rosbag2_bagfile_information"
+        ]
+    except (OSError, ValueError, yaml.YAMLError, KeyError, TypeError) as error:
+        raise BagError(
+            f"{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: "
+            f"{_one_line(error)})"
+        ) from None
 
 
 def _folder_files(folder: Path) -> list[Path]:

@@ -1,8 +1,8 @@
 """``linkage-demo``: the seed's numerical experiments, run through the real node and logged.
 
 Runs ``linkage_node`` once per drive law of the paper (constant ω = 2 rad/s, and
-ω = 0.10 + 2.3·α) over the 90° turn in the seed's fixed steps of 0.5°, each run logged to a new
-bag under the log folder, then reads every bag back and prints the head and tail of the seed's
+ω = 0.10 + 2.3·α) over the 90° turn in the seed's fixed steps of 0.5°, each step published when
+the drive law reaches it (0.785 s and 1.571 s), each run logged to a new bag under the log folder, then reads every bag back and prints the head and tail of the seed's
 Tables 1–4 from what was logged, and draws the four-panel figure beside each bag.
 """
 
@@ -25,14 +25,13 @@ SCENARIOS = (
 )
 
 
-def _run_node(params_file: Path, log_folder: Path, rate_hz: float) -> Path:
+def _run_node(params_file: Path, log_folder: Path) -> Path:
     """Run one scenario to its end; return the bag it wrote."""
     before = set(log_folder.iterdir()) if log_folder.is_dir() else set()
     command = [
         sys.executable, "-m", "linkage_kinematics.node", "--ros-args",
         "--params-file", str(params_file),
         "-p", "mode:=fixed_step",
-        "-p", f"rate_hz:={rate_hz}",
         "-p", f"log.folder:={log_folder}",
     ]
     completed = subprocess.run(command, check=False)
@@ -49,8 +48,6 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="linkage-demo", description=__doc__.splitlines()[0])
     parser.add_argument("--log-folder", type=Path, default=Path("bags"),
                         help="folder that receives one new bag per run (default: bags)")
-    parser.add_argument("--rate-hz", type=number(above=0.0, rule="greater than zero"), default=200.0,
-                        help="steps of 0.5° published per second (default: 200)")
     parser.add_argument("--rows", type=number(int, at_least=1, rule="at least 1"), default=2,
                         help="rows shown at the head and at the tail of each table (default: 2)")
     arguments = parser.parse_args(argv)
@@ -63,7 +60,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     for params_name, title in SCENARIOS:
         try:
-            bag = _run_node(config_folder / params_name, arguments.log_folder, arguments.rate_hz)
+            bag = _run_node(config_folder / params_name, arguments.log_folder)
             _stamps, state = read_states(bag)
         except (RuntimeError, OSError, BagError) as error:
             print(f"linkage-demo: {title}: {error}", file=sys.stderr)

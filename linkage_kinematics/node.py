@@ -36,11 +36,12 @@ from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 
-from linkage_kinematics import messages
+from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import package_version
 from linkage_kinematics.geometry import GeometryError, UnreachableError
 from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
 from linkage_kinematics.motion import (
+    MotionSample,
     blocked_note,
     dead_point_problem,
     met_dead_point,
@@ -50,6 +51,7 @@ from linkage_kinematics.motion import (
 )
 from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
+    REAL_PARAMETERS,
     ConfigurationError,
     ParameterSpec,
     RunConfiguration,
@@ -127,7 +129,8 @@ def assess(
 
 
 class LinkageNode(Node):
-    """Publishes the linkage's state at rate_hz, markers at display_rate_hz, diagnostics at 1 Hz.
+    """Publishes the linkage's state as the drive law moves the crank, markers at
+    display_rate_hz, diagnostics at 1 Hz and whenever the motion's activity changes.
 
     Construction raises ConfigurationError for bad parameters before anything is published or
     written. ``exit_code`` becomes an int when the node has finished (see README).
@@ -145,11 +148,13 @@ class LinkageNode(Node):
                 self.set_descriptor(spec.name, parameter_descriptor(spec))
         if blocked_note(self.config) is not None:
             self.get_logger().warning(blocked_note(self.config))
-        self._pending: RunConfiguration | None = None
+        self._pending: tuple[RunConfiguration, list[str]] | None = None
         self._problem: str | None = None
         self._activity = "starting"
         self._recording_error: str | None = None
-        self._state: LinkageState | None = None
+        self._described: RunConfiguration | None = None
+        # frame_id and frame_prefix are read-only: one frame for the node's life.
+        self._frame_id = self.config.frame_prefix + self.config.frame_id
         self._joint_state = JointState(name=list(messages.JOINT_NAMES), position=[0.0] * 3)
         self._linkage_state: JointTrajectory | None = None
         self._markers: MarkerArray | None = None
@@ -157,26 +162,40 @@ class LinkageNode(Node):
         self._window_ticks = 0
         self._achieved_rate = 0.0
         self._missed_deadlines = 0
+        self._missed_before_restart = 0
         self._restart_motion()
-        self._topic_publishers = {
-            "/joint_states": self.create_publisher(JointState, "/joint_states", DATA_QOS),
-            "/linkage/state": self.create_publisher(JointTrajectory, "/linkage/state", DATA_QOS),
-            "/robot_description": self.create_publisher(
-                String, "/robot_description", ROBOT_DESCRIPTION_QOS
-            ),
-            "/linkage/markers": self.create_publisher(MarkerArray, "/linkage/markers", DATA_QOS),
-            "/diagnostics": self.create_publisher(DiagnosticArray, "/diagnostics", DATA_QOS),
-        }
+        # Relative names resolve under the node's namespace (as joint_state_publisher's and
+        # robot_state_publisher's do), so mechanisms in different namespaces never mix;
+        # /diagnostics is absolute, diagnostic_updater's convention.
+        publishers = (
+            self.create_publisher(JointState, "joint_states", DATA_QOS),
+            self.create_publisher(JointTrajectory, "linkage/state", DATA_QOS),
+            self.create_publisher(String, "robot_description", ROBOT_DESCRIPTION_QOS),
+            self.create_publisher(MarkerArray, "linkage/markers", DATA_QOS),
+            self.create_publisher(DiagnosticArray, "/diagnostics", DATA_QOS),
+        )
+        self._topic_publishers = {publisher.topic_name: publisher for publisher in publishers}
+        (
+            self._joint_states_topic,
+            self._state_topic,
+            self._description_topic,
+            self._markers_topic,
+            self._diagnostics_topic,
+        ) = self._topic_publishers
         self._recorder = self._open_recorder() if self.config.log_enabled else None
-        self._publish_robot_description()
-        self._publish_diagnostics()
-        self._state_timer = self.create_timer(1.0 / self.config.rate_hz, self._tick)
+        if self._recorder is not None:
+            self.get_logger().info(f"recording to {self._recorder.bag_path}")
+        self._state_timer = self.create_timer(self._timer_period(), self._tick)
         self._marker_timer = self.create_timer(
             1.0 / self.config.display_rate_hz, self._publish_markers
         )
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics)
+        self.add_pre_set_parameters_callback(self._keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
+        # The motion starts now (its first state, scene first, is published at once), unless
+        # the clock does not run yet (use_sim_time before the first /clock).
+        self._tick()
 
     # parameters
 
@@ -198,51 +217,69 @@ class LinkageNode(Node):
             self.declare_parameter(
                 spec.name, spec.default, parameter_descriptor(spec, with_range=False)
             )
+        # A whole number given for a real parameter (`-p rate_hz:=50`) is stored as that real.
+        whole_numbers = [
+            self.get_parameter(name) for name in REAL_PARAMETERS
+            if self.get_parameter(name).type_ == Parameter.Type.INTEGER
+        ]
+        if whole_numbers:
+            self.set_parameters(self._keep_declared_types(whole_numbers))
         return specs
 
     def parameter_values(self) -> dict[str, Any]:
         """Current values of the node's own parameters (name → value)."""
         return {name: self.get_parameter(name).value for name in PARAMETER_NAMES}
 
+    @staticmethod
+    def _keep_declared_types(changed: list[Parameter]) -> list[Parameter]:
+        """Whole numbers given for real parameters become those reals, so that a parameter
+        never changes type (`ros2 param set /linkage_node rate_hz 50`)."""
+        return [
+            Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+            if p.name in REAL_PARAMETERS and p.type_ == Parameter.Type.INTEGER
+            else p
+            for p in changed
+        ]
+
     def _validate_change(self, changed: list[Parameter]) -> SetParametersResult:
         """Validate the whole configuration the change would produce; keep it for the post-set
         callback, which swaps it in once rclpy has stored the values."""
+        current = self.parameter_values()
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
-        if not updates:
-            self._pending = None
-            return SetParametersResult(successful=True)
         try:
-            self._pending = build_configuration({**self.parameter_values(), **updates})
+            config = build_configuration({**current, **updates})
         except ConfigurationError as error:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
+        differing = [name for name, value in updates.items() if value != current[name]]
+        self._pending = (config, differing)
         return SetParametersResult(successful=True)
 
     def _apply_change(self, changed: list[Parameter]) -> None:
-        new, self._pending = self._pending, None
-        if new is None:
+        if self._pending is None:
             return
+        (new, differing), self._pending = self._pending, None
+        if not differing:
+            return  # e.g. `ros2 param load` of the node's own dump: nothing changes
         old, self.config = self.config, new
+        restarts = new.restarts_motion(old)
         self.get_logger().info(
             "parameters changed: "
-            + ", ".join(f"{p.name}={p.value!r}" for p in changed)
-            + ("; motion restarts at alpha_start" if new.restarts_motion(old) else "")
+            + ", ".join(f"{name}={self.get_parameter(name).value!r}" for name in differing)
+            + ("; motion restarts at alpha_start" if restarts else "")
         )
         note = blocked_note(new)
         if note is not None:
             self.get_logger().warning(note)
-        if new.linkage != old.linkage:
-            self._publish_robot_description()
-            self._markers = None
-        if new.rate_hz != old.rate_hz:
-            self._state_timer.destroy()
-            self._state_timer = self.create_timer(1.0 / new.rate_hz, self._tick)
         if new.display_rate_hz != old.display_rate_hz:
             self._marker_timer.destroy()
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
                                                    self._publish_markers)
-        if new.restarts_motion(old):
+        if restarts:
             self._restart_motion()
+            self._state_timer.destroy()
+            self._state_timer = self.create_timer(self._timer_period(), self._tick)
+            self._tick()
 
     # recording
 
@@ -295,12 +332,24 @@ class LinkageNode(Node):
         except OSError as error:
             self.get_logger().error(f"could not finalize the log: {error}")
             return False
+        bag = self._recorder.bag_path
+        count = bag_reader.bag_information(bag)["message_count"]
+        self.get_logger().info(f"bag finalized: {bag}, {count} messages")
         return True
 
     # motion
 
+    def _timer_period(self) -> float:
+        """The state timer's period: rate_hz in real_time mode; in fixed_step mode the timer is
+        re-armed for each step's time, and this first period only starts it."""
+        if self.config.mode == "real_time":
+            return 1.0 / self.config.rate_hz
+        return 1e-3
+
     def _restart_motion(self) -> None:
         self._motion_start: Time | None = None
+        self._state: LinkageState | None = None
+        self._state_time: Time | None = None
         self._step = 0
         self._ticks = 0
         self._pass_index = 0
@@ -311,24 +360,59 @@ class LinkageNode(Node):
         if self.exit_code is not None:
             return
         now = self.get_clock().now()
+        if now.nanoseconds == 0:
+            return  # use_sim_time and no /clock yet: the motion has no time to start at
         if self._motion_start is None or now < self._motion_start:
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
             self._motion_start = now
+        if self.config.mode == "real_time":
+            self._advance_in_real_time(now)
+        else:
+            self._advance_steps(now)
+
+    def _advance_in_real_time(self, now: Time) -> None:
         elapsed = (now - self._motion_start).nanoseconds * 1e-9
         self._count_tick(elapsed)
-        config = self.config
-        if config.mode == "real_time":
-            sample = sample_at_time(config, elapsed)
-        else:
-            sample = sample_at_step(config, self._step)
-            self._step += 1
+        sample = sample_at_time(self.config, elapsed)
         if sample is None:
             self._cannot_go_on(None)
             return
+        # The end of a 'stop' pass is published at the time the drive law reaches it.
+        at = self._motion_time(sample.motion_time) if sample.final else now
+        self._publish_sample(sample, at)
+
+    def _advance_steps(self, now: Time) -> None:
+        """Publish every step whose drive-law time has come, each stamped with that time, then
+        re-arm the timer for the next step's time."""
+        published = 0
+        while self.exit_code is None:
+            sample = sample_at_step(self.config, self._step)
+            if sample is None:
+                self._cannot_go_on(None)
+                return
+            due = self._motion_time(sample.motion_time)
+            if due > now:
+                self._state_timer.timer_period_ns = (due - now).nanoseconds
+                self._state_timer.reset()
+                return
+            if published:
+                # The step before this one went out only once this one's time had come.
+                self._missed_deadlines += 1
+            published += 1
+            self._step += 1
+            self._ticks += 1
+            self._window_ticks += 1
+            self._publish_sample(sample, due)
+
+    def _motion_time(self, seconds: float) -> Time:
+        """The node-clock time ``seconds`` of drive-law time after the motion started."""
+        return self._motion_start + Duration(nanoseconds=round(seconds * 1e9))
+
+    def _publish_sample(self, sample: MotionSample, at: Time) -> None:
+        config = self.config
         if met_dead_point(config, self._pass_index, sample.pass_index):
-            # Stamped with the tick's time, like the state that follows, so log times never fall.
-            self._publish_diagnostics(dead_point_problem(config), now)
+            self._publish_diagnostics(dead_point_problem(config), at)
         self._pass_index = sample.pass_index
         try:
             state = solve_sample(config, sample)
@@ -337,7 +421,7 @@ class LinkageNode(Node):
                 self._cannot_go_on(str(error))
             # loop and bounce turn round at the dead point itself, which has no state to show.
             return
-        self._publish_state(state, sample.motion_time, now)
+        self._publish_state(state, sample.motion_time, at)
         if sample.final:
             self._finish_at_end()
 
@@ -351,20 +435,30 @@ class LinkageNode(Node):
         )
         self._window_ticks += 1
 
-    def _publish_state(self, state: LinkageState, motion_time: float, now: Time) -> None:
-        stamp = now.to_msg()
-        nanoseconds = now.nanoseconds
+    def _publish_state(self, state: LinkageState, motion_time: float, at: Time) -> None:
+        """Publish a state stamped ``at``; the first of a motion comes after its scene (so a
+        viewer knows the frame before anything refers to it), the URDF if the geometry is new,
+        and the status that says the crank moves."""
+        first = self._state is None
         self._state = state
-        self._activity = "moving"
+        self._state_time = at
+        if first:
+            self._publish_markers()
+            if self._described is None or self._described.linkage != self.config.linkage:
+                self._publish_robot_description(at)
+            self._activity = "moving"
+            self._publish_diagnostics()
+        stamp = at.to_msg()
+        nanoseconds = at.nanoseconds
         joint_state = messages.joint_state(
             state, stamp, self._joint_state.position, out=self._joint_state
         )
-        self._publish("/joint_states", joint_state, nanoseconds)
+        self._publish(self._joint_states_topic, joint_state, nanoseconds)
         self._linkage_state = messages.linkage_state(
-            self.config.linkage, state, stamp, motion_time, self.config.frame_id,
+            self.config.linkage, state, stamp, motion_time, self._frame_id,
             out=self._linkage_state,
         )
-        self._publish("/linkage/state", self._linkage_state, nanoseconds)
+        self._publish(self._state_topic, self._linkage_state, nanoseconds)
 
     def _finish_at_end(self) -> None:
         self._activity = (
@@ -388,25 +482,28 @@ class LinkageNode(Node):
 
     # display and diagnostics
 
-    def _publish_robot_description(self) -> None:
+    def _publish_robot_description(self, at: Time) -> None:
+        self._described = self.config
         message = String(data=urdf_text(self.config.linkage, self.config.frame_id))
-        self._publish("/robot_description", message, self.get_clock().now().nanoseconds)
+        self._publish(self._description_topic, message, at.nanoseconds)
 
     def _publish_markers(self) -> None:
+        """The scene of the latest state, stamped with that state's time."""
         if self._state is None:
             return
-        now = self.get_clock().now()
         self._markers = messages.marker_array(
-            self.config.linkage, self._state, now.to_msg(), self.config.frame_id,
+            self.config.linkage, self._state, self._state_time.to_msg(), self._frame_id,
             out=self._markers,
         )
-        self._publish("/linkage/markers", self._markers, now.nanoseconds)
+        self._publish(self._markers_topic, self._markers, self._state_time.nanoseconds)
 
-    def _publish_diagnostics(self, event: str | None = None, now: Time | None = None) -> None:
-        """Publish the status (at ``now``, by default the clock's); ``event``, a problem of this
-        moment only, makes it ERROR."""
-        if now is None:
-            now = self.get_clock().now()
+    def _publish_diagnostics(self, event: str | None = None, at: Time | None = None) -> None:
+        """Publish the status, stamped ``at`` (by default the latest state's time, so that log
+        times never fall behind the states'); ``event``, a problem of this moment only, makes
+        it ERROR."""
+        now = self.get_clock().now()
+        if at is None:
+            at = self._state_time if self._state_time is not None else now
         if self._window_start is not None:
             window = (now - self._window_start).nanoseconds * 1e-9
             if window > 0.0:
@@ -416,14 +513,14 @@ class LinkageNode(Node):
         problem = event or self._problem or self._recording_error
         level, text = assess(self.config, self._state, problem, self._activity)
         message = messages.diagnostic_array(
-            now.to_msg(),
+            at.to_msg(),
             f"{self.get_name()}: {DIAGNOSTIC_TASK}",
             f"four-bar linkage ({self.config.preset or 'explicit geometry'})",
             level,
             text,
             self._diagnostic_values(),
         )
-        self._publish("/diagnostics", message, now.nanoseconds)
+        self._publish(self._diagnostics_topic, message, at.nanoseconds)
 
     def _diagnostic_values(self) -> dict[str, str]:
         config = self.config

@@ -75,6 +75,7 @@ class RunConfiguration:
     rate_hz: float
     display_rate_hz: float
     frame_id: str
+    frame_prefix: str
     min_transmission_angle: float
     dead_point_warning: float
     log_enabled: bool
@@ -123,13 +124,14 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
             name,
             getattr(geometry, name) if geometry is not None else None,
             f"{text} (m); defaults to the preset's value, required when preset is ''",
+            floating_range=limits,
         )
-        for name, text in (
-            ("crank_length", "disk radius OA"),
-            ("coupler_length", "coupler length AB"),
-            ("rocker_length", "rocker length BC"),
-            ("ground_x", "x of the fixed pivot C relative to O"),
-            ("ground_y", "y of the fixed pivot C relative to O"),
+        for name, text, limits in (
+            ("crank_length", "disk radius OA, greater than 0", (0.0, MAX_LENGTH)),
+            ("coupler_length", "coupler length AB, greater than 0", (0.0, MAX_LENGTH)),
+            ("rocker_length", "rocker length BC, greater than 0", (0.0, MAX_LENGTH)),
+            ("ground_x", "x of the fixed pivot C relative to O", (-MAX_LENGTH, MAX_LENGTH)),
+            ("ground_y", "y of the fixed pivot C relative to O", (-MAX_LENGTH, MAX_LENGTH)),
         )
     )
     return (
@@ -142,22 +144,36 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         *geometry_specs,
         ParameterSpec("branch", 1, "assembly branch: +1 (B left of A→C) or −1",
                       integer_range=(-1, 1, 2)),
-        ParameterSpec("omega0", 2.0, "drive law ω = omega0 + k·α: omega0 (rad/s)"),
-        ParameterSpec("k", 0.0, "drive law ω = omega0 + k·α: k (1/s)"),
-        ParameterSpec("alpha_start", 0.0, "crank angle where the motion starts (rad)"),
-        ParameterSpec("alpha_end", math.pi / 2.0, "crank angle where one pass ends (rad)"),
+        ParameterSpec("omega0", 2.0, "drive law ω = omega0 + k·α: omega0 (rad/s)",
+                      floating_range=(-MAX_OMEGA0, MAX_OMEGA0)),
+        ParameterSpec("k", 0.0, "drive law ω = omega0 + k·α: k (1/s)",
+                      floating_range=(-MAX_DRIVE_GAIN, MAX_DRIVE_GAIN)),
+        ParameterSpec("alpha_start", 0.0, "crank angle where the motion starts (rad)",
+                      floating_range=(-MAX_ANGLE, MAX_ANGLE)),
+        ParameterSpec("alpha_end", math.pi / 2.0,
+                      "crank angle where one pass ends (rad), not alpha_start",
+                      floating_range=(-MAX_ANGLE, MAX_ANGLE)),
         ParameterSpec("end_behavior", "stop",
                       "at the end of a pass: stop (and exit), loop or bounce"),
         ParameterSpec("mode", "real_time",
-                      "real_time: α from node-clock time; fixed_step: one alpha_step per tick"),
-        ParameterSpec("alpha_step", math.radians(0.5), "crank step in fixed_step mode (rad)",
+                      "real_time: α from node-clock time at rate_hz; fixed_step: steps of "
+                      "alpha_step, each published when the drive law reaches it"),
+        ParameterSpec("alpha_step", math.radians(0.5),
+                      "crank step in fixed_step mode (rad), greater than 0",
                       floating_range=(0.0, TWO_PI)),
-        ParameterSpec("rate_hz", 100.0, "compute and publish rate of the state (Hz)",
+        ParameterSpec("rate_hz", 100.0,
+                      "state compute and publish rate in real_time mode (Hz), greater than 0; "
+                      "unused in fixed_step mode",
                       floating_range=(0.0, MAX_RATE_HZ)),
-        ParameterSpec("display_rate_hz", 30.0, "publish rate of /linkage/markers (Hz)",
+        ParameterSpec("display_rate_hz", 30.0,
+                      "publish rate of linkage/markers (Hz), greater than 0",
                       floating_range=(0.0, MAX_DISPLAY_RATE_HZ)),
         ParameterSpec("frame_id", DEFAULT_FRAME_ID,
-                      "frame of markers and /linkage/state, root link of the URDF",
+                      "frame of the markers and linkage/state, root link of the URDF",
+                      read_only=True),
+        ParameterSpec("frame_prefix", "",
+                      "prefix of every frame id the node publishes (robot_state_publisher's "
+                      "frame_prefix, e.g. 'left/'); the URDF stays unprefixed",
                       read_only=True),
         ParameterSpec("diagnostics.min_transmission_angle", math.radians(10.0),
                       "WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)",
@@ -174,6 +190,9 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
 
 
 PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(""))
+REAL_PARAMETERS = frozenset(
+    spec.name for spec in parameter_specs("") if spec.floating_range is not None
+)
 
 
 # --- validation: pure functions from parameter values to a RunConfiguration ---------------
@@ -214,13 +233,18 @@ def _within(
     return value
 
 
-def _text(values: Mapping[str, Any], name: str, choices: tuple[str, ...] | None = None) -> str:
+def _text(
+    values: Mapping[str, Any],
+    name: str,
+    choices: tuple[str, ...] | None = None,
+    allow_empty: bool = False,
+) -> str:
     value = values.get(name)
     if not isinstance(value, str):
         raise ConfigurationError(name, f"must be a string, got {describe_value(value)}")
     if choices is not None and value not in choices:
         raise ConfigurationError(name, f"must be one of {', '.join(choices)}; got {value!r}")
-    if choices is None and not value:
+    if choices is None and not value and not allow_empty:
         raise ConfigurationError(name, "must not be empty")
     return value
 
@@ -333,6 +357,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     rate_hz = _positive(values, "rate_hz", "Hz", MAX_RATE_HZ)
     display_rate_hz = _positive(values, "display_rate_hz", "Hz", MAX_DISPLAY_RATE_HZ)
     frame_id = _text(values, "frame_id")
+    frame_prefix = _text(values, "frame_prefix", allow_empty=True)
     min_transmission_angle = _within(
         values, "diagnostics.min_transmission_angle", 0.0, math.pi / 2.0
     )
@@ -359,6 +384,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         rate_hz=rate_hz,
         display_rate_hz=display_rate_hz,
         frame_id=frame_id,
+        frame_prefix=frame_prefix,
         min_transmission_angle=min_transmission_angle,
         dead_point_warning=dead_point_warning,
         log_enabled=log_enabled,

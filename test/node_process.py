@@ -11,7 +11,7 @@ import os
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -53,13 +53,18 @@ def parameter_argument(name: str, value: Any) -> str:
     return f"{name}:={text}"
 
 
-def node_command(parameters: Mapping[str, Any], executable: list[str] | None = None) -> list[str]:
-    """The command line of a node with ``parameters``."""
+def node_command(
+    parameters: Mapping[str, Any],
+    executable: list[str] | None = None,
+    ros_arguments: Sequence[str] = (),
+) -> list[str]:
+    """The command line of a node with ``parameters`` and further ``ros_arguments`` (e.g.
+    ``-r __ns:=/left``)."""
     command = executable or [sys.executable, "-m", "linkage_kinematics.node"]
     arguments = ["--ros-args"]
     for name, value in parameters.items():
         arguments += ["-p", parameter_argument(name, value)]
-    return command + arguments
+    return command + arguments + list(ros_arguments)
 
 
 def start_node(
@@ -70,12 +75,13 @@ def start_node(
     environment: Mapping[str, str] | None = None,
     cwd: Path = REPOSITORY,
     preexec_fn: Callable[[], None] | None = None,
+    ros_arguments: Sequence[str] = (),
 ) -> subprocess.Popen:
     """Start a node process (by default the working tree's, from the repository root); its
     stdout and stderr go to the file ``output``; ``preexec_fn`` runs in the child first."""
     with open(output, "w") as log:
         return subprocess.Popen(
-            node_command(parameters, executable),
+            node_command(parameters, executable, ros_arguments),
             cwd=cwd,
             env=dict(environment) if environment is not None else ros_environment(domain_id),
             stdout=log,
@@ -109,11 +115,14 @@ class Listener:
         self.executor = SingleThreadedExecutor(context=context)
         self.executor.add_node(self.node)
         self.received: dict[str, list[Any]] = {}
+        # Transient-local topics (the robot description) are published once, not once per tick.
+        self.latched: set[str] = set()
 
     def subscribe(self, topic: str, msg_type: type, transient_local: bool = False) -> None:
         self.received.setdefault(topic, [])
         qos = QoSProfile(depth=1000)
         if transient_local:
+            self.latched.add(topic)
             qos = QoSProfile(
                 depth=1,
                 durability=DurabilityPolicy.TRANSIENT_LOCAL,
@@ -132,11 +141,15 @@ class Listener:
         return self.spin_until(lambda: self.node.count_publishers(topic) > 0, timeout)
 
     def heard_every_topic(self, count: int = 1) -> bool:
-        """Whether at least ``count`` messages arrived on every subscribed topic."""
-        return all(len(messages) >= count for messages in self.received.values())
+        """Whether at least ``count`` messages (one on a transient-local topic) arrived on every
+        subscribed topic."""
+        return all(
+            len(messages) >= (1 if topic in self.latched else count)
+            for topic, messages in self.received.items()
+        )
 
     def wait_for_every_topic(self, count: int = 1, timeout: float = PROCESS_TIMEOUT) -> bool:
-        """Spin until at least ``count`` messages arrived on every subscribed topic."""
+        """Spin until ``heard_every_topic(count)``."""
         return self.spin_until(lambda: self.heard_every_topic(count), timeout)
 
     def drain(self) -> None:

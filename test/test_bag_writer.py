@@ -382,11 +382,7 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
             run_folder / "node.log",
         )
         try:
-            # /robot_description is published once; every other topic more often.
-            assert listener.spin_until(
-                lambda: listener.heard_every_topic()
-                and min(len(listener.received[topic]) for topic in DATA_TOPICS) >= 2
-            ), (run_folder / "node.log").read_text()
+            assert listener.wait_for_every_topic(count=2), (run_folder / "node.log").read_text()
             process.send_signal(signal.SIGINT)
             assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (run_folder / "node.log").read_text()
         finally:

@@ -82,6 +82,7 @@ ACCEPTED = {
     "rate_hz": set(),                        # in (0, 10000]
     "display_rate_hz": set(),                # in (0, 1000]
     "frame_id": set(),
+    "frame_prefix": set(),                   # any string, "" for none
     "diagnostics.min_transmission_angle": {"zero"},  # 0 turns the warning off
     "diagnostics.dead_point_warning": {"zero"},
     "log.enabled": set(),

@@ -20,6 +20,7 @@ from linkage_kinematics.parameters import (
     ConfigurationError,
     build_configuration,
     first_singular_point,
+    parameter_specs,
 )
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
@@ -217,3 +218,64 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
         finally:
             stop_process(process)
             listener.destroy()
+
+
+def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change_nothing(
+    tmp_path,
+):
+    output = tmp_path / "node.log"
+    with ros_context(DOMAIN_ID) as context:
+        listener = Listener("parameter_contract_tester", context)
+        listener.subscribe("/linkage/state", JointTrajectory)
+        states = listener.received["/linkage/state"]
+        process = start_node(
+            {"preset": "grashof_crank_rocker", "alpha_end": 2.0 * math.pi,
+             "end_behavior": "loop", "rate_hz": 50, "log.enabled": False},
+            DOMAIN_ID, output)
+        try:
+            client = AsyncParameterClient(listener.node, "linkage_node")
+            assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
+
+            # Every numeric parameter's descriptor carries its range (/describe_parameters).
+            numeric = [spec.name for spec in parameter_specs("paper")
+                       if isinstance(spec.default, (int, float))
+                       and not isinstance(spec.default, bool)]
+            descriptors = listener.result_of(client.describe_parameters(numeric)).descriptors
+            for name, descriptor in zip(numeric, descriptors):
+                assert descriptor.name == name
+                assert descriptor.floating_point_range or descriptor.integer_range, name
+            (rate_range,) = descriptors[numeric.index("rate_hz")].floating_point_range
+            assert (rate_range.from_value, rate_range.to_value) == (0.0, 10000.0)
+
+            # A whole number for a real parameter, at start-up and at run time, stays a real.
+            def rate() -> object:
+                (value,) = listener.result_of(client.get_parameters(["rate_hz"])).values
+                return parameter_value_to_python(value)
+
+            assert rate() == 50.0 and isinstance(rate(), float)
+            assert _set(client, listener, "rate_hz", 60) == (True, "")
+            assert rate() == 60.0 and isinstance(rate(), float)
+            successful, reason = _set(client, listener, "rate_hz", 0)
+            assert not successful and reason == _set(client, listener, "rate_hz", 0.0)[1]
+
+            # Setting every writable parameter to its current value (as `ros2 param load` of the
+            # node's own dump does) restarts nothing: time_from_start keeps counting.
+            assert listener.spin_until(lambda: len(states) >= 3)
+            writable = [spec.name for spec in parameter_specs("grashof_crank_rocker")
+                        if not spec.read_only]
+            values = listener.result_of(client.get_parameters(writable)).values
+            before = len(states)
+            results = listener.result_of(client.set_parameters(
+                [Parameter(name, value=parameter_value_to_python(value))
+                 for name, value in zip(writable, values)])).results
+            assert all(result.successful for result in results)
+            assert listener.spin_until(lambda: len(states) > before + 10)
+            times = [m.points[0].time_from_start.sec * 10**9 + m.points[0].time_from_start.nanosec
+                     for m in states[before - 1:]]
+            assert times == sorted(times)
+            assert process.poll() is None
+        finally:
+            stop_process(process)
+            listener.destroy()
+    log = output.read_text()
+    assert log.count("parameters changed") == 1 and "parameters changed: rate_hz=60.0" in log
