@@ -2,7 +2,8 @@
 
 Runs ``linkage_node`` once per drive law of the paper (constant ω = 2 rad/s, and
 ω = 0.10 + 2.3·α) over the 90° turn in the seed's fixed steps of 0.5°, each step published when
-the drive law reaches it (0.785 s and 1.571 s), each run logged to a new bag under the log folder, then reads every bag back and prints the head and tail of the seed's
+the drive law reaches it (the turns last 0.785 s and 1.571 s), each run logged to a new bag
+under the log folder, then reads every bag back and prints the head and tail of the seed's
 Tables 1–4 from what was logged, and draws the four-panel figure beside each bag.
 """
 

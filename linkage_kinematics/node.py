@@ -50,6 +50,7 @@ from linkage_kinematics.motion import (
     solve_sample,
 )
 from linkage_kinematics.parameters import (
+    NODE_NAME,
     PARAMETER_NAMES,
     REAL_PARAMETERS,
     ConfigurationError,
@@ -62,7 +63,6 @@ from linkage_kinematics.parameters import (
 from linkage_kinematics.recording import Recorder
 from linkage_kinematics.urdf import urdf_text
 
-NODE_NAME = "linkage_node"
 DIAGNOSTIC_TASK = "crank motion"
 DIAGNOSTICS_PERIOD = 1.0  # s
 

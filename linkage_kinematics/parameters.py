@@ -13,6 +13,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 from linkage_kinematics.drive import DriveError, DriveLaw
 from linkage_kinematics.geometry import (
     ANGLE_TOLERANCE,
@@ -25,6 +27,7 @@ from linkage_kinematics.geometry import (
 from linkage_kinematics.kinematics import DeadPointError, solve
 from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 
+NODE_NAME = "linkage_node"
 END_BEHAVIORS = ("stop", "loop", "bounce")
 MODES = ("real_time", "fixed_step")
 GEOMETRY_PARAMETERS = ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")
@@ -399,3 +402,22 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         ),
         step_count=step_count,
     )
+
+
+def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
+    """The namespaces of a parameters file's ``/<namespace>/linkage_node`` entries, in file
+    order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry."""
+    path = Path(parameters_file)
+    try:
+        entries = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as error:
+        raise ValueError(f"cannot read parameters file {path}: {error}") from None
+    if not isinstance(entries, dict) or not entries:
+        raise ValueError(f"{path} has no /<namespace>/{NODE_NAME} entries")
+    namespaces = []
+    for key in entries:
+        namespace, _, name = str(key).rpartition("/")
+        if name != NODE_NAME or not namespace.startswith("/") or "*" in namespace:
+            raise ValueError(f"{path}: entry {key!r} is not /<namespace>/{NODE_NAME}")
+        namespaces.append(namespace)
+    return namespaces

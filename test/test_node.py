@@ -458,7 +458,7 @@ def test_installed_urdf_is_the_generated_paper_urdf():
 def test_launch_configs_hold_the_seed_scenarios():
     for name, omega0, k in (("constant", 2.0, 0.0), ("variable", 0.10, 2.3)):
         text = (REPOSITORY / "config" / f"seed_{name}.yaml").read_text()
-        parameters = yaml.safe_load(text)["linkage_node"]["ros__parameters"]
+        parameters = yaml.safe_load(text)["/**/linkage_node"]["ros__parameters"]
         config = _configuration(**parameters)
         assert (config.drive, config.alpha_start, config.alpha_end, config.end_behavior) == (
             DriveLaw(omega0, k), 0.0, math.pi / 2.0, "stop")
