@@ -116,6 +116,32 @@ _ARRAY_MATH: MathFunctions = (np.sin, np.cos, np.sqrt, np.arctan2, np.abs)
 _CHUNK = 8192
 
 
+# Below this |sin(½(α − a))| the half-angle sine is recomputed from α − a less whole turns
+# held exactly (``_half_sine``); above it, the rounding of α − a is harmless beside it.
+_NEAR_HALF_SINE = 0.25
+
+
+def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -> FloatOrArray:
+    """sin(½(α − a)) for a singular angle a (a double-double), to rounding of the result even
+    where it vanishes: there α − a − 2π·k is taken exactly (Dekker's product for 2π·k), so the
+    sine keeps its sign and its relative accuracy right next to the zero, after many turns too.
+    """
+    high, low = point
+    value = sin(0.5 * ((alpha - high) - low))
+    if isinstance(value, np.ndarray):
+        near = np.abs(value) < _NEAR_HALF_SINE
+        if not np.any(near):
+            return value
+        turns = np.round((alpha - high) / TWO_PI)
+        exact = sin(0.5 * _offset(alpha, point, turns)) * (1.0 - 2.0 * (turns % 2.0))
+        return np.where(near, exact, value)
+    if abs(value) >= _NEAR_HALF_SINE:
+        return value
+    turns = float(round((alpha - high) / TWO_PI))
+    exact = sin(0.5 * _offset(alpha, point, turns))
+    return -exact if turns % 2.0 else exact
+
+
 def _factor(part: LoopFactor, orientation: float, scale: float, alpha: FloatOrArray,
             distance: FloatOrArray, sin: Callable) -> tuple[FloatOrArray, FloatOrArray | None]:
     """One factor of Heron's product (geometry's comment on LoopFactor) and, for a factor with
@@ -127,14 +153,12 @@ def _factor(part: LoopFactor, orientation: float, scale: float, alpha: FloatOrAr
     if kind == _PLAIN:
         length = part.length
         return orientation * (distance - length) * (distance + length), None
-    first_high, first_low = part.first
-    first = sin(0.5 * ((alpha - first_high) - first_low))
+    first = _half_sine(alpha, part.first, sin)
     if kind == _TOUCH:
         return part.gap + scale * first * first, None
-    second_high, second_low = part.second
-    second = sin(0.5 * ((alpha - second_high) - second_low))
+    second = _half_sine(alpha, part.second, sin)
     absolute = abs(first), abs(second)
-    nearest = np.minimum(*absolute) if isinstance(alpha, np.ndarray) else min(absolute)
+    nearest = np.minimum(*absolute) if isinstance(first, np.ndarray) else min(absolute)
     return orientation * scale * first * second, nearest
 
 
@@ -189,8 +213,8 @@ def _loop_closure(
     sine = height * distance / (coupler * rocker)
     smooth = None
     if closure.change_points:
-        smooth = _smooth_rate_terms(linkage, branch, alpha, stretched, folded, distance_squared,
-                                    along, distance, xp)
+        smooth = _smooth_rate_terms(linkage, branch, alpha, stretched, folded,
+                                    distance_squared, along, distance, xp)
     return (sin_alpha, cos_alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y,
             sine, closes, nearest_dead, smooth)
 
@@ -215,11 +239,9 @@ def _smooth_rate_terms(
     crank = linkage.crank_length
     ground = closure.ground
     half_scale = 0.25 * closure.scale  # OA·OC
-    direction_high, direction_low = closure.direction
-    opposite_high, opposite_low = closure.opposite
     # sin and cos of ½φ, φ = α − α₀, each from the crank's offset to the angle where it vanishes
-    sin_half = sin(0.5 * ((alpha - direction_high) - direction_low))
-    cos_half = -sin(0.5 * ((alpha - opposite_high) - opposite_low))
+    sin_half = _half_sine(alpha, closure.direction, sin)
+    cos_half = -_half_sine(alpha, closure.opposite, sin)
     # p = OC·cos φ, q = −OC·sin φ
     p_minus_crank = ground * (cos_half - sin_half) * (cos_half + sin_half) - crank
     q = -2.0 * ground * sin_half * cos_half
@@ -227,7 +249,7 @@ def _smooth_rate_terms(
         # m = sin(½φ)·sin(½(φ − π)), q = 2·OC·m, R = 2·OA·OC/d
         vanishing = -sin_half * cos_half
         # at m = 0, the sign just counterclockwise is the other factor's
-        other = (np.where(sin_half == 0.0, -cos_half, sin_half) if isinstance(alpha, np.ndarray)
+        other = (np.where(sin_half == 0.0, -cos_half, sin_half) if isinstance(sin_half, np.ndarray)
                  else -cos_half if sin_half == 0.0 else sin_half)
         numerator = 2.0 * ground
         numerator_rate = 0.0
