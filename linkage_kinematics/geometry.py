@@ -304,6 +304,14 @@ class LoopClosure:
     change_points: tuple[tuple[float, float], ...]
     # True where OA = OC and AB = BC: pin A passes through C, where the dyad ABC is undetermined.
     passes_through_pivot: bool
+    # (AB + BC, |AB − BC|), and whether the factors may come from d where both are far from zero
+    # (not for change-point linkages, whose rates always take the analytic form).
+    reach: tuple[float, float] = (0.0, 0.0)
+    plain_where_far: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "reach", (self.stretched.length, self.folded.length))
+        object.__setattr__(self, "plain_where_far", not self.change_points)
 
 
 def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:

@@ -116,113 +116,55 @@ _ARRAY_MATH: MathFunctions = (np.sin, np.cos, np.sqrt, np.arctan2, np.abs)
 _CHUNK = 8192
 
 
+# Where AB + BC − d and d − |AB − BC| both exceed this fraction of d, the factors are taken
+# from d (their relative error is then at most a few roundings) instead of from α's offsets to
+# the singular angles: the scalar path's shortcut for ordinary angles.
+_FAR = 0.0625
+# |sin(½(α − a))| below which α is checked against the refusal rule: ½δ for the refusal zone's
+# widest δ ≈ 1500·ulp(α) at |α| up to ~3e6 rad.
+_NEAR_DEAD = 1e-6
 # Below this |sin(½(α − a))| the half-angle sine is recomputed from α − a less whole turns
 # held exactly (``_half_sine``); above it, the rounding of α − a is harmless beside it.
 _NEAR_HALF_SINE = 0.25
 
 
-def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -> FloatOrArray:
-    """sin(½(α − a)) for a singular angle a (a double-double), to rounding of the result even
-    where it vanishes: there α − a − 2π·k is taken exactly (Dekker's product for 2π·k), so the
-    sine keeps its sign and its relative accuracy right next to the zero, after many turns too.
+def _corrected_half_sine(alpha: FloatOrArray, point: tuple[float, float], difference: FloatOrArray,
+                         value: FloatOrArray, sin: Callable) -> FloatOrArray:
+    """sin(½(α − a)) for a singular angle a (a double-double), given ``value`` =
+    sin(½((α − a_high) − a_low)) and ``difference`` = α − a_high: to rounding of the result even
+    where it vanishes. Within half a turn of a, ``value`` carries only the rounding of the
+    result; near another turn's image of a, α − a − 2π·k is taken exactly instead (Dekker's
+    product for 2π·k), so that the sine keeps its sign and relative accuracy next to the zero
+    after many turns too. Call it for a float only where -π ≤ difference ≤ π fails and
+    |value| < _NEAR_HALF_SINE.
     """
-    high, low = point
-    value = sin(0.5 * ((alpha - high) - low))
     if isinstance(value, np.ndarray):
-        near = np.abs(value) < _NEAR_HALF_SINE
+        near = (np.abs(value) < _NEAR_HALF_SINE) & (np.abs(difference) > math.pi)
         if not np.any(near):
             return value
-        turns = np.round((alpha - high) / TWO_PI)
+        turns = np.round(difference / TWO_PI)
         exact = sin(0.5 * _offset(alpha, point, turns)) * (1.0 - 2.0 * (turns % 2.0))
         return np.where(near, exact, value)
-    if abs(value) >= _NEAR_HALF_SINE:
-        return value
-    turns = float(round((alpha - high) / TWO_PI))
+    turns = float(round(difference / TWO_PI))
     exact = sin(0.5 * _offset(alpha, point, turns))
     return -exact if turns % 2.0 else exact
 
 
-def _factor(part: LoopFactor, orientation: float, scale: float, alpha: FloatOrArray,
-            distance: FloatOrArray, sin: Callable) -> tuple[FloatOrArray, FloatOrArray | None]:
-    """One factor of Heron's product (geometry's comment on LoopFactor) and, for a factor with
-    dead points, the smaller |sin(½(α − a))| of its two zeros a (else None).
-
-    ``orientation`` is −1 for the stretched factor (AB + BC)² − d², +1 for the folded one.
-    """
-    kind = part.kind
-    if kind == _PLAIN:
-        length = part.length
-        return orientation * (distance - length) * (distance + length), None
-    first = _half_sine(alpha, part.first, sin)
-    if kind == _TOUCH:
-        return part.gap + scale * first * first, None
-    second = _half_sine(alpha, part.second, sin)
-    absolute = abs(first), abs(second)
-    nearest = np.minimum(*absolute) if isinstance(first, np.ndarray) else min(absolute)
-    return orientation * scale * first * second, nearest
-
-
-def _loop_closure(
-    linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, xp: MathFunctions
-) -> tuple:
-    """Positions by loop closure, and what the rates and the checks need.
-
-    Returns sin α, cos α, pin A, the vectors A→B and C→B, S = sin μ (signed), whether the loop
-    closes (both factors > 0, or a change factor ≥ 0), the smallest |sin(½(α − a))| over the
-    dead points a (None without dead points), and for a change-point linkage the terms of its
-    analytic rates (``_smooth_rate_terms``), else None.
-
-    ``xp`` is (sin, cos, sqrt, atan2, abs) from ``math`` or ``numpy``.
-    """
-    sin, cos, sqrt, _, _ = xp
-    closure = linkage.closure
-    crank = linkage.crank_length
-    coupler = linkage.coupler_length
-    rocker = linkage.rocker_length
-    sin_alpha = sin(alpha)
-    cos_alpha = cos(alpha)
-    pin_a_x = crank * sin_alpha
-    pin_a_y = -crank * cos_alpha
-    to_c_x = linkage.ground_x - pin_a_x
-    to_c_y = linkage.ground_y - pin_a_y
-    distance_squared = to_c_x * to_c_x + to_c_y * to_c_y
-    distance = sqrt(distance_squared)
-    scale = closure.scale
-    stretched, stretched_near = _factor(closure.stretched, -1.0, scale, alpha, distance, sin)
-    folded, folded_near = _factor(closure.folded, 1.0, scale, alpha, distance, sin)
-    if stretched_near is None:
-        nearest_dead = folded_near
-    elif folded_near is None:
-        nearest_dead = stretched_near
-    else:
-        nearest_dead = np.minimum(stretched_near, folded_near)
-    # A touching factor is ≥ 0 by construction; at a change point it is 0 and the loop closes.
-    closes = ((True if closure.stretched.kind == _TOUCH else stretched > 0.0)
-              & (True if closure.folded.kind == _TOUCH else folded > 0.0))
-    heron = stretched * folded
-    two_distance = 2.0 * distance
-    u_x = to_c_x / distance
-    u_y = to_c_y / distance
-    along = (closure.squares + distance_squared) / two_distance
-    height = branch * sqrt(heron * (heron > 0.0)) / two_distance
-    rocker_along = along - distance
-    coupler_x = along * u_x - height * u_y
-    coupler_y = along * u_y + height * u_x
-    rocker_x = rocker_along * u_x - height * u_y
-    rocker_y = rocker_along * u_y + height * u_x
-    sine = height * distance / (coupler * rocker)
-    smooth = None
-    if closure.change_points:
-        smooth = _smooth_rate_terms(linkage, branch, alpha, stretched, folded,
-                                    distance_squared, along, distance, xp)
-    return (sin_alpha, cos_alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y,
-            sine, closes, nearest_dead, smooth)
+def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -> FloatOrArray:
+    """sin(½(α − a)) for a singular angle a, as ``_corrected_half_sine`` describes."""
+    high, low = point
+    difference = alpha - high
+    value = sin(0.5 * (difference - low))
+    if (isinstance(value, np.ndarray) or not (-math.pi <= difference <= math.pi
+                                               or abs(value) >= _NEAR_HALF_SINE)):
+        return _corrected_half_sine(alpha, point, difference, value, sin)
+    return value
 
 
 def _smooth_rate_terms(
     linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, stretched: FloatOrArray,
-    folded: FloatOrArray, distance_squared: FloatOrArray, along: FloatOrArray,
-    distance: FloatOrArray, xp: MathFunctions,
+    folded: FloatOrArray, distance_squared: FloatOrArray, distance: FloatOrArray,
+    xp: MathFunctions,
 ) -> tuple[FloatOrArray, ...]:
     """p − OA, q, Q = q/h and dQ/dα of a change-point linkage, analytic through its change points.
 
@@ -279,28 +221,116 @@ def _smooth_rate_terms(
         analytic = branch * math.copysign(1.0, other if vanishing == 0.0 else vanishing)
     ratio = analytic * numerator / radius
     ratio_rate = analytic * (numerator_rate - numerator * radius_log_rate) / radius
-    return p_minus_crank, q, ratio, ratio_rate, distance_squared, along, distance
+    return p_minus_crank, q, ratio, ratio_rate
 
 
 def _closed_form(
-    linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, drive: DriveLaw,
+    linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, drive: DriveLaw | None,
     xp: MathFunctions,
 ) -> tuple[FloatOrArray, ...]:
-    """Evaluate the closed form: the 22 LinkageState fields in order, then S, whether the loop
-    closes, and the nearness to a dead point (``_loop_closure``)."""
-    atan2 = xp[3]
+    """Evaluate the closed form: the 22 LinkageState fields in order, then S = sin μ (signed),
+    whether the loop closes (both factors > 0, or a change factor ≥ 0), and the smallest
+    |sin(½(α − a))| over the dead points a (None without dead points or far from them).
+
+    With ``drive`` None, only the positions: α, β, γ, pin A, pin B, μ, then the same three.
+    ``xp`` is (sin, cos, sqrt, atan2, abs) from ``math`` or ``numpy``.
+    """
+    sin, cos, sqrt, atan2, _ = xp
+    closure = linkage.closure
     crank = linkage.crank_length
     coupler = linkage.coupler_length
     rocker = linkage.rocker_length
-    (
-        sin_alpha, cos_alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y, sine,
-        closes, nearest_dead, smooth,
-    ) = _loop_closure(linkage, branch, alpha, xp)
+    ground_x = linkage.ground_x
+    ground_y = linkage.ground_y
+    sin_alpha = sin(alpha)
+    cos_alpha = cos(alpha)
+    pin_a_x = crank * sin_alpha
+    pin_a_y = -crank * cos_alpha
+    to_c_x = ground_x - pin_a_x
+    to_c_y = ground_y - pin_a_y
+    distance_squared = to_c_x * to_c_x + to_c_y * to_c_y
+    distance = sqrt(distance_squared)
+    reach, difference = closure.reach
+    stretched = reach - distance
+    folded = distance - difference
+    if (closure.plain_where_far and xp is _SCALAR_MATH
+            and stretched >= _FAR * distance and folded >= _FAR * distance):
+        # Far from every zero of the factors, d's own rounding is harmless beside them: the
+        # cheaper product from d, with the loop surely closed and no dead point near.
+        stretched *= reach + distance
+        folded *= distance + difference
+        closes = True
+        nearest_dead = None
+    else:
+        # Each factor in the form geometry.LoopFactor names: from d; from the offsets to its two
+        # dead points a₁, a₂ as ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as
+        # gap + 4·OA·OC·sin²(½(α − a)). nearest_dead is the least |sin(½(α − a))| of the dead
+        # points; a touching factor is ≥ 0 by construction (0 at a change point, where the loop
+        # closes).
+        scale = closure.scale
+        nearest_dead = None
+        closes = True
+        factors = []
+        for part, orientation, value in ((closure.stretched, -1.0, stretched),
+                                         (closure.folded, 1.0, folded)):
+            kind = part.kind
+            if kind == _PLAIN:
+                value = value * (distance + part.length)
+                closes = closes & (value > 0.0)
+                factors.append(value)
+                continue
+            high, low = part.first
+            difference = alpha - high
+            first = sin(0.5 * (difference - low))
+            if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
+                                          or abs(first) >= _NEAR_HALF_SINE)):
+                first = _corrected_half_sine(alpha, part.first, difference, first, sin)
+            if kind == _TOUCH:
+                factors.append(part.gap + scale * first * first)
+                continue
+            high, low = part.second
+            difference = alpha - high
+            second = sin(0.5 * (difference - low))
+            if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
+                                          or abs(second) >= _NEAR_HALF_SINE)):
+                second = _corrected_half_sine(alpha, part.second, difference, second, sin)
+            value = orientation * scale * first * second
+            closes = closes & (value > 0.0)
+            first = abs(first)
+            second = abs(second)
+            if xp is _ARRAY_MATH:
+                near = np.minimum(first, second)
+                nearest_dead = near if nearest_dead is None else np.minimum(nearest_dead, near)
+            else:
+                # only a float within the refusal check's reach is reported
+                near = first if first < second else second
+                if near < _NEAR_DEAD and (nearest_dead is None or near < nearest_dead):
+                    nearest_dead = near
+            factors.append(value)
+        stretched, folded = factors
+        if closure.passes_through_pivot:
+            closes = closes & (distance >= PIVOT_PASSAGE * closure.ground)
+    heron = stretched * folded
+    two_distance = 2.0 * distance
+    u_x = to_c_x / distance
+    u_y = to_c_y / distance
+    along = (closure.squares + distance_squared) / two_distance
+    height = branch * sqrt(heron * (heron > 0.0)) / two_distance
+    rocker_along = along - distance
+    coupler_x = along * u_x - height * u_y
+    coupler_y = along * u_y + height * u_x
+    rocker_x = rocker_along * u_x - height * u_y
+    rocker_y = rocker_along * u_y + height * u_x
+    sine = height * distance / (coupler * rocker)
     e_ab_x = coupler_x / coupler
     e_ab_y = coupler_y / coupler
     e_bc_x = rocker_x / rocker
     e_bc_y = rocker_y / rocker
     cosine = e_ab_x * e_bc_x + e_ab_y * e_bc_y
+    if drive is None:
+        return (alpha, atan2(rocker_y, -rocker_x), atan2(coupler_y, coupler_x), pin_a_x,
+                pin_a_y, ground_x + rocker_x, ground_y + rocker_y, atan2(abs(sine), cosine),
+                sine, closes, nearest_dead)
 
     omega = drive.omega0 + drive.k * alpha
     omega_dot = drive.k * omega
@@ -312,7 +342,7 @@ def _closed_form(
     acceleration_a_x = crank * (omega_dot * cos_alpha - omega_squared * sin_alpha)
     acceleration_a_y = crank * (omega_dot * sin_alpha + omega_squared * cos_alpha)
 
-    if smooth is None:
+    if not closure.change_points:
         # Cramer's rule on the differentiated loop (module docstring).
         coupler_sine = coupler * sine
         rocker_sine = rocker * sine
@@ -329,18 +359,18 @@ def _closed_form(
         # A→C and G = dγ/dα, G_BC = d(angle of C→B)/dα,
         #   G = −OA·((p − OA) + (x − d)·Q)/d²,  G_BC = −OA·((p − OA) + x·Q)/d²
         # and their α-derivatives, from p' = q, q' = −p, (d²)' = −2·OA·q, x' = OA·q·(x − d)/d².
-        p_minus_crank, q, ratio, ratio_rate, distance_squared, along, distance = smooth
-        lever = along - distance
+        p_minus_crank, q, ratio, ratio_rate = _smooth_rate_terms(
+            linkage, branch, alpha, stretched, folded, distance_squared, distance, xp)
         scale = -crank / distance_squared
         drift = crank * q / distance_squared
-        coupler_rate = scale * (p_minus_crank + lever * ratio)
+        coupler_rate = scale * (p_minus_crank + rocker_along * ratio)
         rocker_rate = scale * (p_minus_crank + along * ratio)
         coupler_curvature = scale * (
-            q + lever * ratio_rate
-            + drift * (along * ratio + 2.0 * p_minus_crank + 2.0 * lever * ratio))
+            q + rocker_along * ratio_rate
+            + drift * (along * ratio + 2.0 * p_minus_crank + 2.0 * rocker_along * ratio))
         rocker_curvature = scale * (
             q + along * ratio_rate
-            + drift * (lever * ratio + 2.0 * p_minus_crank + 2.0 * along * ratio))
+            + drift * (rocker_along * ratio + 2.0 * p_minus_crank + 2.0 * along * ratio))
         omega_ab = omega * coupler_rate
         omega_bc = omega * rocker_rate
         omega_dot_ab = omega_dot * coupler_rate + omega_squared * coupler_curvature
@@ -360,8 +390,8 @@ def _closed_form(
         omega_dot_bc,
         pin_a_x,
         pin_a_y,
-        linkage.ground_x + rocker_x,
-        linkage.ground_y + rocker_y,
+        ground_x + rocker_x,
+        ground_y + rocker_y,
         velocity_a_x,
         velocity_a_y,
         -omega_bc * rocker_y,
@@ -417,9 +447,26 @@ def _check_pivot_passage(linkage: FourBar, alpha: FloatOrArray) -> None:
         )
 
 
+def _check_closure(linkage: FourBar, alpha: float, closes: bool,
+                   nearest_dead: float | None) -> None:
+    """Raise as ``solve`` does where the loop does not close or α is too close to a dead point."""
+    if not closes:
+        raise _refuse(linkage, alpha)
+    if nearest_dead is not None and nearest_dead < _NEAR_DEAD and _too_close(alpha, nearest_dead):
+        raise DeadPointError(_dead_point_message(alpha))
+
+
 def _refuse(linkage: FourBar, alpha: float) -> ValueError:
-    """The error for an α where the loop does not close: UnreachableError outside the reachable
-    set (with its tolerance), DeadPointError at an interval end."""
+    """The error for an α where the loop does not close: UnreachableError for a non-finite α or
+    outside the reachable set (with its tolerance), DeadPointError at an interval end or with
+    pin A on the pivot C."""
+    if not math.isfinite(alpha):
+        return UnreachableError(f"crank angle α must be finite, got {alpha!r}")
+    if linkage.closure.passes_through_pivot:
+        try:
+            _check_pivot_passage(linkage, alpha)
+        except DeadPointError as error:
+            return error
     try:
         linkage.reachability.require(alpha)
     except UnreachableError as error:
@@ -441,24 +488,18 @@ def solve(
     RATE_ACCURACY (``solve_pose`` still gives the positions there). The state returned never
     holds NaN or inf.
     """
-    if not math.isfinite(alpha):
-        raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
     if branch != 1 and branch != -1:
         _check_branch(branch)
     try:
         values = _closed_form(linkage, branch, alpha, drive, _SCALAR_MATH)
     except ZeroDivisionError:
         # S = 0: past or on a dead point (the loop does not close), or pin A on the pivot C.
-        if linkage.closure.passes_through_pivot:
-            _check_pivot_passage(linkage, alpha)
         raise _refuse(linkage, alpha) from None
-    if not values[23]:
-        raise _refuse(linkage, alpha)
-    if linkage.closure.passes_through_pivot:
-        _check_pivot_passage(linkage, alpha)
-    nearest_dead = values[24]
-    if nearest_dead is not None and nearest_dead < 1e-6 and _too_close(alpha, nearest_dead):
-        raise DeadPointError(_dead_point_message(alpha))
+    except ValueError:
+        # math.sin of ±inf, or rounding NaN to whole turns
+        raise _refuse(linkage, alpha) from None
+    if values[23] is not True or values[24] is not None:
+        _check_closure(linkage, alpha, values[23], values[24])
     state = _StateBuilder()
     (
         state.alpha,
@@ -487,7 +528,7 @@ def solve(
         _,
         _,
     ) = values
-    object.__setattr__(state, "__class__", LinkageState)
+    state.__class__ = LinkageState
     return state
 
 
@@ -513,31 +554,13 @@ def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
     if not math.isfinite(alpha):
         raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
     _check_branch(branch)
-    try:
-        (
-            _, _, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y, sine, closes, _, _
-        ) = _loop_closure(linkage, branch, alpha, _SCALAR_MATH)
-    except ZeroDivisionError:
+    if linkage.closure.passes_through_pivot:
         _check_pivot_passage(linkage, alpha)
-        raise
+    *pose, _, closes, _ = _closed_form(linkage, branch, alpha, None, _SCALAR_MATH)
     if not closes:
         # On the interval end (within its tolerance) the positions are the dead point's.
         linkage.reachability.require(alpha)
-    coupler = linkage.coupler_length
-    rocker = linkage.rocker_length
-    cosine = (
-        (coupler_x / coupler) * (rocker_x / rocker) + (coupler_y / coupler) * (rocker_y / rocker)
-    )
-    return LinkagePose(
-        alpha=alpha,
-        beta=math.atan2(rocker_y, -rocker_x),
-        gamma=math.atan2(coupler_y, coupler_x),
-        pin_a_x=pin_a_x,
-        pin_a_y=pin_a_y,
-        pin_b_x=linkage.ground_x + rocker_x,
-        pin_b_y=linkage.ground_y + rocker_y,
-        transmission_angle=math.atan2(abs(sine), cosine),
-    )
+    return LinkagePose(*pose)
 
 
 def solve_many(
@@ -585,11 +608,9 @@ def _raise_at_first_refusal(
     closes = np.broadcast_to(closes, alpha.shape)
     refused = ~closes
     if nearest_dead is not None:
-        close = nearest_dead < 1e-6
+        close = nearest_dead < _NEAR_DEAD
         if np.any(close):
             refused |= close & (1.5 * np.spacing(np.abs(alpha)) > RATE_ACCURACY * 2.0 * nearest_dead)
-    if linkage.closure.passes_through_pivot:
-        _check_pivot_passage(linkage, alpha)
     if np.any(refused):
         first = int(np.argmax(refused.reshape(-1)))
         angle = float(alpha.reshape(-1)[first])
