@@ -36,7 +36,7 @@ from linkage_kinematics.geometry import (
     ANGLE_TOLERANCE,
     TWO_PI,
     FourBar,
-    LoopFactor,
+    LoopClosure,
     UnreachableError,
 )
 
@@ -161,6 +161,64 @@ def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -
     return value
 
 
+def _exact_factors(
+    closure: LoopClosure, alpha: FloatOrArray, distance: FloatOrArray, xp: MathFunctions
+) -> tuple[FloatOrArray, FloatOrArray, FloatOrArray, FloatOrArray | None]:
+    """Heron's two factors (AB + BC)² − d² and d² − (AB − BC)², each in the form
+    geometry.LoopFactor names: from d; from the offsets to its two dead points a₁, a₂ as
+    ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as gap + 4·OA·OC·sin²(½(α − a)).
+
+    Also whether the loop closes (a touching factor is ≥ 0 by construction, 0 at a change point,
+    where the loop closes) and the least |sin(½(α − a))| over the dead points a (for a float,
+    only if below _NEAR_DEAD; None if there is none).
+    """
+    sin = xp[0]
+    scale = closure.scale
+    nearest_dead = None
+    closes = True
+    factors = []
+    for part, orientation in ((closure.stretched, -1.0), (closure.folded, 1.0)):
+        kind = part.kind
+        if kind == _PLAIN:
+            length = part.length
+            value = orientation * (distance - length) * (distance + length)
+            closes = closes & (value > 0.0)
+            factors.append(value)
+            continue
+        high, low = part.first
+        difference = alpha - high
+        first = sin(0.5 * (difference - low))
+        if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
+                                      or abs(first) >= _NEAR_HALF_SINE)):
+            first = _corrected_half_sine(alpha, part.first, difference, first, sin)
+        if kind == _TOUCH:
+            factors.append(part.gap + scale * first * first)
+            continue
+        high, low = part.second
+        difference = alpha - high
+        second = sin(0.5 * (difference - low))
+        if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
+                                      or abs(second) >= _NEAR_HALF_SINE)):
+            second = _corrected_half_sine(alpha, part.second, difference, second, sin)
+        value = orientation * scale * first * second
+        closes = closes & (value > 0.0)
+        first = abs(first)
+        second = abs(second)
+        if xp is _ARRAY_MATH:
+            near = np.minimum(first, second)
+            nearest_dead = near if nearest_dead is None else np.minimum(nearest_dead, near)
+        else:
+            # only a float within the refusal check's reach is reported
+            near = first if first < second else second
+            if near < _NEAR_DEAD and (nearest_dead is None or near < nearest_dead):
+                nearest_dead = near
+        factors.append(value)
+    stretched, folded = factors
+    if closure.passes_through_pivot:
+        closes = closes & (distance >= PIVOT_PASSAGE * closure.ground)
+    return stretched, folded, closes, nearest_dead
+
+
 def _smooth_rate_terms(
     linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, stretched: FloatOrArray,
     folded: FloatOrArray, distance_squared: FloatOrArray, distance: FloatOrArray,
@@ -253,63 +311,31 @@ def _closed_form(
     reach, difference = closure.reach
     stretched = reach - distance
     folded = distance - difference
-    if (closure.plain_where_far and xp is _SCALAR_MATH
-            and stretched >= _FAR * distance and folded >= _FAR * distance):
-        # Far from every zero of the factors, d's own rounding is harmless beside them: the
-        # cheaper product from d, with the loop surely closed and no dead point near.
-        stretched *= reach + distance
-        folded *= distance + difference
-        closes = True
+    if xp is _SCALAR_MATH and closure.plain_where_far:
+        if stretched >= _FAR * distance and folded >= _FAR * distance:
+            # Far from every zero of the factors, d's own rounding is harmless beside them: the
+            # cheaper product from d, with the loop surely closed and no dead point near.
+            stretched *= reach + distance
+            folded *= distance + difference
+            closes = True
+            nearest_dead = None
+        else:
+            stretched, folded, closes, nearest_dead = _exact_factors(closure, alpha, distance, xp)
+    elif closure.plain_where_far:
+        # The same choice for each element of an array.
+        near = (stretched < _FAR * distance) | (folded < _FAR * distance)
+        stretched = stretched * (reach + distance)
+        folded = folded * (distance + difference)
+        closes = np.ones(alpha.shape, dtype=bool)
         nearest_dead = None
+        if np.any(near):
+            (stretched[near], folded[near], closes[near], nearest) = _exact_factors(
+                closure, alpha[near], distance[near], xp)
+            if nearest is not None:
+                nearest_dead = np.full(alpha.shape, np.inf)
+                nearest_dead[near] = nearest
     else:
-        # Each factor in the form geometry.LoopFactor names: from d; from the offsets to its two
-        # dead points a₁, a₂ as ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as
-        # gap + 4·OA·OC·sin²(½(α − a)). nearest_dead is the least |sin(½(α − a))| of the dead
-        # points; a touching factor is ≥ 0 by construction (0 at a change point, where the loop
-        # closes).
-        scale = closure.scale
-        nearest_dead = None
-        closes = True
-        factors = []
-        for part, orientation, value in ((closure.stretched, -1.0, stretched),
-                                         (closure.folded, 1.0, folded)):
-            kind = part.kind
-            if kind == _PLAIN:
-                value = value * (distance + part.length)
-                closes = closes & (value > 0.0)
-                factors.append(value)
-                continue
-            high, low = part.first
-            difference = alpha - high
-            first = sin(0.5 * (difference - low))
-            if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
-                                          or abs(first) >= _NEAR_HALF_SINE)):
-                first = _corrected_half_sine(alpha, part.first, difference, first, sin)
-            if kind == _TOUCH:
-                factors.append(part.gap + scale * first * first)
-                continue
-            high, low = part.second
-            difference = alpha - high
-            second = sin(0.5 * (difference - low))
-            if (xp is _ARRAY_MATH or not (-math.pi <= difference <= math.pi
-                                          or abs(second) >= _NEAR_HALF_SINE)):
-                second = _corrected_half_sine(alpha, part.second, difference, second, sin)
-            value = orientation * scale * first * second
-            closes = closes & (value > 0.0)
-            first = abs(first)
-            second = abs(second)
-            if xp is _ARRAY_MATH:
-                near = np.minimum(first, second)
-                nearest_dead = near if nearest_dead is None else np.minimum(nearest_dead, near)
-            else:
-                # only a float within the refusal check's reach is reported
-                near = first if first < second else second
-                if near < _NEAR_DEAD and (nearest_dead is None or near < nearest_dead):
-                    nearest_dead = near
-            factors.append(value)
-        stretched, folded = factors
-        if closure.passes_through_pivot:
-            closes = closes & (distance >= PIVOT_PASSAGE * closure.ground)
+        stretched, folded, closes, nearest_dead = _exact_factors(closure, alpha, distance, xp)
     heron = stretched * folded
     two_distance = 2.0 * distance
     u_x = to_c_x / distance
@@ -582,11 +608,6 @@ def solve_many(
     else:
         _check_branch(branch)
     with np.errstate(divide="ignore", invalid="ignore"):
-        if alpha.size <= _CHUNK:
-            *values, _, closes, nearest_dead = _closed_form(linkage, branch, alpha, drive,
-                                                            _ARRAY_MATH)
-            _raise_at_first_refusal(linkage, alpha, closes, nearest_dead)
-            return LinkageState(*values)
         flat_alpha = alpha.reshape(-1)
         flat_branch = branch.reshape(-1) if isinstance(branch, np.ndarray) else branch
         columns = [np.empty(flat_alpha.size) for _ in range(len(fields(LinkageState)) - 1)]
