@@ -23,7 +23,7 @@ All lengths are in metres and all angles in radians; degrees appear only in mess
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from decimal import Decimal, localcontext
 
 TWO_PI = 2.0 * math.pi
@@ -173,7 +173,7 @@ class FourBar:
                     f"got {value!r}"
                 )
         closure, reachability = _loop_closure(self)
-        object.__setattr__(self, "closure", closure)
+        object.__setattr__(self, "closure", _closure_constants(self, closure))
         object.__setattr__(self, "reachability", reachability)
 
     @property
@@ -304,14 +304,18 @@ class LoopClosure:
     change_points: tuple[tuple[float, float], ...]
     # True where OA = OC and AB = BC: pin A passes through C, where the dyad ABC is undetermined.
     passes_through_pivot: bool
-    # (AB + BC, |AB − BC|), and whether the factors may come from d where both are far from zero
-    # (not for change-point linkages, whose rates always take the analytic form).
-    reach: tuple[float, float] = (0.0, 0.0)
-    plain_where_far: bool = False
+    # What the closed form reads first, in one tuple (one attribute load on the hot path):
+    # OA, AB, BC, x_C, y_C, AB + BC, |AB − BC|, AB² − BC², and whether the factors may come
+    # from d where both are far from zero (not for change-point linkages, whose rates always
+    # take the analytic form).
+    constants: tuple = ()
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "reach", (self.stretched.length, self.folded.length))
-        object.__setattr__(self, "plain_where_far", not self.change_points)
+
+def _closure_constants(linkage: FourBar, closure: LoopClosure) -> LoopClosure:
+    constants = (linkage.crank_length, linkage.coupler_length, linkage.rocker_length,
+                 linkage.ground_x, linkage.ground_y, closure.stretched.length,
+                 closure.folded.length, closure.squares, not closure.change_points)
+    return replace(closure, constants=constants)
 
 
 def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:

@@ -216,7 +216,9 @@ def _exact_factors(
     stretched, folded = factors
     if closure.passes_through_pivot:
         closes = closes & (distance >= PIVOT_PASSAGE * closure.ground)
-    return stretched, folded, closes, nearest_dead
+    # Where the loop does not close, B is placed on the dead point (h = 0): solve refuses
+    # there, and solve_pose gives the interval end for an α within its tolerance.
+    return stretched * (stretched > 0.0), folded * (folded > 0.0), closes, nearest_dead
 
 
 def _smooth_rate_terms(
@@ -295,11 +297,8 @@ def _closed_form(
     """
     sin, cos, sqrt, atan2, _ = xp
     closure = linkage.closure
-    crank = linkage.crank_length
-    coupler = linkage.coupler_length
-    rocker = linkage.rocker_length
-    ground_x = linkage.ground_x
-    ground_y = linkage.ground_y
+    (crank, coupler, rocker, ground_x, ground_y, reach, difference, squares,
+     plain_where_far) = closure.constants
     sin_alpha = sin(alpha)
     cos_alpha = cos(alpha)
     pin_a_x = crank * sin_alpha
@@ -308,10 +307,9 @@ def _closed_form(
     to_c_y = ground_y - pin_a_y
     distance_squared = to_c_x * to_c_x + to_c_y * to_c_y
     distance = sqrt(distance_squared)
-    reach, difference = closure.reach
     stretched = reach - distance
     folded = distance - difference
-    if xp is _SCALAR_MATH and closure.plain_where_far:
+    if xp is _SCALAR_MATH and plain_where_far:
         if stretched >= _FAR * distance and folded >= _FAR * distance:
             # Far from every zero of the factors, d's own rounding is harmless beside them: the
             # cheaper product from d, with the loop surely closed and no dead point near.
@@ -321,7 +319,7 @@ def _closed_form(
             nearest_dead = None
         else:
             stretched, folded, closes, nearest_dead = _exact_factors(closure, alpha, distance, xp)
-    elif closure.plain_where_far:
+    elif plain_where_far:
         # The same choice for each element of an array.
         near = (stretched < _FAR * distance) | (folded < _FAR * distance)
         stretched = stretched * (reach + distance)
@@ -340,8 +338,8 @@ def _closed_form(
     two_distance = 2.0 * distance
     u_x = to_c_x / distance
     u_y = to_c_y / distance
-    along = (closure.squares + distance_squared) / two_distance
-    height = branch * sqrt(heron * (heron > 0.0)) / two_distance
+    along = (squares + distance_squared) / two_distance
+    height = branch * sqrt(heron) / two_distance
     rocker_along = along - distance
     coupler_x = along * u_x - height * u_y
     coupler_y = along * u_y + height * u_x
