@@ -14,8 +14,10 @@ Conventions (the seed paper's, used everywhere in this package):
   therefore ``ω_BC = −dβ/dt``, and the coupler's is ``ω_AB = dγ/dt``.
 * For one α the loop closes in two ways (assembly branches). ``branch = +1`` puts B to the left
   of the directed line A→C, ``branch = −1`` to its right. The seed's mechanism is on ``+1``.
-  A branch can only change where AB and BC are collinear (a dead point or a change point), so a
-  fixed branch is a continuous motion everywhere else.
+  B can only change sides where AB and BC are collinear. At a dead point the crank cannot go
+  on; at a change point (Grashof's s + l = p + q, where both assemblies meet) a mechanism
+  driven through continues on the smooth branch, on which B does cross the line A→C
+  (``kinematics.continued_branch``). A fixed branch is a continuous motion everywhere else.
 
 All lengths are in metres and all angles in radians; degrees appear only in messages for people.
 """

@@ -4,10 +4,11 @@ Positions come from loop closure: B is where the circle of radius AB about A mee
 radius BC about C. With d = |C − A|, u the unit vector A→C and u⊥ it turned by +90°,
 
     B − A = x·u + σ·h·u⊥,   B − C = (x − d)·u + σ·h·u⊥,
-    x = (AB² − BC² + d²)/(2d),  h² = (AB+BC−d)(BC+d−AB)(AB+d−BC)(AB+BC+d)/(4d²)
+    x = (AB² − BC² + d²)/(2d),  4·d²·h² = ((AB + BC)² − d²)·(d² − (AB − BC)²)
 
-(σ the branch). Heron's factored form keeps h accurate near the dead points where h → 0, and
-the link vectors never come from subtracting nearly equal pin coordinates.
+(σ the branch). Near a dead point a each factor is evaluated from α − a (a held to twice double
+precision, ``geometry.LoopClosure``), so h is exact to rounding however close α is; at a change
+point (a double zero) as 4·OA·OC·sin²(½(α − a)), whose root continues analytically.
 
 Rates solve the differentiated loop A + AB·e_AB = C + BC·e_BC. Writing e⊥ for a unit vector
 turned by +90° and S = e_AB × e_BC (= σ·h·d/(AB·BC), the sine of the transmission angle):
@@ -16,9 +17,26 @@ turned by +90° and S = e_AB × e_BC (= σ·h·d/(AB·BC), the sine of the trans
     ω̇_AB = −(w·e_BC)/(AB·S),       ω̇_BC = −(w·e_AB)/(BC·S)
     w = a_A − AB·ω_AB²·e_AB + BC·ω_BC²·e_BC
 
-which is Cramer's rule on the 2×2 velocity and acceleration systems. One function serves the
-scalar path (``math`` on floats, the node's hot path) and the vectorised path (``numpy`` on
-arrays, sweeps and benchmarks; long arrays go through it in cache-sized pieces).
+which is Cramer's rule on the 2×2 velocity and acceleration systems. For a change-point linkage
+the system is singular at its change points while the motion is smooth; there the rates come
+from an analytic form with the common factor of numerator and S taken out
+(``_smooth_rate_terms``), finite and exact at the change point itself.
+
+Branches. ``branch`` is the side of B relative to the directed line A→C at the α solved for
+(+1 left, −1 right; at a change point itself, the side just counterclockwise of it). A real
+mechanism driven through a change point continues on the smooth branch, on which B crosses
+that line: ``continued_branch(linkage, alpha_start, branch, alpha, turns)`` gives the side at α
+of the motion that has ``branch`` at ``alpha_start``. With an odd number of change points per
+turn the smooth motion repeats only every two turns; ``turns`` lets a caller that keeps α within
+one pass (the node) get the branch of any later turn.
+
+Refusal. ``solve`` raises DeadPointError only where a one-ulp change of the float α moves the
+exact accelerations by more than RATE_ACCURACY (δ < 1500·ulp(α) from a dead point), and where
+pin A meets C in a linkage with OA = OC and AB = BC.
+
+One function serves the scalar path (``math`` on floats, the node's hot path) and the
+vectorised path (``numpy`` on arrays, sweeps and benchmarks; long arrays go through it in
+cache-sized pieces).
 """
 
 from __future__ import annotations
@@ -453,9 +471,10 @@ def _dead_point_message(alpha: float) -> str:
 
 # A linkage whose pin A passes through C (OA = OC, AB = BC) is refused this close to it,
 # relative to OC: there coupler and rocker lie on each other and can turn together about the
-# joined pins, so the motion is undetermined at the point and its rates lose accuracy as
-# (rounding)/|C − A|² on the way to it.
-PIVOT_PASSAGE = 1e-6
+# joined pins, so the motion is undetermined at the point, and on the way to it the direction
+# A→C, taken from C − A, carries its rounding divided by |C − A|: the accelerations lose
+# accuracy as ~2e-16·(OC/|C − A|)³ (2.4e-4 relative at this distance, docs/kinematics.md).
+PIVOT_PASSAGE = 1e-4
 
 
 def _check_pivot_passage(linkage: FourBar, alpha: FloatOrArray) -> None:
