@@ -13,7 +13,7 @@ import competitors
 from competitors import QUANTITIES, States
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import DeadPointError, continued_branch, solve, solve_many
+from linkage_kinematics.kinematics import continued_branch, solve, solve_many
 from reference import continued_sides, reference_state
 from seed_formulation import seed_state
 from timing import format_error, format_seconds, interleaved_medians, markdown_table
