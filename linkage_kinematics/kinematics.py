@@ -648,7 +648,8 @@ def _raise_at_first_refusal(
     if nearest_dead is not None:
         close = nearest_dead < _NEAR_DEAD
         if np.any(close):
-            refused |= close & (1.5 * np.spacing(np.abs(alpha)) > RATE_ACCURACY * 2.0 * nearest_dead)
+            ulp = np.spacing(np.abs(alpha))
+            refused |= close & (1.5 * ulp > RATE_ACCURACY * 2.0 * nearest_dead)
     if np.any(refused):
         first = int(np.argmax(refused.reshape(-1)))
         angle = float(alpha.reshape(-1)[first])
