@@ -16,7 +16,7 @@ import scipy.optimize
 
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import solve_many
+from linkage_kinematics.kinematics import continued_branch, solve_many
 
 QUANTITIES = ("beta", "gamma", "omega_ab", "omega_bc", "omega_dot_ab", "omega_dot_bc")
 States = dict[str, list[float]]
@@ -80,14 +80,19 @@ def minimal_closed_form(
     )
 
 
-def minimal_states(linkage: FourBar, alphas: list[float], drive: DriveLaw) -> States:
-    """``minimal_closed_form`` at every angle."""
-    rows = [
-        minimal_closed_form(linkage.crank_length, linkage.coupler_length,
-                            linkage.rocker_length, linkage.ground_x, linkage.ground_y, 1,
-                            drive.omega0, drive.k, alpha)
-        for alpha in alphas
-    ]
+def minimal_states(
+    linkage: FourBar, alphas: list[float], drive: DriveLaw, sides: list[int]
+) -> States:
+    """``minimal_closed_form`` at every angle, each on the given side of A→C. Where it divides
+    by a sine that rounded to zero, NaN (no result)."""
+    rows = []
+    for alpha, side in zip(alphas, sides):
+        try:
+            rows.append(minimal_closed_form(
+                linkage.crank_length, linkage.coupler_length, linkage.rocker_length,
+                linkage.ground_x, linkage.ground_y, side, drive.omega0, drive.k, alpha))
+        except ZeroDivisionError:
+            rows.append((math.nan,) * 22)
     return {name: [row[index] for row in rows]
             for name, index in zip(QUANTITIES, (1, 2, 5, 6, 7, 8))}
 
@@ -216,18 +221,22 @@ def _append(
 # --- Rates by finite differences of exact positions -----------------------------------------
 
 def finite_difference_states(
-    linkage: FourBar, alphas: np.ndarray, drive: DriveLaw, step: float
+    linkage: FourBar, alphas: np.ndarray, drive: DriveLaw, step: float, start: float = 0.0,
+    branch: int = 1,
 ) -> States:
-    """Positions from solve_many; rates from central differences in α (forward ones where
-    α − step is past the dead point), times ω, with α̈ = k·ω for the accelerations."""
+    """Positions from solve_many, on the smooth motion that has ``branch`` at ``start``; rates
+    from central differences in α (forward ones where α − step is past the dead point), times
+    ω, with α̈ = k·ω for the accelerations."""
     alphas = np.asarray(alphas, dtype=float)
-    central = alphas - step > linkage.reachability.intervals[0][0]
+    central = (np.full(alphas.shape, True) if linkage.reachability.full_rotation
+               else alphas - step > linkage.reachability.intervals[0][0])
     stencil = np.concatenate([
         np.where(central, alphas - step, alphas),
         np.where(central, alphas, alphas + step),
         np.where(central, alphas + step, alphas + 2.0 * step),
     ])
-    positions = solve_many(linkage, stencil, drive)
+    positions = solve_many(linkage, stencil, drive,
+                           continued_branch(linkage, start, branch, stencil))
     size = alphas.size
     omega = drive.omega0 + drive.k * alphas
     omega_dot = drive.k * omega
@@ -260,22 +269,23 @@ class PylinkageModel:
     ``angular_velocity`` per step, and its kinematics take ω and α̈ per crank.
     """
 
-    def __init__(self, linkage: FourBar, step: float = 0.0) -> None:
+    def __init__(self, linkage: FourBar, step: float = 0.0, start: float = 0.0,
+                 branch: int = 1) -> None:
         import pylinkage
 
         self.linkage = linkage
         self.ground_o = pylinkage.Ground(0.0, 0.0, name="O")
         self.ground_c = pylinkage.Ground(linkage.ground_x, linkage.ground_y, name="C")
         self.crank = pylinkage.Crank(self.ground_o, linkage.crank_length,
-                                     angular_velocity=step, initial_angle=-math.pi / 2)
+                                     angular_velocity=step, initial_angle=start - math.pi / 2)
         self.pin_b = pylinkage.RRRDyad(self.crank.output, self.ground_c,
                                        distance1=linkage.coupler_length,
                                        distance2=linkage.rocker_length, name="B")
-        # start B on the paper's branch (left of A→C, above the line)
-        start = minimal_closed_form(linkage.crank_length, linkage.coupler_length,
-                                    linkage.rocker_length, linkage.ground_x, linkage.ground_y,
-                                    1, 0.0, 0.0, 0.0)
-        self.pin_b.set_coord(start[11], start[12])
+        # start B on the requested branch at the start angle (the paper's: left of A→C)
+        placed = minimal_closed_form(linkage.crank_length, linkage.coupler_length,
+                                     linkage.rocker_length, linkage.ground_x, linkage.ground_y,
+                                     branch, 0.0, 0.0, start)
+        self.pin_b.set_coord(placed[11], placed[12])
         self.model = pylinkage.Linkage([self.ground_o, self.ground_c, self.crank, self.pin_b])
 
     def states(self, alphas: list[float], drive: DriveLaw) -> States:

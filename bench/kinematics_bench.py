@@ -13,15 +13,19 @@ import competitors
 from competitors import QUANTITIES, States
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import solve, solve_many
-from reference import reference_state
+from linkage_kinematics.kinematics import continued_branch, solve, solve_many
+from reference import continued_sides, reference_state
 from seed_formulation import seed_state
 from timing import format_error, format_seconds, interleaved_medians, markdown_table
 
 LAWS = {"constant ω = 2 rad/s": DriveLaw(2.0), "ω = 0.10 + 2.3·α": DriveLaw(0.1, 2.3)}
-# Closest approach to the dead point: at 1e-8 rad |sin μ| is 1.6e-4, just above the
-# library's SINGULAR_SINE, below which it reports a dead point instead of rates.
-NEAR_DEAD_CLOSEST = 1e-8
+# Closest approach to the dead point: 1e-13 rad, just outside the library's refusal zone (a
+# one-ulp change of α moves the exact accelerations by more than 0.1 % within ~1e-14 rad).
+NEAR_DEAD_CLOSEST = 1e-13
+# The change-point set: the parallelogram OA = BC = 0.3, AB = OC = 1.0 on its crossed assembly,
+# turning through its change point at α = 90° from 80° on.
+PARALLELOGRAM = FourBar(0.3, 1.0, 0.3, 1.0, 0.0)
+CHANGE_START = math.radians(80.0)
 # An error this small or smaller is drawn at this height on the log plot (0 cannot be drawn).
 PLOT_FLOOR = 1e-17
 # Label placements (points) that keep the clustered exact methods' labels apart.
@@ -31,12 +35,28 @@ LABEL_OFFSETS = {"solve": (-10, -16), "minimal": (-30, 8), "Newton 1e-08": (-20,
 
 
 @dataclass
+class AngleSet:
+    """Crank angles of one motion of one linkage: the motion starts at ``start`` on ``branch``
+    and turns smoothly through ``alphas``; ``sides`` are the assemblies the reference's own
+    continuation finds there (what a method must follow); ``start_guess`` is the (γ, β) an
+    iterative solver starts from at ``start``."""
+
+    linkage: FourBar
+    alphas: list[float]
+    start: float
+    branch: int
+    sides: list[int]
+    start_guess: tuple[float, float]
+    title: str
+
+
+@dataclass
 class Method:
     """One way of computing the state, one setting of it."""
 
     name: str
     family: str
-    states: Callable[[list[float], DriveLaw], States]
+    states: Callable[[AngleSet, DriveLaw], States]
     workload: Callable[[], int]
     note: str = ""
 
@@ -56,30 +76,45 @@ class Errors:
         return max(self.position, self.rate, self.acceleration)
 
 
-def angle_sets(linkage: FourBar, quick: bool) -> dict[str, list[float]]:
-    """The seed's 0°–90° sweep, and a sweep from 1e-3 rad down to 1e-8 rad above the dead point."""
+def angle_sets(linkage: FourBar, quick: bool) -> dict[str, AngleSet]:
+    """The seed's 0°–90° sweep; a sweep from 1e-3 rad down to 1e-13 rad above the dead point;
+    and the crossed parallelogram through its change point, from 1e-3 rad below it to 1e-13
+    rad below, on the float nearest it, and from 1e-13 to 1e-3 rad above."""
     dead = linkage.reachability.intervals[0][0]
     sweep = np.radians(np.linspace(0.0, 90.0, 31 if quick else 91))
     offsets = np.logspace(-3, math.log10(NEAR_DEAD_CLOSEST), 11 if quick else 21)
+    near_dead = [float(dead + offset) for offset in offsets]
+    change = math.pi / 2
+    change_offsets = np.logspace(-3, -13, 6 if quick else 11)
+    through_change = ([float(change - offset) for offset in change_offsets] + [change]
+                      + [float(change + offset) for offset in change_offsets[::-1]])
+    paper_guess = competitors.seed_start_guess(linkage)
+    start_state = solve(PARALLELOGRAM, CHANGE_START, DriveLaw(1.0), 1)
+    change_guess = (start_state.gamma, start_state.beta)
     return {
-        "0°–90° sweep": [float(a) for a in sweep],
-        "near the dead point": [float(dead + offset) for offset in offsets],
+        "0°–90° sweep": AngleSet(linkage, [float(a) for a in sweep], 0.0, 1,
+                                 [1] * sweep.size, paper_guess, "paper mechanism"),
+        "near the dead point": AngleSet(linkage, near_dead, 0.0, 1, [1] * len(near_dead),
+                                        paper_guess, "paper mechanism"),
+        "through a change point": AngleSet(
+            PARALLELOGRAM, through_change, CHANGE_START, 1,
+            continued_sides(PARALLELOGRAM, CHANGE_START, 1, through_change), change_guess,
+            "crossed parallelogram"),
     }
 
 
-def references(
-    linkage: FourBar, sets: dict[str, list[float]]
-) -> dict[tuple[str, str], list[dict[str, mpf]]]:
-    """The mpmath reference at every angle of every set, under each law."""
+def references(sets: dict[str, AngleSet]) -> dict[tuple[str, str], list[dict[str, mpf]]]:
+    """The mpmath reference at every angle of every set, under each law, on the set's sides."""
     return {
-        (set_name, law_name): [reference_state(linkage, alpha, law) for alpha in alphas]
-        for set_name, alphas in sets.items()
+        (set_name, law_name): [reference_state(angle_set.linkage, alpha, law, side)
+                               for alpha, side in zip(angle_set.alphas, angle_set.sides)]
+        for set_name, angle_set in sets.items()
         for law_name, law in LAWS.items()
     }
 
 
 def measure_errors(
-    method: Method, sets: dict[str, list[float]],
+    method: Method, sets: dict[str, AngleSet],
     reference: dict[tuple[str, str], list[dict[str, mpf]]], set_name: str,
 ) -> Errors:
     """Angles: largest |error| of β and γ (rad). Rates and accelerations: largest |error| of
@@ -87,14 +122,14 @@ def measure_errors(
     same far from and close to the dead point, where the rates grow without bound)."""
     position = rate = acceleration = 0.0
     missing = 0
-    per_point = [0.0] * len(sets[set_name])
+    per_point = [0.0] * len(sets[set_name].alphas)
     provided = QUANTITIES[:2] if method.note == "no rates" else QUANTITIES
     with mp.workdps(30):
         for law_name, law in LAWS.items():
             states = method.states(sets[set_name], law)
             for index, exact in enumerate(reference[(set_name, law_name)]):
                 values = {name: float(states[name][index]) for name in provided}
-                if any(math.isnan(value) for value in values.values()):
+                if any(not math.isfinite(value) for value in values.values()):
                     missing += 1
                     per_point[index] = math.inf
                     continue
@@ -111,7 +146,7 @@ def measure_errors(
                 acceleration = max(acceleration, acceleration_error)
                 per_point[index] = max(per_point[index], angle_error, rate_error,
                                        acceleration_error)
-    if missing == len(sets[set_name]) * len(LAWS):
+    if missing == len(sets[set_name].alphas) * len(LAWS):
         position = rate = acceleration = math.nan
     return Errors(position, rate, acceleration, missing, per_point)
 
@@ -138,20 +173,26 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
     parameters = (linkage.crank_length, linkage.coupler_length, linkage.rocker_length,
                   linkage.ground_x, linkage.ground_y, 1, variable.omega0, variable.k)
 
-    def library_states(alphas: list[float], drive: DriveLaw) -> States:
-        rows = [solve(linkage, alpha, drive) for alpha in alphas]
+    def library_states(angle_set: AngleSet, drive: DriveLaw) -> States:
+        rows = [solve(angle_set.linkage, alpha, drive, branch)
+                for alpha, branch in zip(angle_set.alphas, _library_branches(angle_set))]
         return {name: [getattr(row, name) for row in rows] for name in QUANTITIES}
 
-    def library_many_states(alphas: list[float], drive: DriveLaw) -> States:
-        state = solve_many(linkage, np.array(alphas), drive)
+    def library_many_states(angle_set: AngleSet, drive: DriveLaw) -> States:
+        alphas = np.array(angle_set.alphas)
+        state = solve_many(angle_set.linkage, alphas, drive,
+                           np.array(_library_branches(angle_set)))
         return {name: getattr(state, name) for name in QUANTITIES}
 
     def continued(function: Callable[..., States], *settings) -> Callable[..., States]:
-        """Iterative solvers march from the seed's start position (α = 0) to the set's
-        first angle, as a node turning the crank would, then along the set."""
-        def states(alphas: list[float], drive: DriveLaw) -> States:
-            lead_in = [float(a) for a in np.linspace(0.0, alphas[0], 20)]
-            result = function(linkage, lead_in + alphas, drive, *settings)
+        """Iterative solvers march from the set's start position (for the paper mechanism the
+        seed's, at α = 0) to the set's first angle, as a node turning the crank would, then
+        along the set."""
+        def states(angle_set: AngleSet, drive: DriveLaw) -> States:
+            alphas = angle_set.alphas
+            lead_in = [float(a) for a in np.linspace(angle_set.start, alphas[0], 20)]
+            result = function(angle_set.linkage, lead_in + alphas, drive, *settings,
+                              angle_set.start_guess)
             return {name: values[len(lead_in):] for name, values in result.items()}
         return states
 
@@ -182,43 +223,55 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
                lambda: (solve_many(linkage, sweep, variable), sweep.size)[1]),
         Method("minimal hand-written closed form (bench code, no checks, tuple out)",
                "closed form (bench yardstick)",
-               lambda alphas, drive: competitors.minimal_states(linkage, alphas, drive),
+               lambda angle_set, drive: competitors.minimal_states(
+                   angle_set.linkage, angle_set.alphas, drive, angle_set.sides),
                minimal_loop),
         Method("seed paper's Eqs. (2)–(19)", "seed formulation",
-               lambda alphas, drive: _seed_states(linkage, alphas, drive),
+               lambda angle_set, drive: _seed_states(angle_set, drive),
                scalar_loop(lambda alpha: seed_state(linkage, alpha, variable), scalar_alphas)),
     ]
     for tolerance in (1e-4, 1e-8, 1e-12):
         result.append(Method(
             f"Newton on the loop equations, step size < {tolerance:g}", "generic solver",
-            continued(competitors.newton_states, tolerance, start),
+            continued(competitors.newton_states, tolerance),
             lambda tolerance=tolerance: len(competitors.newton_states(
                 linkage, iterative_alphas, variable, tolerance, start)["beta"])))
     for tolerance in (1e-4, 1e-8, 1e-12):
         result.append(Method(
             f"scipy.optimize.root (hybr, analytic Jacobian), tol = {tolerance:g}",
             "generic solver",
-            continued(competitors.scipy_root_states, tolerance, start),
+            continued(competitors.scipy_root_states, tolerance),
             lambda tolerance=tolerance: len(competitors.scipy_root_states(
                 linkage, iterative_alphas, variable, tolerance, start)["beta"])))
     result.append(Method(
         "scipy.optimize.fsolve, defaults", "generic solver",
-        continued(competitors.fsolve_states, start),
+        continued(competitors.fsolve_states),
         lambda: len(competitors.fsolve_states(linkage, iterative_alphas, variable,
                                               start)["beta"])))
     for step in (1e-2, 1e-4, 1e-6, 1e-8):
         result.append(Method(
             f"finite differences of exact positions, h = {step:g} rad", "finite differences",
-            lambda alphas, drive, step=step: competitors.finite_difference_states(
-                linkage, np.array(alphas), drive, step),
+            lambda angle_set, drive, step=step: competitors.finite_difference_states(
+                angle_set.linkage, np.array(angle_set.alphas), drive, step, angle_set.start,
+                angle_set.branch),
             lambda step=step: (competitors.finite_difference_states(
                 linkage, sweep[: vector_count // 4], variable, step), vector_count // 4)[1]))
     result.extend(_pylinkage_methods(linkage, iterative_count))
     return result
 
 
-def _seed_states(linkage: FourBar, alphas: list[float], drive: DriveLaw) -> States:
-    rows = [seed_state(linkage, alpha, drive) for alpha in alphas]
+def _library_branches(angle_set: AngleSet) -> list[int]:
+    """The library's own branch at each angle of the set's motion (continued_branch)."""
+    return [continued_branch(angle_set.linkage, angle_set.start, angle_set.branch, alpha)
+            for alpha in angle_set.alphas]
+
+
+def _seed_states(angle_set: AngleSet, drive: DriveLaw) -> States:
+    """The seed's equations hold for its own mechanism only (OA = BC, C level with O, the
+    α = 0 start): no result for another linkage."""
+    if angle_set.linkage != preset("paper").geometry:
+        return {name: [math.nan] * len(angle_set.alphas) for name in QUANTITIES}
+    rows = [seed_state(angle_set.linkage, alpha, drive) for alpha in angle_set.alphas]
     return {name: [row[name] for row in rows] for name in QUANTITIES}
 
 
@@ -229,17 +282,23 @@ def _pylinkage_methods(linkage: FourBar, count: int) -> list[Method]:
         print(f"pylinkage is not installed ({error}); its rows are left out")
         return []
     step = (math.pi / 2) / count
-    model = competitors.PylinkageModel(linkage, step)
     sweeper = competitors.PylinkageModel(linkage, step)
     constant = LAWS["constant ω = 2 rad/s"]
+
+    def states(angle_set: AngleSet, drive: DriveLaw) -> States:
+        # a model per set, assembled at the set's start on its branch
+        model = competitors.PylinkageModel(angle_set.linkage, 0.0, angle_set.start,
+                                           angle_set.branch)
+        return model.states(angle_set.alphas, drive)
+
     return [
         Method(f"pylinkage {pylinkage.__version__} step_with_derivatives", "other package",
-               model.states, lambda: sweeper.sweep(count, constant),
+               states, lambda: sweeper.sweep(count, constant),
                "timed on its own constant-ω loop"),
         Method(f"pylinkage {pylinkage.__version__} step (positions only)", "other package",
-               lambda alphas, drive: {**model.states(alphas, drive),
-                                      **{name: [math.nan] * len(alphas)
-                                         for name in QUANTITIES[2:]}},
+               lambda angle_set, drive: {**states(angle_set, drive),
+                                         **{name: [math.nan] * len(angle_set.alphas)
+                                            for name in QUANTITIES[2:]}},
                lambda: sweeper.sweep_positions(count), "no rates"),
     ]
 
@@ -248,7 +307,7 @@ def run(quick: bool, repetitions: int) -> tuple[str, dict[str, object]]:
     """Measure, print and return the section's markdown and the figures the goals need."""
     linkage = preset("paper").geometry
     sets = angle_sets(linkage, quick)
-    reference = references(linkage, sets)
+    reference = references(sets)
     all_methods = methods(linkage, quick)
     errors = {
         (method.name, set_name): measure_errors(method, sets, reference, set_name)
@@ -268,7 +327,8 @@ def run(quick: bool, repetitions: int) -> tuple[str, dict[str, object]]:
             cells = [format_error(error.position), format_error(error.rate),
                      format_error(error.acceleration)]
             if error.missing and not math.isnan(error.position):
-                cells[0] += f" ({error.missing} of {len(sets[set_name]) * len(LAWS)} failed)"
+                cells[0] += (f" ({error.missing} of {len(sets[set_name].alphas) * len(LAWS)} "
+                             "failed)")
             if method.note == "no rates":
                 cells[1] = cells[2] = "no rates"
             row += cells
@@ -298,7 +358,7 @@ def _goal_figures(all_methods, errors, times, sets) -> dict[str, object]:
         worst_ratio, worst_index = max(worse_by)
         exactness[set_name] = (sum(ratio > 1.0 for ratio, _ in worse_by),
                                sum(ratio > 2.0 for ratio, _ in worse_by), len(library),
-                               worst_ratio, sets[set_name][worst_index])
+                               worst_ratio, sets[set_name].alphas[worst_index])
     return {
         "scalar_over_minimal": times[scalar] / times[minimal],
         "vector_rate": 1.0 / times[vector],
@@ -321,7 +381,7 @@ def plot(results: dict[str, object], path: str) -> None:
                "generic solver": ("^", "tab:blue"),
                "finite differences": ("v", "tab:purple"),
                "other package": ("D", "tab:orange")}
-    figure, axes = plt.subplots(1, len(sets), figsize=(13, 6.5), sharey=True)
+    figure, axes = plt.subplots(1, len(sets), figsize=(17, 6.5), sharey=True)
     for axis, set_name in zip(axes, sets):
         no_result = []
         finite_differences_labelled = False
@@ -349,7 +409,7 @@ def plot(results: dict[str, object], path: str) -> None:
         if no_result:
             axis.text(0.03, 0.97, "no result: " + ", ".join(no_result), transform=axis.transAxes,
                       va="top", fontsize=9)
-        axis.set_title(f"{set_name} (paper mechanism, both drive laws)")
+        axis.set_title(f"{set_name}\n({sets[set_name].title}, both drive laws)", fontsize=10)
         axis.set_xlabel("time per configuration (s), median")
         axis.grid(True, which="major", alpha=0.4)
         axis.set_xlim(3e-8, 3e-3)

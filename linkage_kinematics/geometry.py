@@ -14,8 +14,10 @@ Conventions (the seed paper's, used everywhere in this package):
   therefore ``ω_BC = −dβ/dt``, and the coupler's is ``ω_AB = dγ/dt``.
 * For one α the loop closes in two ways (assembly branches). ``branch = +1`` puts B to the left
   of the directed line A→C, ``branch = −1`` to its right. The seed's mechanism is on ``+1``.
-  A branch can only change where AB and BC are collinear (a dead point or a change point), so a
-  fixed branch is a continuous motion everywhere else.
+  B can only change sides where AB and BC are collinear. At a dead point the crank cannot go
+  on; at a change point (Grashof's s + l = p + q, where both assemblies meet) a mechanism
+  driven through continues on the smooth branch, on which B does cross the line A→C
+  (``kinematics.continued_branch``). A fixed branch is a continuous motion everywhere else.
 
 All lengths are in metres and all angles in radians; degrees appear only in messages for people.
 """
@@ -23,12 +25,18 @@ All lengths are in metres and all angles in radians; degrees appear only in mess
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from decimal import Decimal, localcontext
 
 TWO_PI = 2.0 * math.pi
-# Cosine bounds within this distance of ±1 are treated as touching: the linkage then has a
-# change point (both branches meet) instead of a vanishingly small gap in its reachable set.
-_TOUCH_TOLERANCE = 1e-12
+# Cosine bounds k± (computed exactly from the float lengths) within this distance of ±1 are
+# treated as touching: the linkage is solved as the exact change-point linkage (s + l = p + q)
+# instead of one with a vanishingly small gap in its reachable set or a near-miss of its
+# branches. It covers lengths typed as decimals whose Grashof sums differ only by the rounding
+# of those decimals to floats (~1e-16); near its change points such a linkage moves as the
+# exact one, which may differ from its float lengths' own motion by up to √(2·tolerance)
+# relative there (and by tolerance/S² at a transmission sine S).
+TOUCH_TOLERANCE = 1e-14
 # A crank angle this close outside a computed interval end is still taken as the end itself.
 ANGLE_TOLERANCE = 1e-14
 # Lengths and coordinates are kept within these magnitudes so that the products of four lengths
@@ -105,14 +113,38 @@ class Reachability:
         return interval
 
     def dead_point_distance(self, alpha: float) -> float | None:
-        """Crank-angle distance (rad) from ``alpha`` to the nearest dead or change point.
+        """Crank-angle distance (rad) from ``alpha`` to the nearest dead point (mod 2π).
 
-        None when the mechanism has neither (a crank that turns fully with no branch meeting).
+        None when the crank turns fully (a linkage without dead points).
         """
-        singular = self.dead_points + self.change_points
-        if not singular:
-            return None
-        return min(abs(wrap_angle(alpha - point)) for point in singular)
+        return _nearest(self.dead_points, alpha)
+
+    def change_point_distance(self, alpha: float) -> float | None:
+        """Crank-angle distance (rad) from ``alpha`` to the nearest change point (mod 2π), where
+        the two assemblies meet and the motion continues smoothly; None if there is none."""
+        return _nearest(self.change_points, alpha)
+
+    def first_dead_point(self, alpha_from: float, alpha_to: float) -> float | None:
+        """The first dead point the crank meets turning from ``alpha_from`` to ``alpha_to``
+        (``alpha_to`` included), as an unwrapped crank angle; None if the way is clear.
+
+        Change points do not stop the crank (it continues through them on its smooth branch,
+        see ``kinematics.continued_branch``), so they are not counted here.
+        """
+        direction = 1.0 if alpha_to > alpha_from else -1.0
+        travel = abs(alpha_to - alpha_from)
+        nearest = None
+        for point in self.dead_points:
+            distance = (direction * (point - alpha_from)) % TWO_PI
+            if distance <= travel + ANGLE_TOLERANCE and (nearest is None or distance < nearest):
+                nearest = distance
+        return None if nearest is None else alpha_from + direction * nearest
+
+
+def _nearest(points: tuple[float, ...], alpha: float) -> float | None:
+    if not points:
+        return None
+    return min(abs(wrap_angle(alpha - point)) for point in points)
 
 
 @dataclass(frozen=True)
@@ -125,6 +157,7 @@ class FourBar:
     ground_x: float
     ground_y: float = 0.0
     reachability: Reachability = field(init=False, repr=False, compare=False)
+    closure: LoopClosure = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in ("crank_length", "coupler_length", "rocker_length"):
@@ -141,7 +174,9 @@ class FourBar:
                     f"{name} must be a coordinate from {-MAX_LENGTH:g} to {MAX_LENGTH:g} m, "
                     f"got {value!r}"
                 )
-        object.__setattr__(self, "reachability", _reachability(self))
+        closure, reachability = _loop_closure(self)
+        object.__setattr__(self, "closure", _closure_constants(self, closure))
+        object.__setattr__(self, "reachability", reachability)
 
     @property
     def ground_length(self) -> float:
@@ -154,7 +189,7 @@ class FourBar:
         lengths = sorted(
             (self.crank_length, self.coupler_length, self.rocker_length, self.ground_length)
         )
-        return lengths[0] + lengths[3] <= (lengths[1] + lengths[2]) * (1.0 + _TOUCH_TOLERANCE)
+        return lengths[0] + lengths[3] <= (lengths[1] + lengths[2]) * (1.0 + TOUCH_TOLERANCE)
 
     def scaled(self, factor: float) -> FourBar:
         """The same mechanism with every length multiplied by ``factor``."""
@@ -167,70 +202,214 @@ class FourBar:
         )
 
 
-def _snap_cosine(value: float) -> tuple[float, bool]:
-    """Snap a cosine bound that touches ±1 onto it, saying whether it touched."""
-    for bound in (-1.0, 1.0):
-        if abs(value - bound) <= _TOUCH_TOLERANCE:
-            return bound, True
-    return value, False
+# --- the exact zeros of the loop closure, computed once per linkage ---------------------------
+#
+# With φ = α − α₀ the angle from OC to OA (α₀ = π/2 + atan2(y_C, x_C)) and d = |C − A|,
+# d² = OC² + OA² − 2·OA·OC·cos φ, and Heron's product 4·d²·h² is the product of two factors:
+#
+#   stretched  (AB + BC)² − d² = 2·OA·OC·(cos φ − k₊),  k₊ = (OC² + OA² − (AB + BC)²)/(2·OA·OC)
+#   folded     d² − (AB − BC)² = 2·OA·OC·(k₋ − cos φ),  k₋ = (OC² + OA² − (AB − BC)²)/(2·OA·OC)
+#
+# A factor whose k lies inside (−1, 1) vanishes at two dead points α₀ ± acos k, and is written as
+# 4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)) (up to sign) with a₁, a₂ those crank angles held to twice
+# double precision: α − a is then exact to rounding however close α is to a, where the
+# difference of the pin distance d from AB + BC would lose everything but the rounding of d.
+# A factor with k = ∓1 (Grashof's s + l = p + q) has a double zero, a change point, and is
+# written as 4·OA·OC·sin²(½(α − a)), whose square root continues analytically through it.
+# A factor that stays away from zero is taken from d directly (the cheapest form).
+
+_PLAIN = 0
+_ROOTS = 1
+_TOUCH = 2
+# Digits of the one-time computation of the singular crank angles (decimal arithmetic).
+_DIGITS = 60
+_PI = Decimal("3.14159265358979323846264338327950288419716939937510582097494459230781640629")
 
 
-def _reachability(linkage: FourBar) -> Reachability:
-    """Crank intervals where |C − A| lies within [|AB − BC|, AB + BC]."""
-    r = linkage.crank_length
-    b = linkage.coupler_length
-    c = linkage.rocker_length
-    g = linkage.ground_length
-    if g == 0.0:
-        # O and C coincide: |C − A| = OA for every α, so the loop closes everywhere or nowhere.
-        if abs(b - c) < r < b + c:
-            return Reachability(intervals=((-math.pi, math.pi),), dead_points=(), change_points=())
-        raise GeometryError(
-            "with O and C coincident the loop needs |AB − BC| < OA < AB + BC, "
-            f"got OA = {r} m, AB = {b} m, BC = {c} m"
-        )
-    # |C − A|² = g² + r² − 2gr·cos φ with φ the angle between OA and OC; the loop closes where
-    # cos φ lies in [lowest_cosine, highest_cosine].
-    lowest_cosine, touches_low = _snap_cosine((g * g + r * r - (b + c) ** 2) / (2.0 * g * r))
-    highest_cosine, touches_high = _snap_cosine((g * g + r * r - (b - c) ** 2) / (2.0 * g * r))
-    if lowest_cosine >= 1.0 or highest_cosine <= -1.0:
-        raise GeometryError(
-            f"the loop cannot close at any crank angle: |C − A| spans [{abs(g - r):.6g}, "
-            f"{g + r:.6g}] m but AB and BC reach only [{abs(b - c):.6g}, {b + c:.6g}] m"
-        )
-    # φ = α − π/2 − ψ, where ψ is the direction of OC.
-    offset = math.pi / 2.0 + math.atan2(linkage.ground_y, linkage.ground_x)
-    phi_intervals: list[tuple[float, float]]
-    change_phis: list[float] = []
-    if lowest_cosine <= -1.0 and highest_cosine >= 1.0:
-        phi_intervals = [(-math.pi, math.pi)]
-    elif highest_cosine >= 1.0:
-        limit = math.acos(lowest_cosine)
-        phi_intervals = [(-limit, limit)]
-    elif lowest_cosine <= -1.0:
-        limit = math.acos(highest_cosine)
-        phi_intervals = [(limit, TWO_PI - limit)]
+def _cos_sin(angle: Decimal) -> tuple[Decimal, Decimal]:
+    """cos and sin of a decimal angle of a few radians, by their Taylor series."""
+    cosine = sine = Decimal(0)
+    term = Decimal(1)
+    tiny = Decimal(10) ** -(_DIGITS + 5)
+    order = 0
+    while abs(term) > tiny or order < 4:
+        if order % 4 == 0:
+            cosine += term
+        elif order % 4 == 1:
+            sine += term
+        elif order % 4 == 2:
+            cosine -= term
+        else:
+            sine -= term
+        order += 1
+        term = term * angle / order
+    return cosine, sine
+
+
+def _atan2(y: Decimal, x: Decimal) -> Decimal:
+    """atan2 in decimal: the float's value refined by Newton's method on x·sin θ − y·cos θ."""
+    if x == 0:
+        # exact, so that a pivot C straight above or below O puts α₀ on an exact float
+        return _PI / 2 if y > 0 else -_PI / 2
+    angle = Decimal(math.atan2(float(y), float(x)))
+    for _ in range(3):
+        cosine, sine = _cos_sin(angle)
+        angle += (y * cosine - x * sine) / (x * cosine + y * sine)
+    return angle
+
+
+def _split(value: Decimal) -> tuple[float, float]:
+    """The nearest float and the float nearest to what it leaves over (a double-double)."""
+    high = float(value)
+    return high, float(value - Decimal(high))
+
+
+@dataclass(frozen=True)
+class LoopFactor:
+    """One factor of Heron's product, and the form it is evaluated in (see the comment above).
+
+    ``kind`` is ``_PLAIN`` (from d; ``length`` is AB + BC or |AB − BC|), ``_ROOTS`` (two dead
+    points ``first`` and ``second``, double-doubles) or ``_TOUCH`` (``gap`` + 4·OA·OC·sin²(½(α −
+    first)); ``gap`` = 0 at a change point).
+    """
+
+    kind: int
+    length: float
+    first: tuple[float, float] = (0.0, 0.0)
+    second: tuple[float, float] = (0.0, 0.0)
+    gap: float = 0.0
+
+    @property
+    def is_change(self) -> bool:
+        return self.kind == _TOUCH and self.gap == 0.0
+
+
+@dataclass(frozen=True)
+class LoopClosure:
+    """Constants of the loop-closure evaluation of one linkage, computed once.
+
+    ``stretched`` and ``folded`` are the two factors; ``scale`` = 4·OA·OC; ``ground`` = OC;
+    ``squares`` = AB² − BC²; ``direction`` is α₀ and ``opposite`` α₀ + π (double-doubles), the
+    crank angles at which OA points along OC and against it. ``dead_points`` and
+    ``change_points`` are the singular crank angles as double-doubles, unwrapped as the factors
+    use them.
+    """
+
+    stretched: LoopFactor
+    folded: LoopFactor
+    scale: float
+    ground: float
+    squares: float
+    direction: tuple[float, float]
+    opposite: tuple[float, float]
+    dead_points: tuple[tuple[float, float], ...]
+    change_points: tuple[tuple[float, float], ...]
+    # True where OA = OC and AB = BC: pin A passes through C, where the dyad ABC is undetermined.
+    passes_through_pivot: bool
+    # What the closed form reads first, in one tuple (one attribute load on the hot path):
+    # OA, AB, BC, x_C, y_C, AB + BC, |AB − BC|, AB² − BC², and whether the factors may come
+    # from d where both are far from zero (not for change-point linkages, whose rates always
+    # take the analytic form).
+    constants: tuple = ()
+
+
+def _closure_constants(linkage: FourBar, closure: LoopClosure) -> LoopClosure:
+    constants = (linkage.crank_length, linkage.coupler_length, linkage.rocker_length,
+                 linkage.ground_x, linkage.ground_y, closure.stretched.length,
+                 closure.folded.length, closure.squares, not closure.change_points)
+    return replace(closure, constants=constants)
+
+
+def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
+    """The factors of the loop closure and the reachable crank angles, from exact arithmetic."""
+    with localcontext() as context:
+        context.prec = _DIGITS
+        r = Decimal(linkage.crank_length)
+        b = Decimal(linkage.coupler_length)
+        c = Decimal(linkage.rocker_length)
+        x_c = Decimal(linkage.ground_x)
+        y_c = Decimal(linkage.ground_y)
+        ground_squared = x_c * x_c + y_c * y_c
+        if ground_squared == 0:
+            # O and C coincide: |C − A| = OA for every α, so the loop closes everywhere or nowhere.
+            crank, coupler, rocker = (linkage.crank_length, linkage.coupler_length,
+                                      linkage.rocker_length)
+            if not abs(coupler - rocker) < crank < coupler + rocker:
+                raise GeometryError(
+                    "with O and C coincident the loop needs |AB − BC| < OA < AB + BC, "
+                    f"got OA = {crank} m, AB = {coupler} m, BC = {rocker} m"
+                )
+            closure = LoopClosure(
+                LoopFactor(_PLAIN, coupler + rocker), LoopFactor(_PLAIN, abs(coupler - rocker)),
+                0.0, 0.0, float(b * b - c * c), (0.0, 0.0), (0.0, 0.0), (), (), False,
+            )
+            return closure, Reachability(((-math.pi, math.pi),), (), ())
+        ground = ground_squared.sqrt()
+        product = 2 * r * ground
+        lowest_cosine = (ground_squared + r * r - (b + c) ** 2) / product
+        highest_cosine = (ground_squared + r * r - (b - c) ** 2) / product
+        if lowest_cosine >= 1 - TOUCH_TOLERANCE or highest_cosine <= -1 + TOUCH_TOLERANCE:
+            raise GeometryError(
+                f"the loop cannot close at any crank angle: |C − A| spans "
+                f"[{float(abs(ground - r)):.6g}, {float(ground + r):.6g}] m but AB and BC reach "
+                f"only [{float(abs(b - c)):.6g}, {float(b + c):.6g}] m"
+            )
+        direction = _PI / 2 + _atan2(y_c, x_c)
+        opposite = direction + _PI
+        scale = float(2 * product)
+
+        def factor(cosine: Decimal, bound: int, touch_at: Decimal, length: Decimal
+                   ) -> LoopFactor:
+            """The factor that vanishes where cos φ = ``cosine`` and whose extreme over a turn
+            is at cos φ = ``bound``."""
+            if abs(cosine - bound) <= TOUCH_TOLERANCE:
+                return LoopFactor(_TOUCH, float(length), _split(touch_at))
+            gap = product * (cosine - bound) * bound  # the factor's least value over a turn
+            if gap > 0:
+                # Far from zero everywhere, d's own rounding is small beside the factor.
+                plain = gap >= Decimal("0.25") * (ground + r) ** 2
+                return LoopFactor(_PLAIN if plain else _TOUCH, float(length), _split(touch_at),
+                                  gap=float(gap))
+            half_width = _atan2((1 - cosine * cosine).sqrt(), cosine)
+            return LoopFactor(_ROOTS, float(length), _split(direction - half_width),
+                              _split(direction + half_width))
+
+        stretched = factor(lowest_cosine, -1, opposite, b + c)
+        folded = factor(highest_cosine, 1, direction, abs(b - c))
+        passes_through_pivot = folded.is_change and b == c
+    dead_points = tuple(
+        angle for part in (stretched, folded) if part.kind == _ROOTS
+        for angle in (part.first, part.second)
+    )
+    change_points = tuple(part.first for part in (folded, stretched) if part.is_change)
+    closure = LoopClosure(stretched, folded, scale, linkage.ground_length, float(b * b - c * c),
+                          _split(direction), _split(opposite), dead_points, change_points,
+                          passes_through_pivot)
+    return closure, _reachability(closure)
+
+
+def _reachability(closure: LoopClosure) -> Reachability:
+    """Crank intervals where both factors are ≥ 0, ending at the dead points (φ₋ ≤ |φ| ≤ φ₊)."""
+    stretched, folded = closure.stretched, closure.folded
+    if stretched.kind != _ROOTS and folded.kind != _ROOTS:
+        ends = [(closure.direction[0] - math.pi, closure.direction[0] + math.pi)]
+    elif folded.kind != _ROOTS:
+        ends = [(stretched.first[0], stretched.second[0])]
+    elif stretched.kind != _ROOTS:
+        ends = [(folded.second[0], folded.first[0] + TWO_PI)]
     else:
-        inner = math.acos(highest_cosine)
-        outer = math.acos(lowest_cosine)
-        phi_intervals = [(inner, outer), (-outer, -inner)]
-    if touches_high:
-        change_phis.append(0.0)
-    if touches_low:
-        change_phis.append(math.pi)
-    full_turn = phi_intervals == [(-math.pi, math.pi)]
+        ends = [(folded.second[0], stretched.second[0]), (stretched.first[0], folded.first[0])]
     intervals = []
-    dead_points = []
-    for low, high in phi_intervals:
-        centre = wrap_angle(0.5 * (low + high) + offset)
-        half = 0.5 * (high - low)
-        intervals.append((centre - half, centre + half))
-        if not full_turn:
-            dead_points.extend((centre - half, centre + half))
+    for low, high in ends:
+        # Each interval is written with its centre in (−π, π].
+        shift = wrap_angle(0.5 * (low + high)) - 0.5 * (low + high)
+        shift = TWO_PI * round(shift / TWO_PI)
+        intervals.append((low + shift, high + shift))
+    full_turn = not closure.dead_points
     return Reachability(
         intervals=tuple(intervals),
-        dead_points=tuple(dead_points),
-        change_points=tuple(wrap_angle(phi + offset) for phi in change_phis),
+        dead_points=() if full_turn else tuple(end for interval in intervals for end in interval),
+        change_points=tuple(wrap_angle(high) for high, _ in closure.change_points),
     )
 
 

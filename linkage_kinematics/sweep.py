@@ -25,7 +25,12 @@ from linkage_kinematics.bag_reader import BagError, bag_files, read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import PRESETS, FourBar, GeometryError, UnreachableError, preset
-from linkage_kinematics.kinematics import DeadPointError, LinkageState, solve_many
+from linkage_kinematics.kinematics import (
+    DeadPointError,
+    LinkageState,
+    continued_branch,
+    solve_many,
+)
 
 PROGRAM = "linkage-sweep"
 CSV_COLUMNS = (
@@ -279,10 +284,14 @@ def _computed_sweep(args: argparse.Namespace) -> tuple[LinkageState, np.ndarray,
     step = DEFAULT_STEP_DEG * direction if args.alpha_step is None else args.alpha_step
     branch = 1 if args.branch is None else args.branch
     alpha_deg = crank_angles(start, end, step)
-    state = solve_many(linkage, np.radians(alpha_deg), drive, branch)
+    alpha = np.radians(alpha_deg)
+    # The branch names the assembly at the start; through change points the mechanism goes on
+    # along its smooth motion, on which B changes sides.
+    state = solve_many(linkage, alpha, drive,
+                       continued_branch(linkage, float(alpha[0]), branch, alpha))
     name = f"'{preset_name}' modified" if overrides else f"'{preset_name}'"
     title = (
-        f"Four-bar {describe_mechanism(linkage, name)}, branch {branch:+d}\n"
+        f"Four-bar {describe_mechanism(linkage, name)}, branch {branch:+d} at the start\n"
         f"{describe_drive(drive)}, α from {start:g}° to {end:g}° by {step:g}°"
     )
     return state, alpha_deg, title
@@ -377,7 +386,8 @@ def _parser() -> argparse.ArgumentParser:
             "  When the range leaves the reachable set nothing is written.\n"
             "exit status:\n"
             "  0 success; 2 bad arguments, including a range that leaves the reachable set or\n"
-            "  meets a dead point; 1 a bag that cannot be read or a plot that cannot be written."
+            "  meets a dead point (change points are passed through); 1 a bag that cannot be\n"
+            "  read or a plot that cannot be written."
         ),
     )
     mechanism = parser.add_argument_group(
@@ -397,8 +407,11 @@ def _parser() -> argparse.ArgumentParser:
                            help="x of the rocker pivot C relative to O (m)")
     mechanism.add_argument("--ground-y", type=_finite, default=None, metavar="M",
                            help="y of the rocker pivot C relative to O (m)")
-    mechanism.add_argument("--branch", type=int, choices=(1, -1), default=None,
-                           help="assembly branch: +1 (default, the seed's) or -1")
+    mechanism.add_argument(
+        "--branch", type=int, choices=(1, -1), default=None,
+        help="assembly at the first crank angle: +1 (default, the seed's: B left of the line "
+             "A→C) or -1; through a change point the mechanism continues smoothly, so B may "
+             "change sides there")
     drive = parser.add_argument_group("drive law ω = ω0 + k·α (α in rad)")
     drive.add_argument(
         "--omega0", type=_finite, default=None, metavar="RAD_PER_S",

@@ -20,6 +20,11 @@ Why it is independent of ``linkage_kinematics.kinematics``:
 * Dead points come from |C − A(α)| = AB + BC or |AB − BC| written in coordinates
   (x_C·sin α − y_C·cos α = (OC² + OA² − L²)/(2·OA)) and solved with asin, where the library
   uses the cosine of the angle between OA and OC.
+* Through change points (``continued_sides``) the motion is followed in small steps, choosing
+  at each the root whose angles and slopes continue those before it; the library instead flips
+  the side by rule at each change point it knows of.
+* The input floor (``input_floor``) is the change of the exact answer between α and its
+  neighbouring floats.
 
 Every input is the exact float the library receives (converted to mpf without rounding), so
 any difference is the library's own error. Used by the tests and by the benchmarks.
@@ -27,6 +32,7 @@ any difference is the library's own error. Used by the tests and by the benchmar
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 from mpmath import mp, mpf
@@ -58,7 +64,10 @@ def _angles(linkage: FourBar, alpha: mpf, branch: int) -> tuple[mpf, mpf]:
     distance_squared = p * p + q * q
     ratio = (distance_squared + c * c - b * b) / (2 * c * mp.sqrt(distance_squared))
     if abs(ratio) > 1:
-        raise ValueError(f"reference: the loop does not close at α = {alpha}")
+        # At a change point |ratio| touches 1; rounding in the last digits may pass it.
+        if abs(ratio) - 1 > mpf(10) ** (10 - mp.dps):
+            raise ValueError(f"reference: the loop does not close at α = {alpha}")
+        ratio = mp.sign(ratio)
     beta = -mp.atan2(q, p) + branch * mp.acos(ratio)
     pin_b_x = mpf(linkage.ground_x) - c * mp.cos(beta)
     pin_b_y = mpf(linkage.ground_y) + c * mp.sin(beta)
@@ -155,21 +164,68 @@ def reference_singular_angles(linkage: FourBar) -> list[mpf]:
         return sorted(angles)
 
 
-def state_errors(state: LinkageState, reference: dict[str, mpf]) -> dict[str, float]:
-    """How far a float ``LinkageState`` is from ``reference_state``, by kind of quantity.
+def continued_sides(
+    linkage: FourBar, alpha_start: float, branch: int, alphas: list[float],
+    max_step: float = 0.01,
+) -> list[int]:
+    """The assembly (``branch`` argument of ``reference_state``) at each of ``alphas`` for the
+    motion that starts at ``alpha_start`` on ``branch`` and turns smoothly through them.
 
-    ``angle``: largest error of β and γ (rad). ``pin``: largest pin-coordinate error relative to
-    the largest pin distance from O. The rest are normwise relative errors of a group: angular
-    rates (ω, ω_AB, ω_BC), angular accelerations (ω̇, ω̇_AB, ω̇_BC, scaled by at least ω²),
-    pin velocities and pin accelerations; a group's scale is its largest reference magnitude,
-    so a component passing through zero does not blow up the figure.
+    ``alphas`` must run monotonically away from ``alpha_start``. Independent of the library's
+    rule (change points flip the side): this follows the motion in steps of at most
+    ``max_step`` rad in 30-digit arithmetic, taking at each step the root of the rocker-angle
+    equation whose β and γ continue those of the steps before (extrapolated along their
+    secant). Where both roots fit about equally (a step landing on a change point, where the
+    roots have the same angles but different slopes), the root whose slopes dβ/dα, dγ/dα
+    continue the motion's is taken.
     """
+    with mp.workdps(30):
+        def slopes(alpha: mpf, side: int, angles: tuple[mpf, mpf]) -> tuple[mpf, mpf]:
+            return tuple(
+                mp.diff(lambda t, i=i: _wrap(_angles(linkage, t, side)[i] - angles[i]), alpha)
+                for i in (0, 1)
+            )
+
+        side = branch
+        position = mpf(alpha_start)
+        angles = _angles(linkage, position, side)
+        rates = slopes(position, side, angles)
+        sides = []
+        for target in alphas:
+            target = mpf(target)
+            pieces = max(1, int(mp.ceil(abs(target - position) / max_step)))
+            start = position
+            for index in range(1, pieces + 1):
+                here = start + (target - start) * index / pieces if index < pieces else target
+                moved = here - position
+                predicted = [angle + rate * moved for angle, rate in zip(angles, rates)]
+                candidates = {s: _angles(linkage, here, s) for s in (1, -1)}
+                misfit = {s: sum(abs(_wrap(c - p)) for c, p in zip(candidates[s], predicted))
+                          for s in candidates}
+                best, other = sorted(candidates, key=misfit.get)
+                if misfit[best] < mpf("0.01") * misfit[other]:
+                    side = best
+                    # the secant carries the slopes on (its error is O(step·curvature))
+                    rates = [_wrap(c - a) / moved for c, a in zip(candidates[side], angles)]
+                else:
+                    candidate_rates = {s: slopes(here, s, candidates[s]) for s in candidates}
+                    side = min(candidates, key=lambda s: sum(
+                        abs(c - r) for c, r in zip(candidate_rates[s], rates)))
+                    rates = list(candidate_rates[side])
+                angles = candidates[side]
+                position = here
+            sides.append(side)
+        return sides
+
+
+def _group_errors(values: dict[str, mpf], reference: dict[str, mpf]) -> dict[str, float]:
+    """``state_errors`` for any values keyed like ``reference_state``."""
     with mp.workdps(DIGITS):
         def gap(name: str) -> mpf:
-            return abs(mpf(getattr(state, name)) - reference[name])
+            return abs(values[name] - reference[name])
 
         def angle_gap(name: str) -> mpf:
-            return abs(_wrap(mpf(getattr(state, name)) - reference[name]))
+            return abs(_wrap(values[name] - reference[name]))
 
         def normwise(names: tuple[str, ...], floor: mpf = mpf(0)) -> float:
             scale = max([abs(reference[name]) for name in names] + [floor])
@@ -189,3 +245,36 @@ def state_errors(state: LinkageState, reference: dict[str, mpf]) -> dict[str, fl
                 ("acceleration_a_x", "acceleration_a_y", "acceleration_b_x", "acceleration_b_y")
             ),
         }
+
+
+def state_errors(state: LinkageState, reference: dict[str, mpf]) -> dict[str, float]:
+    """How far a float ``LinkageState`` is from ``reference_state``, by kind of quantity.
+
+    ``angle``: largest error of β and γ (rad). ``pin``: largest pin-coordinate error relative to
+    the largest pin distance from O. The rest are normwise relative errors of a group: angular
+    rates (ω, ω_AB, ω_BC), angular accelerations (ω̇, ω̇_AB, ω̇_BC, scaled by at least ω²),
+    pin velocities and pin accelerations; a group's scale is its largest reference magnitude,
+    so a component passing through zero does not blow up the figure.
+    """
+    with mp.workdps(DIGITS):
+        values = {name: mpf(getattr(state, name)) for name in reference}
+    return _group_errors(values, reference)
+
+
+def input_floor(
+    linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1
+) -> dict[str, float]:
+    """What a one-ulp change of the float α alone does to the exact answer, in the terms of
+    ``state_errors``: the larger change over the two neighbouring floats of α (only those on
+    which the loop closes), on the same assembly.
+
+    No float64 evaluation from α can be expected to do better than this.
+    """
+    exact = reference_state(linkage, alpha, drive, branch)
+    floors = []
+    for neighbour in (math.nextafter(alpha, math.inf), math.nextafter(alpha, -math.inf)):
+        try:
+            floors.append(_group_errors(reference_state(linkage, neighbour, drive, branch), exact))
+        except ValueError:  # past a dead point
+            continue
+    return {kind: max(floor[kind] for floor in floors) for kind in floors[0]}

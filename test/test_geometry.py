@@ -102,7 +102,32 @@ def test_dead_point_distance() -> None:
     paper = PRESETS["paper"].geometry.reachability
     assert paper.dead_point_distance(0.0) == pytest.approx(-paper.dead_points[0], rel=1e-15)
     assert paper.dead_point_distance(paper.dead_points[1]) == 0.0
+    assert paper.change_point_distance(0.0) is None
     assert PRESETS["grashof_crank_rocker"].geometry.reachability.dead_point_distance(1.0) is None
+
+
+def test_change_points_are_not_dead_points() -> None:
+    """A parallelogram has change points and no dead points: distances and the first dead point
+    on the way say so, which is what lets a motion run through its change points."""
+    parallelogram = FourBar(0.3, 1.0, 0.3, 1.0, 0.0).reachability
+    assert parallelogram.dead_point_distance(1.5) is None
+    assert parallelogram.change_point_distance(1.5) == pytest.approx(math.pi / 2 - 1.5, abs=1e-15)
+    assert parallelogram.change_point_distance(1.5 + 2 * math.pi * 3) == pytest.approx(
+        math.pi / 2 - 1.5, abs=1e-13)
+    assert parallelogram.first_dead_point(0.0, 2 * math.pi * 1000) is None
+
+
+def test_first_dead_point_on_the_way() -> None:
+    paper = PRESETS["paper"].geometry.reachability
+    low, high = paper.dead_points
+    # counterclockwise from 0 the crank meets the 181.94° dead point, clockwise the −1.94° one
+    assert paper.first_dead_point(0.0, math.radians(200.0)) == pytest.approx(high, abs=1e-15)
+    assert paper.first_dead_point(0.0, math.radians(-10.0)) == pytest.approx(low, abs=1e-15)
+    assert paper.first_dead_point(0.0, math.radians(90.0)) is None
+    assert paper.first_dead_point(0.0, high) == pytest.approx(high, abs=1e-15)
+    # unwrapped: from 720° on, the same dead point two turns later
+    assert paper.first_dead_point(4 * math.pi, 4 * math.pi + math.radians(200.0)) == pytest.approx(
+        high + 4 * math.pi, abs=1e-13)
 
 
 def test_change_points_of_equality_linkages() -> None:

@@ -15,8 +15,8 @@ from matplotlib.colors import to_rgb
 from matplotlib.image import imread
 
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.kinematics import LinkageState, solve_many
+from linkage_kinematics.geometry import FourBar, preset
+from linkage_kinematics.kinematics import LinkageState, continued_branch, solve_many
 from linkage_kinematics.sweep import CSV_COLUMNS, format_tables, main
 from test_bag_reader import write_bag_folder, write_mcap
 
@@ -204,6 +204,42 @@ def test_full_rotation_for_two_turns(capsys: pytest.CaptureFixture[str]) -> None
                        DriveLaw(2.0))
     assert_columns_equal(columns, state, alpha_deg)
     assert columns["beta_deg"][-1] == pytest.approx(columns["beta_deg"][0], abs=1e-9)
+
+
+PARALLELOGRAM_ARGS = ("--crank-length", "0.3", "--coupler-length", "1.0", "--rocker-length",
+                      "0.3", "--ground-x", "1.0", "--ground-y", "0")
+
+
+def test_parallelogram_turns_through_its_change_points() -> None:
+    """The issue's command: a parallelogram turns fully, through its change points at 90° and
+    270°, on the smooth branch the start names (here the crossed one), as one process."""
+    result = run_sweep(*PARALLELOGRAM_ARGS, "--alpha-start", "0", "--alpha-end", "360")
+    assert result.returncode == 0, result.stderr
+    assert result.stderr == ""
+    columns = parse_csv(result.stdout)
+    np.testing.assert_array_equal(columns["alpha_deg"], np.arange(0.0, 360.5, 0.5))
+    linkage = FourBar(0.3, 1.0, 0.3, 1.0, 0.0)
+    alpha = np.radians(columns["alpha_deg"])
+    state = solve_many(linkage, alpha, DriveLaw(2.0), continued_branch(linkage, 0.0, 1, alpha))
+    assert_columns_equal(columns, state, columns["alpha_deg"])
+    # the crossed (anti-)parallelogram: the coupler turns back and forth, never constant
+    assert np.ptp(columns["gamma_deg"]) > 10.0
+
+
+@pytest.mark.parametrize(("start", "end", "step"), [("0", "1800", "0.5"), ("0", "-1800", "-0.5")])
+def test_parallelogram_stays_one_over_many_turns_both_ways(
+    capsys: pytest.CaptureFixture[str], start: str, end: str, step: str
+) -> None:
+    status, out, err = run_in_process(capsys, *PARALLELOGRAM_ARGS, "--branch", "-1",
+                                      "--alpha-start", start, "--alpha-end", end,
+                                      "--alpha-step", step)
+    assert status == 0, err
+    columns = parse_csv(out)
+    assert columns["alpha_deg"].size == 3601
+    assert np.max(np.abs(columns["gamma_deg"])) <= 1e-12
+    assert np.max(np.abs(columns["omega_ab"])) <= 1e-14
+    np.testing.assert_allclose(columns["omega_bc"], 2.0, rtol=1e-14)
+    assert np.max(np.abs(columns["omega_dot_ab"])) <= 1e-13
 
 
 def test_table_shows_the_seeds_head_and_tail(capsys: pytest.CaptureFixture[str]) -> None:
