@@ -10,7 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from linkage_kinematics.kinematics import LinkageState, solve
+from linkage_kinematics.geometry import TWO_PI
+from linkage_kinematics.kinematics import LinkageState, continued_branch, solve
 from linkage_kinematics.parameters import RunConfiguration
 
 
@@ -126,7 +127,13 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
 def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState:
     """The library's state for a motion sample (raises as ``kinematics.solve``)."""
     drive = config.reverse_drive if sample.reversed else config.drive
-    state = solve(config.linkage, sample.alpha, drive, config.branch)
+    # `branch` names the assembly at alpha_start; through change points the mechanism goes on
+    # on its smooth branch, which after an odd number of them is the other side.
+    branch = continued_branch(
+        config.linkage, config.alpha_start, config.branch, sample.alpha,
+        turns=round(sample.turn_offset / TWO_PI),
+    )
+    state = solve(config.linkage, sample.alpha, drive, branch)
     if sample.turn_offset:
         state = replace(state, alpha=state.alpha + sample.turn_offset)
     return state

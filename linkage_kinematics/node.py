@@ -114,9 +114,16 @@ def assess(
             f"transmission angle {math.degrees(state.transmission_angle):.2f}° is within "
             f"{math.degrees(config.min_transmission_angle):.2f}° of a straight line"
         )
-    distance = config.linkage.reachability.dead_point_distance(state.alpha)
+    reachability = config.linkage.reachability
+    distance = reachability.dead_point_distance(state.alpha)
     if distance is not None and distance < config.dead_point_warning:
         warnings.append(f"{math.degrees(distance):.3f}° from a dead point")
+    distance = reachability.change_point_distance(state.alpha)
+    if distance is not None and distance < config.dead_point_warning:
+        warnings.append(
+            f"{math.degrees(distance):.3f}° from a change point (the assemblies meet; the "
+            "motion continues smoothly on its branch)"
+        )
     note = blocked_note(config)
     if note is not None:
         warnings.append(note)
@@ -533,7 +540,9 @@ class LinkageNode(Node):
         }
         state = self._state
         if state is not None:
-            distance = config.linkage.reachability.dead_point_distance(state.alpha)
+            reachability = config.linkage.reachability
+            distance = reachability.dead_point_distance(state.alpha)
+            change_distance = reachability.change_point_distance(state.alpha)
             residual = float(loop_closure_residual(config.linkage, state))
             values.update({
                 "alpha (rad)": repr(state.alpha),
@@ -541,6 +550,9 @@ class LinkageNode(Node):
                 "dead point distance (deg)": (
                     "none (full rotation)" if distance is None
                     else f"{math.degrees(distance):.6f}"
+                ),
+                "change point distance (deg)": (
+                    "none" if change_distance is None else f"{math.degrees(change_distance):.6f}"
                 ),
                 "transmission angle (deg)": f"{math.degrees(state.transmission_angle):.6f}",
                 "loop closure residual": f"{residual:.3g}",

@@ -17,14 +17,13 @@ import yaml
 
 from linkage_kinematics.drive import DriveError, DriveLaw
 from linkage_kinematics.geometry import (
-    ANGLE_TOLERANCE,
     TWO_PI,
     FourBar,
     GeometryError,
     UnreachableError,
     preset,
 )
-from linkage_kinematics.kinematics import DeadPointError, solve
+from linkage_kinematics.kinematics import DeadPointError, continued_branch, solve
 from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 
 NODE_NAME = "linkage_node"
@@ -61,9 +60,9 @@ class RunConfiguration:
     """Validated parameters plus the motion they imply; replaced as a whole, never mutated.
 
     ``segment_end`` is where one pass of the motion ends: alpha_end, or ``blocked_at``, the
-    first dead (or change) point the crank meets on its way there. ``segment_duration`` is the
-    drive-law time of that pass (s), ``direction`` the sign of the crank's travel and
-    ``step_count`` the number of fixed steps strictly before ``segment_end``.
+    first dead point the crank meets on its way there (change points do not stop it).
+    ``segment_duration`` is the drive-law time of that pass (s), ``direction`` the sign of the
+    crank's travel and ``step_count`` the number of fixed steps strictly before ``segment_end``.
     """
 
     preset: str
@@ -145,7 +144,9 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
             read_only=True,
         ),
         *geometry_specs,
-        ParameterSpec("branch", 1, "assembly branch: +1 (B left of A→C) or −1",
+        ParameterSpec("branch", 1,
+                      "assembly at alpha_start: +1 (B left of A→C) or −1; through change points "
+                      "the motion continues on its smooth branch",
                       integer_range=(-1, 1, 2)),
         ParameterSpec("omega0", 2.0, "drive law ω = omega0 + k·α: omega0 (rad/s)",
                       floating_range=(-MAX_OMEGA0, MAX_OMEGA0)),
@@ -182,7 +183,8 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                       "WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)",
                       floating_range=(0.0, math.pi / 2.0)),
         ParameterSpec("diagnostics.dead_point_warning", math.radians(1.0),
-                      "WARN when the crank is closer than this to a dead point (rad)",
+                      "WARN when the crank is closer than this to a dead point or a change "
+                      "point (rad)",
                       floating_range=(0.0, math.pi)),
         ParameterSpec("log.enabled", True, "record every published message to a bag",
                       read_only=True),
@@ -290,20 +292,6 @@ def _branch(values: Mapping[str, Any]) -> int:
     return int(branch)
 
 
-def first_singular_point(linkage: FourBar, alpha_start: float, alpha_end: float) -> float | None:
-    """The first dead or change point the crank meets going from alpha_start to alpha_end
-    (inclusive of alpha_end), as an unwrapped crank angle; None if the way is clear."""
-    reachability = linkage.reachability
-    direction = 1.0 if alpha_end > alpha_start else -1.0
-    travel = abs(alpha_end - alpha_start)
-    nearest = None
-    for point in reachability.dead_points + reachability.change_points:
-        distance = (direction * (point - alpha_start)) % TWO_PI
-        if distance <= travel + ANGLE_TOLERANCE and (nearest is None or distance < nearest):
-            nearest = distance
-    return None if nearest is None else alpha_start + direction * nearest
-
-
 def _motion(
     linkage: FourBar, drive: DriveLaw, branch: int, alpha_start: float, alpha_end: float
 ) -> tuple[float | None, float]:
@@ -323,10 +311,12 @@ def _motion(
         drive.time_to(alpha_start, alpha_end)
     except DriveError as error:
         raise ConfigurationError("alpha_end", str(error)) from None
-    blocked_at = first_singular_point(linkage, alpha_start, alpha_end)
+    # Change points do not stop the crank: it goes through them on its smooth branch.
+    blocked_at = linkage.reachability.first_dead_point(alpha_start, alpha_end)
     if blocked_at is None:
         try:
-            solve(linkage, alpha_end, drive, branch)
+            solve(linkage, alpha_end, drive,
+                  continued_branch(linkage, alpha_start, branch, alpha_end))
         except DeadPointError:
             blocked_at = alpha_end
     segment_end = alpha_end if blocked_at is None else blocked_at

@@ -82,6 +82,8 @@ def test_the_scenario_launch_files_name_existing_parameters_files() -> None:
     (node,) = xml.iter("node")
     assert (node.get("pkg"), node.get("exec")) == ("linkage_kinematics", "linkage_node")
     (argument,) = xml.iter("arg")
+    # A misspelt scenario fails at launch, as in the Python file, instead of running defaults.
+    assert [choice.get("value") for choice in argument.iter("choice")] == choices
     assert argument.get("default") in choices
     (parameters,) = node.iter("param")
     for scenario in choices:

@@ -136,3 +136,56 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
     # Across the jump the coupler and rocker joints stay within π of where they were.
     last, resumed = joints[phases[0][-1]], joints[phases[1][0]]
     assert all(abs(now - then) <= math.pi for now, then in zip(resumed[1:], last[1:]))
+
+
+PARALLELOGRAM = {"crank_length": 0.3, "coupler_length": 1.0, "rocker_length": 0.3,
+                 "ground_x": 1.0, "ground_y": 0.0}
+QUARTER = 250_000_000  # ns of simulated time: a quarter turn, from change point to change point
+TURNS = 1000
+
+
+def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_path):
+    """OA = BC, AB = OC: both cranks turn fully, and at α = 90° and 270° (where every tick of
+    this run lands) the two assemblies meet. The node never ends a pass there: the parallelogram
+    stays a parallelogram (γ = 0, ω_AB = 0, ω_BC = ω), α keeps counting, joints stay continuous."""
+    with ros_context(DOMAIN_ID) as context:
+        listener = Listener("parallelogram_tester", context)
+        listener.subscribe("/linkage/state", JointTrajectory)
+        listener.subscribe("/joint_states", JointState)
+        clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
+        states = listener.received["/linkage/state"]
+        process = start_node(
+            {"preset": "", **PARALLELOGRAM, "branch": -1, "end_behavior": "loop",
+             "alpha_start": 0.0, "alpha_end": TWO_PI, "omega0": DRIVE.omega0,
+             "use_sim_time": True, "log.enabled": False},
+            DOMAIN_ID, tmp_path / "node.log")
+        try:
+            assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
+            assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
+            phases = [[CLOCK_START + n * QUARTER for n in range(9)],
+                      [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER
+                       for n in range(9)]]
+            for phase in phases:
+                for clock_ns in phase:
+                    _drive_clock(listener, clock, states, clock_ns)
+            assert listener.spin_until(
+                lambda: len(listener.received["/joint_states"]) >= len(states))
+            assert process.poll() is None, (tmp_path / "node.log").read_text()
+        finally:
+            stop_process(process)
+            listener.destroy()
+
+    by_stamp = {stamp_ns(message): message.points[0] for message in states}
+    assert sorted(by_stamp) == [clock_ns for phase in phases for clock_ns in phase]
+    for clock_ns, point in by_stamp.items():
+        assert point.positions[0] == pytest.approx(
+            DRIVE.alpha_at(0.0, _seconds(clock_ns - CLOCK_START)), rel=1e-12)
+        gamma, omega, omega_ab, omega_bc = (
+            point.positions[2], point.velocities[0], point.velocities[2], point.velocities[7])
+        assert abs(gamma) <= 1e-12 and abs(omega_ab) <= 1e-12 * omega
+        assert omega_bc == pytest.approx(omega, rel=1e-12)
+    joints = {stamp_ns(message): message.position for message in listener.received["/joint_states"]}
+    for phase in phases:
+        for before, after in zip(phase, phase[1:]):
+            step = [now - then for now, then in zip(joints[after], joints[before])]
+            assert step == pytest.approx([math.pi / 2, -math.pi / 2, math.pi / 2], abs=1e-9)

@@ -19,7 +19,6 @@ from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
     ConfigurationError,
     build_configuration,
-    first_singular_point,
     parameter_specs,
 )
 from linkage_kinematics.urdf import urdf_text
@@ -108,9 +107,6 @@ def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
     assert config.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
     assert config.segment_end == config.blocked_at
     assert config.segment_duration == DriveLaw(-1.0).time_to(0.0, config.blocked_at)
-    assert first_singular_point(PAPER, 0.0, math.pi / 2.0) is None
-    assert first_singular_point(PAPER, 0.0, 4.0) == pytest.approx(
-        max(PAPER.reachability.dead_points), abs=1e-15)
 
 
 def test_only_motion_changes_restart_the_motion():
