@@ -279,12 +279,12 @@ class LinkageNode(Node):
         if note is not None:
             self.get_logger().warning(note)
         if new.display_rate_hz != old.display_rate_hz:
-            self._marker_timer.destroy()
+            self.destroy_timer(self._marker_timer)
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
                                                    self._publish_markers)
         if restarts:
             self._restart_motion()
-            self._state_timer.destroy()
+            self.destroy_timer(self._state_timer)
             self._state_timer = self.create_timer(self._timer_period(), self._tick)
             self._tick()
 
