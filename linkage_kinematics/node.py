@@ -38,7 +38,7 @@ from visualization_msgs.msg import MarkerArray
 
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import package_version
-from linkage_kinematics.geometry import GeometryError, UnreachableError
+from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
 from linkage_kinematics.motion import (
     MotionSample,
@@ -159,7 +159,7 @@ class LinkageNode(Node):
         self._problem: str | None = None
         self._activity = "starting"
         self._recording_error: str | None = None
-        self._described: RunConfiguration | None = None
+        self._described_linkage: FourBar | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = self.config.frame_prefix + self.config.frame_id
         self._joint_state = JointState(name=list(messages.JOINT_NAMES), position=[0.0] * 3)
@@ -451,7 +451,7 @@ class LinkageNode(Node):
         self._state_time = at
         if first:
             self._publish_markers()
-            if self._described is None or self._described.linkage != self.config.linkage:
+            if self._described_linkage != self.config.linkage:
                 self._publish_robot_description(at)
             self._activity = "moving"
             self._publish_diagnostics()
@@ -490,7 +490,7 @@ class LinkageNode(Node):
     # display and diagnostics
 
     def _publish_robot_description(self, at: Time) -> None:
-        self._described = self.config
+        self._described_linkage = self.config.linkage
         message = String(data=urdf_text(self.config.linkage, self.config.frame_id))
         self._publish(self._description_topic, message, at.nanoseconds)
 
