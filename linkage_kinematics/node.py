@@ -24,7 +24,7 @@ from rcl_interfaces.msg import (
     SetParametersResult,
 )
 from rclpy.duration import Duration
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -483,7 +483,12 @@ def main(args: list[str] | None = None) -> int:
         except ConfigurationError as error:
             _report_configuration_error(error)
             return EXIT_CONFIGURATION
-        executor = SingleThreadedExecutor()
+        # The events executor dispatches timers and services from C++ instead of rebuilding a
+        # wait set in Python for every callback: at 1 kHz it halves the process's CPU
+        # (docs/benchmarks.md, section 3). Its spin() busy-waits without running timers in
+        # rclpy 7.1.6; spin_once returns after each callback, and at the latest after the
+        # timeout, so the signal handlers above run and the loop sees the end of the run.
+        executor = EventsExecutor()
         executor.add_node(node)
         try:
             while node.exit_code is None and not received:

@@ -1,0 +1,108 @@
+"""linkage_node on rclpy's EventsExecutor: what the executor must still deliver besides ticks.
+
+The node spins on rclpy.experimental.EventsExecutor, which dispatches timers from C++ and takes
+timers and services from the node when they change. Other modules cover its parameter changes
+(test_node_parameters.py, test_node_bad_input.py), signals (test_recording_faults.py) and long
+runs on simulated time (test_node_long_runs.py). This one covers what they do not: the
+describe/list parameter services, and a state timer re-created at run time (rate_hz changed)
+on simulated time: the executor must arm the new timer from /clock jumps alone and drop the old
+one (it keeps firing if the node only calls ``Timer.destroy()``, which leaves the timer in
+``node.timers``; ``Node.destroy_timer`` removes it).
+"""
+
+from __future__ import annotations
+
+import signal
+
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import QoSProfile
+from rosgraph_msgs.msg import Clock
+from trajectory_msgs.msg import JointTrajectory
+
+from linkage_kinematics import bag_reader, messages
+from linkage_kinematics.parameters import PARAMETER_NAMES, parameter_specs
+from node_process import (
+    PROCESS_TIMEOUT,
+    Listener,
+    ros_context,
+    stamp_ns,
+    start_node,
+    stop_process,
+)
+
+DOMAIN_ID = 76
+CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick
+STEP = 10_000_000  # ns of simulated time per /clock step: one period at 100 Hz, half at 50 Hz
+
+
+def _send_until_state(listener: Listener, clock, states: list, clock_ns: int) -> None:
+    """Set simulated time to ``clock_ns`` and wait for the node's state of that instant (a lost
+    /clock message is sent again; the same time again makes no tick)."""
+    message = Clock(clock=messages.time_msg(clock_ns))
+
+    def ticked() -> bool:
+        return bool(states) and stamp_ns(states[-1]) == clock_ns
+
+    for _ in range(round(PROCESS_TIMEOUT / 0.5)):
+        clock.publish(message)
+        if listener.spin_until(ticked, timeout=0.5):
+            return
+    raise AssertionError(f"no state stamped {clock_ns} ns")
+
+
+def test_parameter_services_and_a_rate_change_on_sim_time(tmp_path):
+    bags = tmp_path / "bags"
+    with ros_context(DOMAIN_ID) as context:
+        listener = Listener("executor_tester", context)
+        listener.subscribe("/linkage/state", JointTrajectory)
+        states = listener.received["/linkage/state"]
+        clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
+        process = start_node(
+            {"end_behavior": "loop", "rate_hz": 100.0, "display_rate_hz": 1.0,
+             "use_sim_time": True, "log.folder": str(bags)},
+            DOMAIN_ID, tmp_path / "node.log")
+        try:
+            client = AsyncParameterClient(listener.node, "linkage_node")
+            assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
+            listed = listener.result_of(client.list_parameters([], 0)).result.names
+            assert set(PARAMETER_NAMES) <= set(listed)
+            specs = {spec.name: spec for spec in parameter_specs("paper")}
+            (descriptor,) = listener.result_of(client.describe_parameters(["rate_hz"])).descriptors
+            assert descriptor.description == specs["rate_hz"].description
+            (interval,) = descriptor.floating_point_range
+            assert (interval.from_value, interval.to_value) == specs["rate_hz"].floating_range
+
+            assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
+            assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
+            before = [CLOCK_START + n * STEP for n in range(6)]
+            for clock_ns in before:
+                _send_until_state(listener, clock, states, clock_ns)
+
+            (result,) = listener.result_of(
+                client.set_parameters([Parameter("rate_hz", value=50.0)])).results
+            assert result.successful, result.reason
+            # The new timer starts at the last /clock time: its periods end on every second
+            # step from here, and the steps between must not tick.
+            after = []
+            for n in range(1, 7):
+                clock_ns = before[-1] + n * STEP
+                if n % 2:
+                    clock.publish(Clock(clock=messages.time_msg(clock_ns)))
+                else:
+                    _send_until_state(listener, clock, states, clock_ns)
+                    after.append(clock_ns)
+            assert process.poll() is None
+            process.send_signal(signal.SIGINT)
+            status = process.wait(timeout=PROCESS_TIMEOUT)
+        finally:
+            stop_process(process)
+            listener.destroy()
+
+    assert status == 0, (tmp_path / "node.log").read_text()
+    received = [stamp_ns(message) for message in states]
+    assert received == before + after, [(stamp - CLOCK_START) // 1_000_000 for stamp in received]
+    (bag,) = bags.iterdir()
+    assert all(part.complete for part in bag_reader.bag_files(bag))
+    logged = [message.log_time_ns for message in bag_reader.iter_messages(bag, ["/linkage/state"])]
+    assert logged == received
