@@ -270,7 +270,7 @@ class LinkageNode(Node):
             self._topic_publishers[topic].publish(message)
             return
         # Serialized once: subscribers get the very bytes that are logged.
-        data = self._recorder.serialize(topic, message)
+        data = self._recorder.serialize(message)
         self._topic_publishers[topic].publish(data)
         try:
             self._recorder.record(topic, data, log_time_ns)
