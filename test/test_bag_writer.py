@@ -42,6 +42,7 @@ from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import (
     DEFINITION_SEPARATOR,
     BagExistsError,
+    WRITE_BATCH,
     BagWriter,
     message_definition,
     package_version,
@@ -358,6 +359,33 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
     information = bag_information(bag)
     assert information["message_count"] == 1_999
     assert information["custom_data"]["rate_hz"] == "200"
+
+
+@pytest.mark.parametrize("count", [1, WRITE_BATCH - 1, WRITE_BATCH, 3 * WRITE_BATCH + 1])
+def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: int) -> None:
+    """Messages wait in a queue before they enter the chunk; flush and close take them all, in
+    the order written, on their channels."""
+    writer = BagWriter(tmp_path / "queued", metadata={}, flush_interval=3600.0)
+    channels = [
+        writer.add_topic(topic, "std_msgs/msg/String", message_definition("std_msgs/msg/String"),
+                         offered_qos_profiles_yaml(QoSProfile(depth=10)))
+        for topic in ("/a", "/b")
+    ]
+    written = [(("/a", "/b")[index % 2], encode_cdr(String(data=f"m{index}")), 1_000 + index)
+               for index in range(count)]
+    for index, (_, data, log_time) in enumerate(written):
+        writer.write(channels[index % 2], data, log_time, log_time)
+    writer.flush()
+    flushed = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
+    assert flushed == written
+    writer.write(channels[0], encode_cdr(String(data="last")), 5_000, 5_000)
+    writer.close()
+    logged = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
+    assert logged == written + [("/a", encode_cdr(String(data="last")), 5_000)]
+    information = bag_information(writer.bag_path)
+    assert information["message_count"] == count + 1
+    assert information["starting_time"]["nanoseconds_since_epoch"] == 1_000
+    assert information["duration"]["nanoseconds"] == 4_000
 
 
 def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
