@@ -5,7 +5,10 @@ those bytes and logs the same bytes, so subscribers receive exactly what the bag
 
 ``encode_cdr`` writes a message as little-endian XCDR1 (the encoding rmw_fastrtps publishes
 and rosbag2 stores) from the message's field types alone: one walk over the fields collects a
-``struct`` format and its values, and one ``struct.pack`` writes them. It is the encoding
+``struct`` format and its values, and one ``struct.pack`` writes them. Each run of consecutive
+fixed-size fields (primitives, and messages made only of them such as a Time or a Pose) is one
+step of the walk: one ``attrgetter`` reads all its values and its struct codes are prepared
+for each alignment it can start at. It is the encoding
 rosbags' serializer produces, byte for byte: alignment padding is zero and the length exact.
 rclpy's ``serialize_message`` is not used because it builds a type support object per call (at
 a 1 kHz tick it cost more than the rest of the node's Python), can return a few bytes more
@@ -51,8 +54,9 @@ _PRIMITIVES = {
     "uint32": ("I", 4), "float": ("f", 4), "int64": ("q", 8), "uint64": ("Q", 8),
     "double": ("d", 8),
 }
-# How a field is written: a primitive, a string, a message; each also as an array or sequence.
-_PRIMITIVE, _STRING, _MESSAGE, _PRIMITIVE_LIST, _STRING_LIST, _MESSAGE_LIST = range(6)
+# How a plan entry is written: a run of fixed-size fields (primitives and messages made only of
+# them) in one struct code, a string, a message, and sequences (or arrays) of each.
+_FIXED, _STRING, _MESSAGE, _PRIMITIVE_LIST, _FIXED_LIST, _STRING_LIST, _MESSAGE_LIST = range(7)
 
 
 class RecordingError(OSError):
@@ -69,53 +73,115 @@ def _message_class(slot_type: NamespacedType) -> type:
     return getattr(importlib.import_module(".".join(slot_type.namespaces)), slot_type.name)
 
 
-# One field of a plan: its getter, how it is written, the struct code and size of its
-# primitives, its message class, and whether a sequence length comes first.
-_Field = tuple[Callable[[Any], Any], int, str, int, "type | None", bool]
-
-
-@functools.cache
-def _plan(msg_type: type) -> tuple[_Field, ...]:
-    """How ``encode_cdr`` writes each field of ``msg_type``, in order."""
-    plan = []
-    for name, slot_type in zip(msg_type.get_fields_and_field_types(), msg_type.SLOT_TYPES):
-        counted = isinstance(slot_type, AbstractNestedType) and not isinstance(slot_type, Array)
-        element = slot_type.value_type if isinstance(slot_type, AbstractNestedType) else slot_type
-        nested = isinstance(slot_type, AbstractNestedType)
-        code, size, message_class = "", 0, None
-        if isinstance(element, AbstractWString):
-            raise TypeError(f"{ros_type_name(msg_type)}.{name}: wstring fields are not supported")
-        if isinstance(element, BasicType):
-            kind = _PRIMITIVE_LIST if nested else _PRIMITIVE
-            code, size = _PRIMITIVES[element.typename]
-        elif isinstance(element, AbstractString):
-            kind = _STRING_LIST if nested else _STRING
-        elif isinstance(element, NamespacedType):
-            kind = _MESSAGE_LIST if nested else _MESSAGE
-            message_class = _message_class(element)
-        else:
-            raise TypeError(f"{ros_type_name(msg_type)}.{name}: unsupported type {element!r}")
-        plan.append((operator.attrgetter(name), kind, code, size, message_class, counted))
-    return tuple(plan)
-
-
+# One entry of a plan: its getter, how it is written, a detail (the struct codes and lengths
+# of a fixed run, by offset mod 8; the code and size of a primitive sequence's elements), the
+# element getter or message class of a sequence or message, and whether a length comes first.
+_Entry = tuple[Callable[[Any], Any], int, Any, Any, bool]
 _PADDING = ("",) + tuple(f"{n}x" for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
 
 
-def _walk(message: Any, plan: tuple[_Field, ...], codes: list[str], values: list[Any],
-          offset: int) -> int:
-    """Append the struct codes and values of ``message`` written at ``offset``; the end offset."""
-    for get, kind, code, size, message_class, counted in plan:
-        value = get(message)
-        if kind == _PRIMITIVE:
+def _fields(msg_type: type) -> list[tuple[str, Any]]:
+    return list(zip(msg_type.get_fields_and_field_types(), msg_type.SLOT_TYPES))
+
+
+@functools.cache
+def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
+    """(attribute path, struct code, size) of every primitive of a message made only of
+    primitives and such messages, in order; None for any other message."""
+    leaves: list[tuple[str, str, int]] = []
+    for name, slot_type in _fields(msg_type):
+        if isinstance(slot_type, BasicType):
+            leaves.append((name, *_PRIMITIVES[slot_type.typename]))
+        elif isinstance(slot_type, NamespacedType):
+            nested = _fixed_leaves(_message_class(slot_type))
+            if nested is None:
+                return None
+            leaves += [(f"{name}.{path}", code, size) for path, code, size in nested]
+        else:
+            return None
+    return tuple(leaves)
+
+
+def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tuple], tuple]:
+    """The getter of a run of fixed-size leaves (a tuple of their values) and its struct codes
+    and byte length for each start offset mod 8 (the padding depends on nothing else)."""
+    layouts = []
+    for phase in range(8):
+        codes, offset = [], phase
+        for _, code, size in leaves:
             padding = -offset % size
             codes.append(_PADDING[padding] + code)
-            values.append(value)
             offset += padding + size
-        elif kind == _MESSAGE:
-            offset = _walk(value, _plan(message_class), codes, values, offset)
+        layouts.append(("".join(codes), offset - phase))
+    paths = [path for path, _, _ in leaves]
+    if len(paths) == 1:
+        single = operator.attrgetter(paths[0])
+        return (lambda message: (single(message),)), tuple(layouts)
+    return operator.attrgetter(*paths), tuple(layouts)
+
+
+def _run_entry(leaves: list[tuple[str, str, int]]) -> _Entry:
+    get, layouts = _fixed_entry(leaves)
+    return (get, _FIXED, layouts, None, False)
+
+
+@functools.cache
+def _plan(msg_type: type) -> tuple[_Entry, ...]:
+    """How ``encode_cdr`` writes ``msg_type``: its fields in order, each run of consecutive
+    fixed-size fields merged into one entry."""
+    plan: list[_Entry] = []
+    run: list[tuple[str, str, int]] = []
+    for name, slot_type in _fields(msg_type):
+        element = slot_type.value_type if isinstance(slot_type, AbstractNestedType) else slot_type
+        if isinstance(element, AbstractWString):
+            raise TypeError(f"{ros_type_name(msg_type)}.{name}: wstring fields are not supported")
+        if not isinstance(element, (BasicType, AbstractString, NamespacedType)):
+            raise TypeError(f"{ros_type_name(msg_type)}.{name}: unsupported type {element!r}")
+        message_class = _message_class(element) if isinstance(element, NamespacedType) else None
+        fixed = _fixed_leaves(message_class) if message_class is not None else None
+        if not isinstance(slot_type, AbstractNestedType):
+            if isinstance(element, BasicType):
+                run.append((name, *_PRIMITIVES[element.typename]))
+                continue
+            if fixed is not None:
+                run += [(f"{name}.{path}", code, size) for path, code, size in fixed]
+                continue
+        if run:
+            plan.append(_run_entry(run))
+            run = []
+        get = operator.attrgetter(name)
+        counted = isinstance(slot_type, AbstractNestedType) and not isinstance(slot_type, Array)
+        if not isinstance(slot_type, AbstractNestedType):
+            kind = _STRING if isinstance(element, AbstractString) else _MESSAGE
+            plan.append((get, kind, None, message_class, False))
+        elif isinstance(element, BasicType):
+            plan.append((get, _PRIMITIVE_LIST, _PRIMITIVES[element.typename], None, counted))
+        elif isinstance(element, AbstractString):
+            plan.append((get, _STRING_LIST, None, None, counted))
+        elif fixed is not None:
+            element_get, layouts = _fixed_entry(list(fixed))
+            plan.append((get, _FIXED_LIST, layouts, element_get, counted))
+        else:
+            plan.append((get, _MESSAGE_LIST, None, message_class, counted))
+    if run:
+        plan.append(_run_entry(run))
+    return tuple(plan)
+
+
+def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list[Any],
+          offset: int) -> int:
+    """Append the struct codes and values of ``message`` written at ``offset``; the end offset."""
+    for get, kind, detail, extra, counted in plan:
+        value = get(message)
+        if kind == _FIXED:
+            layout, length = detail[offset & 7]
+            codes.append(layout)
+            values += value
+            offset += length
         elif kind == _STRING:
             offset = _add_string(value, codes, values, offset)
+        elif kind == _MESSAGE:
+            offset = _walk(value, _plan(extra), codes, values, offset)
         else:
             if counted:
                 padding = -offset % 4
@@ -124,15 +190,22 @@ def _walk(message: Any, plan: tuple[_Field, ...], codes: list[str], values: list
                 offset += padding + 4
             if kind == _PRIMITIVE_LIST:
                 if value:
+                    code, size = detail
                     padding = -offset % size
                     codes.append(f"{_PADDING[padding]}{len(value)}{code}")
                     values += value
                     offset += padding + len(value) * size
+            elif kind == _FIXED_LIST:
+                for element in value:
+                    layout, length = detail[offset & 7]
+                    codes.append(layout)
+                    values += extra(element)
+                    offset += length
             elif kind == _STRING_LIST:
                 for text in value:
                     offset = _add_string(text, codes, values, offset)
             else:
-                element_plan = _plan(message_class)
+                element_plan = _plan(extra)
                 for element in value:
                     offset = _walk(element, element_plan, codes, values, offset)
     return offset

@@ -33,7 +33,7 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import JointState, Range
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
@@ -222,7 +222,9 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
     flags: list[bool],
 ) -> None:
     """The other field kinds the node logs: a byte (the diagnostic level), a bool between wider
-    fields, sequences of messages inside sequences of messages, an empty uint8 sequence."""
+    fields, sequences of messages inside sequences of messages, an empty uint8 sequence; and
+    a run of fixed-size fields (a uint8, then float32s) starting at every offset a string of
+    any length leaves."""
     status = DiagnosticStatus(level=bytes([level]), name=texts[0], message=texts[1],
                               hardware_id=texts[2],
                               values=[KeyValue(key=k, value=v) for k, v in values.items()])
@@ -232,6 +234,10 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
         Marker(ns=texts[3], id=index, frame_locked=flag, points=[
             Point(x=x, y=y, z=z) for x, y, z in points]) for index, flag in enumerate(flags)])
     assert_exact_encoding(encode_cdr(markers), markers)
+    ranged = Range(radiation_type=Range.INFRARED, field_of_view=0.5, min_range=0.25,
+                   max_range=2.0, range=1.5)
+    ranged.header.frame_id = texts[0]
+    assert_exact_encoding(encode_cdr(ranged), ranged)
 
 
 def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: Path) -> None:
