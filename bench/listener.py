@@ -2,10 +2,10 @@
 
 Usage: python bench/listener.py OUTPUT.json SECONDS [TOPIC ...]
 
-Subscribes to /diagnostics and to each TOPIC (sensor_msgs/JointState); once the first
-message of every TOPIC has arrived (discovery is done), records for SECONDS every JointState's
-header stamp and receive time (system clock, the clock the node stamps with) and the key-value
-pairs of every /diagnostics status; then writes them as JSON.
+Subscribes to /diagnostics and to each TOPIC (sensor_msgs/JointState); once the first message
+of every TOPIC (without TOPICs: of /diagnostics) has arrived (discovery is done), records for
+SECONDS every JointState's header stamp and receive time (system clock, the clock the node
+stamps with) and the key-value pairs of every /diagnostics status; then writes them as JSON.
 """
 
 from __future__ import annotations
@@ -42,6 +42,7 @@ def main(argv: list[str]) -> int:
         return callback
 
     def on_diagnostics(message: DiagnosticArray) -> None:
+        matched.add("/diagnostics")
         if recording:
             for status in message.status:
                 diagnostics.append({value.key: value.value for value in status.values})
@@ -54,7 +55,8 @@ def main(argv: list[str]) -> int:
     executor.add_node(node)
     print("listening", flush=True)
     give_up = time.monotonic() + 30.0
-    while len(matched) < len(topics) and time.monotonic() < give_up:
+    awaited = set(topics) or {"/diagnostics"}
+    while not awaited <= matched and time.monotonic() < give_up:
         executor.spin_once(timeout_sec=0.05)
     recording = True
     deadline = time.monotonic() + float(seconds)

@@ -34,7 +34,7 @@ def ros_environment(domain: int) -> dict[str, str]:
     environment.update({
         "ROS_DOMAIN_ID": str(domain),
         "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-        "AMENT_PREFIX_PATH": str(ROOT / ".venv"),
+        "AMENT_PREFIX_PATH": os.environ.get("AMENT_PREFIX_PATH", sys.prefix),
     })
     return environment
 
@@ -180,8 +180,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             trajectory = messages.linkage_state(config.linkage, state, stamp, 0.0,
                                                 config.frame_id)
             bare_message = messages.joint_state(state, stamp)
-            joint_state_data = recorder.serialize("/joint_states", joint_state)
-            trajectory_data = recorder.serialize("/linkage/state", trajectory)
+            joint_state_data = recorder.serialize(joint_state)
+            trajectory_data = recorder.serialize(trajectory)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 
             def compute() -> int:
@@ -207,8 +207,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
 
             def serialize() -> int:
                 for _ in range(count):
-                    recorder.serialize("/joint_states", joint_state)
-                    recorder.serialize("/linkage/state", trajectory)
+                    recorder.serialize(joint_state)
+                    recorder.serialize(trajectory)
                 return count
 
             def publish_serialized() -> int:
@@ -243,7 +243,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
                 "compute: sample_at_time + solve_sample (kinematics.solve)": compute,
                 "  of which kinematics.solve alone": solve_only,
                 "build: messages.joint_state + messages.linkage_state": build,
-                "serialize: Recorder.serialize of both messages": serialize,
+                "serialize: Recorder.serialize (encode_cdr) of both messages": serialize,
                 "publish: both serialized messages (logging on)": publish_serialized,
                 "log: Recorder.record of both serialized messages": record,
                 "publish: both messages as objects (logging off)": publish_messages,
@@ -275,12 +275,14 @@ def _percentile(values: list[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
 
 
-def observe(parameters: dict[str, str], seconds: float, domain: int) -> dict[str, Any]:
-    """Run a node with ``parameters`` and a listener on /joint_states for ``seconds``."""
+def observe(parameters: dict[str, str], seconds: float, domain: int,
+            topics: tuple[str, ...] | list[str] = ("/joint_states",)) -> dict[str, Any]:
+    """Run a node with ``parameters`` and a listener on /diagnostics and ``topics`` for
+    ``seconds``."""
     node = start_node({"end_behavior": "loop", **parameters}, domain)
     try:
         time.sleep(STARTUP_S)
-        listener, output = listen(seconds, ["/joint_states"], domain)
+        listener, output = listen(seconds, list(topics), domain)
         data = collect(listener, output)
     finally:
         stop(node)

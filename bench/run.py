@@ -1,14 +1,16 @@
 """The benchmark report: ``./dev bench`` (= ``python bench/run.py``) from the repository root.
 
 Sections: kinematics (cost per configuration against error), drive (the drive law in time),
-node (the ROS node's tick, rates, jitter, latency and log size) and memory (the node's resident
-memory over a long 1 kHz run). Every section prints markdown tables for docs/benchmarks.md;
-the kinematics section also draws docs/benchmark_speed_error.png.
+node (the ROS node's tick, rates, jitter, latency and log size), cost (the node's CPU side by
+side with a minimal hand-written rclpy publisher, its highest sustained rate) and memory (the
+node's resident memory over a long 1 kHz run). Every section prints markdown tables for
+docs/benchmarks.md; the kinematics section also draws docs/benchmark_speed_error.png.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import pathlib
 import sys
 import time
@@ -19,7 +21,7 @@ sys.path[1:1] = [str(ROOT), str(ROOT / "test")]
 
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ("kinematics", "drive", "node", "memory")
+SECTIONS = ("kinematics", "drive", "node", "cost", "memory")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -36,8 +38,8 @@ def main(argv: list[str] | None = None) -> int:
                         help="length of the node's resident-memory run at 1 kHz "
                              "(default 10, 0.5 with --quick)")
     parser.add_argument("--ros-domain", type=int, default=50,
-                        help="first of the five ROS_DOMAIN_IDs the node and memory sections use "
-                             "(default 50, so 50–54)")
+                        help="first of the five ROS_DOMAIN_IDs the node, cost and memory "
+                             "sections use (default 50, so 50–54)")
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
         parser.error("--repetitions must be at least 1")
@@ -68,6 +70,11 @@ def main(argv: list[str] | None = None) -> int:
 
         print("\n## Node\n")
         print(node_bench.run(arguments.quick, repetitions, arguments.ros_domain))
+    if "cost" in sections:
+        import cost_bench
+
+        print("\n## Node against a minimal hand-written publisher\n")
+        print(cost_bench.run(arguments.quick, arguments.ros_domain))
     if "memory" in sections:
         import node_bench
 
@@ -76,7 +83,9 @@ def main(argv: list[str] | None = None) -> int:
             minutes = 0.5 if arguments.quick else 10.0
         print(f"\n## Node memory over {minutes:g} min at 1 kHz\n")
         print(node_bench.memory_run(minutes, arguments.ros_domain))
-    print(f"\nbenchmark took {time.perf_counter() - started:.0f} s")
+    load = ", ".join(f"{value:.2f}" for value in os.getloadavg())
+    print(f"\nbenchmark took {time.perf_counter() - started:.0f} s; load average at the end: "
+          f"{load}")
     return 0
 
 

@@ -24,7 +24,8 @@ from rcl_interfaces.msg import (
     SetParametersResult,
 )
 from rclpy.duration import Duration
-from rclpy.executors import SingleThreadedExecutor
+from rclpy.executors import Executor, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -314,7 +315,7 @@ class LinkageNode(Node):
             self._topic_publishers[topic].publish(message)
             return
         # Serialized once: subscribers get the very bytes that are logged.
-        data = self._recorder.serialize(topic, message)
+        data = self._recorder.serialize(message)
         self._topic_publishers[topic].publish(data)
         try:
             self._recorder.record(topic, data, log_time_ns)
@@ -593,7 +594,18 @@ def main(args: list[str] | None = None) -> int:
         except ConfigurationError as error:
             _report_configuration_error(error)
             return EXIT_CONFIGURATION
-        executor = SingleThreadedExecutor()
+        # The events executor dispatches timers and services from C++ instead of rebuilding a
+        # wait set in Python for every callback: at 1 kHz it halves the process's CPU
+        # (docs/benchmarks.md, section 3). On simulated time rclpy 7.1.6's events executor
+        # runs a timer created at run time (a rate_hz change) twice at its first /clock step,
+        # which also shifts its schedule by a period, so there the node keeps rclpy's default
+        # executor. The events executor's spin() busy-waits without running timers; spin_once
+        # returns after each callback, and at the latest after the timeout, so the signal
+        # handlers above run and the loop sees the end of the run.
+        if node.get_parameter("use_sim_time").value:
+            executor: Executor = SingleThreadedExecutor()
+        else:
+            executor = EventsExecutor()
         executor.add_node(node)
         try:
             while node.exit_code is None and not received:

@@ -1,31 +1,34 @@
 """The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
 
-rclpy's ``serialize_message`` sizes its buffer from an estimate and can return a few bytes more
-than the message's CDR encoding (e.g. after an empty ``effort`` in a JointState); independent
-readers such as rosbags reject such messages. ``cdr_length`` computes the exact XCDR1 length
-from the message's field types (cached per class, no copying), and only that many bytes are
-logged.
+The node encodes each message once (``Recorder.serialize``, which is ``encode_cdr``), publishes
+those bytes and logs the same bytes, so subscribers receive exactly what the bag holds.
 
-The node serializes each message once (``Recorder.serialize``), publishes those bytes and logs
-the same bytes. Walking a message in Python for its length costs about as much as serializing
-it, so ``Recorder.serialize`` keeps each topic's last length together with the message's shape
-(``message_shape``: every string and every sequence length), and walks again only when the
-shape differs: for the per-tick topics, whose strings and arrays stay the same in a run, only
-on the first message.
+``encode_cdr`` writes a message as little-endian XCDR1 (the encoding rmw_fastrtps publishes
+and rosbag2 stores) from the message's field types alone: one walk over the fields collects a
+``struct`` format and its values, and one ``struct.pack`` writes them. Each run of consecutive
+fixed-size fields (primitives, and messages made only of them such as a Time or a Pose) is one
+step of the walk: one ``attrgetter`` reads all its values and its struct codes are prepared
+for each alignment it can start at. It is the encoding
+rosbags' serializer produces, byte for byte: alignment padding is zero and the length exact.
+rclpy's ``serialize_message`` is not used because it builds a type support object per call (at
+a 1 kHz tick it cost more than the rest of the node's Python), can return a few bytes more
+than the message's encoding (after an empty ``effort`` in a JointState; rosbags rejects such
+messages), and leaves padding bytes as it finds them.
 """
 from __future__ import annotations
 
 import functools
 import importlib
+import operator
+import struct
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import yaml
 from rclpy.qos import QoSProfile
-from rclpy.serialization import serialize_message
 from rosidl_parser.definition import (
-    AbstractGenericString,
     AbstractNestedType,
     AbstractString,
     AbstractWString,
@@ -41,12 +44,19 @@ from linkage_kinematics.bag_writer import (
     message_definition,
 )
 
-ENCAPSULATION_HEADER_BYTES = 4
-_PRIMITIVE_BYTES = {
-    "boolean": 1, "octet": 1, "char": 1, "int8": 1, "uint8": 1,
-    "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "float": 4,
-    "int64": 8, "uint64": 8, "double": 8,
+# XCDR1, little endian: the representation identifier and two option bytes.
+ENCAPSULATION_HEADER = b"\x00\x01\x00\x00"
+# struct code and size of each primitive (rclpy holds an octet as a 1-byte bytes, a char as an
+# int).
+_PRIMITIVES = {
+    "boolean": ("?", 1), "octet": ("c", 1), "char": ("B", 1), "int8": ("b", 1),
+    "uint8": ("B", 1), "int16": ("h", 2), "uint16": ("H", 2), "int32": ("i", 4),
+    "uint32": ("I", 4), "float": ("f", 4), "int64": ("q", 8), "uint64": ("Q", 8),
+    "double": ("d", 8),
 }
+# How a plan entry is written: a run of fixed-size fields (primitives and messages made only of
+# them) in one struct code, a string, a message, and sequences (or arrays) of each.
+_FIXED, _STRING, _MESSAGE, _PRIMITIVE_LIST, _FIXED_LIST, _STRING_LIST, _MESSAGE_LIST = range(7)
 
 
 class RecordingError(OSError):
@@ -59,119 +69,163 @@ def ros_type_name(msg_type: type) -> str:
     return f"{package}/{interface_kind}/{msg_type.__name__}"
 
 
-@functools.cache
-def _layout(msg_type: type) -> tuple[tuple[str, Any], ...]:
-    return tuple(zip(msg_type.get_fields_and_field_types(), msg_type.SLOT_TYPES))
-
-
-def _aligned(offset: int, size: int) -> int:
-    return offset + (-offset % size)
-
-
-def _end_of_message(message: Any, offset: int) -> int:
-    for name, slot_type in _layout(type(message)):
-        offset = _end_of_value(slot_type, getattr(message, name), offset)
-    return offset
-
-
-def _end_of_value(slot_type: Any, value: Any, offset: int) -> int:
-    if isinstance(slot_type, BasicType):
-        size = _PRIMITIVE_BYTES[slot_type.typename]
-        return _aligned(offset, size) + size
-    if isinstance(slot_type, AbstractString):
-        return _aligned(offset, 4) + 4 + len(value.encode("utf-8")) + 1
-    if isinstance(slot_type, NamespacedType):
-        return _end_of_message(value, offset)
-    if isinstance(slot_type, AbstractWString):
-        raise TypeError("wstring fields are not supported by the recorder")
-    if isinstance(slot_type, AbstractNestedType):
-        if not isinstance(slot_type, Array):
-            offset = _aligned(offset, 4) + 4  # sequence length
-        element_type = slot_type.value_type
-        if isinstance(element_type, BasicType):
-            if len(value) == 0:
-                return offset
-            size = _PRIMITIVE_BYTES[element_type.typename]
-            return _aligned(offset, size) + len(value) * size
-        for element in value:
-            offset = _end_of_value(element_type, element, offset)
-        return offset
-    raise TypeError(f"unsupported field type {slot_type!r}")
-
-
-def cdr_length(message: Any) -> int:
-    """The exact length in bytes of ``message`` serialized as little-endian XCDR1 with header."""
-    return ENCAPSULATION_HEADER_BYTES + _end_of_message(message, 0)
-
-
-def serialize_exact(message: Any) -> bytes:
-    """rclpy's CDR serialization cut to the message's true length (see the module docstring)."""
-    return serialize_message(message)[: cdr_length(message)]
-
-
-# How message_shape reads a field: a string or a sequence of strings as its text (which fixes
-# its encoded length), a sequence of primitives or of fixed-size messages by its length, a
-# message by its own shape, a sequence of messages by its length and each element's shape.
-_TEXT, _TEXTS, _LENGTH, _MESSAGE, _MESSAGES = range(5)
-
-
 def _message_class(slot_type: NamespacedType) -> type:
     return getattr(importlib.import_module(".".join(slot_type.namespaces)), slot_type.name)
 
 
+# One entry of a plan: its getter, how it is written, a detail (the struct codes and lengths
+# of a fixed run, by offset mod 8; the code and size of a primitive sequence's elements), the
+# element getter or message class of a sequence or message, and whether a length comes first.
+_Entry = tuple[Callable[[Any], Any], int, Any, Any, bool]
+_PADDING = ("",) + tuple(f"{n}x" for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
+
+
+def _fields(msg_type: type) -> list[tuple[str, Any]]:
+    return list(zip(msg_type.get_fields_and_field_types(), msg_type.SLOT_TYPES))
+
+
 @functools.cache
-def _shape_fields(msg_type: type) -> tuple[tuple[str, int, type | None], ...]:
-    """The fields of ``msg_type`` whose encoded length can vary, each with how to read it;
-    fields of fixed encoded length (primitives, fixed arrays of them, such messages) are left
-    out."""
-    fields = []
-    for name, slot_type in _layout(msg_type):
-        if isinstance(slot_type, AbstractGenericString):
-            fields.append((name, _TEXT, None))
+def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
+    """(attribute path, struct code, size) of every primitive of a message made only of
+    primitives and such messages, in order; None for any other message."""
+    leaves: list[tuple[str, str, int]] = []
+    for name, slot_type in _fields(msg_type):
+        if isinstance(slot_type, BasicType):
+            leaves.append((name, *_PRIMITIVES[slot_type.typename]))
         elif isinstance(slot_type, NamespacedType):
-            nested = _message_class(slot_type)
-            if _shape_fields(nested):
-                fields.append((name, _MESSAGE, nested))
-        elif isinstance(slot_type, AbstractNestedType):
-            element_type = slot_type.value_type
-            if isinstance(element_type, AbstractGenericString):
-                fields.append((name, _TEXTS, None))
-            elif isinstance(element_type, NamespacedType):
-                nested = _message_class(element_type)
-                if _shape_fields(nested):
-                    fields.append((name, _MESSAGES, nested))
-                elif not isinstance(slot_type, Array):
-                    fields.append((name, _LENGTH, None))
-            elif not isinstance(slot_type, Array):
-                fields.append((name, _LENGTH, None))
-    return tuple(fields)
-
-
-def _add_shape(message: Any, fields: tuple[tuple[str, int, type | None], ...],
-               shape: list[Any]) -> None:
-    for name, kind, nested in fields:
-        value = getattr(message, name)
-        if kind == _TEXT:
-            shape.append(value)
-        elif kind == _LENGTH:
-            shape.append(len(value))
-        elif kind == _TEXTS:
-            shape.append(tuple(value))
-        elif kind == _MESSAGE:
-            _add_shape(value, _shape_fields(nested), shape)
+            nested = _fixed_leaves(_message_class(slot_type))
+            if nested is None:
+                return None
+            leaves += [(f"{name}.{path}", code, size) for path, code, size in nested]
         else:
-            shape.append(len(value))
-            nested_fields = _shape_fields(nested)
-            for element in value:
-                _add_shape(element, nested_fields, shape)
+            return None
+    return tuple(leaves)
 
 
-def message_shape(message: Any) -> list[Any]:
-    """Everything ``cdr_length(message)`` depends on besides the message's type: equal shapes
-    of two messages of one type mean equal lengths."""
-    shape: list[Any] = []
-    _add_shape(message, _shape_fields(type(message)), shape)
-    return shape
+def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tuple], tuple]:
+    """The getter of a run of fixed-size leaves (a tuple of their values) and its struct codes
+    and byte length for each start offset mod 8 (the padding depends on nothing else)."""
+    layouts = []
+    for phase in range(8):
+        codes, offset = [], phase
+        for _, code, size in leaves:
+            padding = -offset % size
+            codes.append(_PADDING[padding] + code)
+            offset += padding + size
+        layouts.append(("".join(codes), offset - phase))
+    paths = [path for path, _, _ in leaves]
+    if len(paths) == 1:
+        single = operator.attrgetter(paths[0])
+        return (lambda message: (single(message),)), tuple(layouts)
+    return operator.attrgetter(*paths), tuple(layouts)
+
+
+def _run_entry(leaves: list[tuple[str, str, int]]) -> _Entry:
+    get, layouts = _fixed_entry(leaves)
+    return (get, _FIXED, layouts, None, False)
+
+
+@functools.cache
+def _plan(msg_type: type) -> tuple[_Entry, ...]:
+    """How ``encode_cdr`` writes ``msg_type``: its fields in order, each run of consecutive
+    fixed-size fields merged into one entry."""
+    plan: list[_Entry] = []
+    run: list[tuple[str, str, int]] = []
+    for name, slot_type in _fields(msg_type):
+        element = slot_type.value_type if isinstance(slot_type, AbstractNestedType) else slot_type
+        if isinstance(element, AbstractWString):
+            raise TypeError(f"{ros_type_name(msg_type)}.{name}: wstring fields are not supported")
+        if not isinstance(element, (BasicType, AbstractString, NamespacedType)):
+            raise TypeError(f"{ros_type_name(msg_type)}.{name}: unsupported type {element!r}")
+        message_class = _message_class(element) if isinstance(element, NamespacedType) else None
+        fixed = _fixed_leaves(message_class) if message_class is not None else None
+        if not isinstance(slot_type, AbstractNestedType):
+            if isinstance(element, BasicType):
+                run.append((name, *_PRIMITIVES[element.typename]))
+                continue
+            if fixed is not None:
+                run += [(f"{name}.{path}", code, size) for path, code, size in fixed]
+                continue
+        if run:
+            plan.append(_run_entry(run))
+            run = []
+        get = operator.attrgetter(name)
+        counted = isinstance(slot_type, AbstractNestedType) and not isinstance(slot_type, Array)
+        if not isinstance(slot_type, AbstractNestedType):
+            kind = _STRING if isinstance(element, AbstractString) else _MESSAGE
+            plan.append((get, kind, None, message_class, False))
+        elif isinstance(element, BasicType):
+            plan.append((get, _PRIMITIVE_LIST, _PRIMITIVES[element.typename], None, counted))
+        elif isinstance(element, AbstractString):
+            plan.append((get, _STRING_LIST, None, None, counted))
+        elif fixed is not None:
+            element_get, layouts = _fixed_entry(list(fixed))
+            plan.append((get, _FIXED_LIST, layouts, element_get, counted))
+        else:
+            plan.append((get, _MESSAGE_LIST, None, message_class, counted))
+    if run:
+        plan.append(_run_entry(run))
+    return tuple(plan)
+
+
+def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list[Any],
+          offset: int) -> int:
+    """Append the struct codes and values of ``message`` written at ``offset``; the end offset."""
+    for get, kind, detail, extra, counted in plan:
+        value = get(message)
+        if kind == _FIXED:
+            layout, length = detail[offset & 7]
+            codes.append(layout)
+            values += value
+            offset += length
+        elif kind == _STRING:
+            offset = _add_string(value, codes, values, offset)
+        elif kind == _MESSAGE:
+            offset = _walk(value, _plan(extra), codes, values, offset)
+        else:
+            if counted:
+                padding = -offset % 4
+                codes.append(_PADDING[padding] + "I")
+                values.append(len(value))
+                offset += padding + 4
+            if kind == _PRIMITIVE_LIST:
+                if value:
+                    code, size = detail
+                    padding = -offset % size
+                    codes.append(f"{_PADDING[padding]}{len(value)}{code}")
+                    values += value
+                    offset += padding + len(value) * size
+            elif kind == _FIXED_LIST:
+                for element in value:
+                    layout, length = detail[offset & 7]
+                    codes.append(layout)
+                    values += extra(element)
+                    offset += length
+            elif kind == _STRING_LIST:
+                for text in value:
+                    offset = _add_string(text, codes, values, offset)
+            else:
+                element_plan = _plan(extra)
+                for element in value:
+                    offset = _walk(element, element_plan, codes, values, offset)
+    return offset
+
+
+def _add_string(text: str, codes: list[str], values: list[Any], offset: int) -> int:
+    encoded = text.encode("utf-8")
+    padding = -offset % 4
+    length = len(encoded) + 1  # with the terminating NUL, which struct adds
+    codes.append(f"{_PADDING[padding]}I{length}s")
+    values += (length, encoded)
+    return offset + padding + 4 + length
+
+
+def encode_cdr(message: Any) -> bytes:
+    """``message`` (an rclpy message) as little-endian XCDR1 with its encapsulation header."""
+    codes: list[str] = ["<"]
+    values: list[Any] = []
+    _walk(message, _plan(type(message)), codes, values, 0)
+    return ENCAPSULATION_HEADER + struct.pack("".join(codes), *values)
 
 
 def _duration(nanoseconds: int) -> dict[str, int]:
@@ -218,7 +272,6 @@ class Recorder:
                 raise RecordingError(f"cannot log into folder {folder}: {error}") from None
         self.bag_path: Path = self._writer.bag_path
         self._channels: dict[str, int] = {}
-        self._last_lengths: dict[str, tuple[type, list[Any], int]] = {}
 
     @property
     def size_bytes(self) -> int:
@@ -233,18 +286,13 @@ class Recorder:
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
 
-    def serialize(self, topic: str, message: Any) -> bytes:
-        """``serialize_exact(message)``, with the length walk skipped while ``topic``'s messages
-        keep their shape; the bytes to publish and to ``record``."""
-        data = serialize_message(message)
-        shape = message_shape(message)
-        last = self._last_lengths.get(topic)
-        if last is None or last[0] is not type(message) or last[1] != shape:
-            last = self._last_lengths[topic] = (type(message), shape, cdr_length(message))
-        return data[: last[2]]
+    @staticmethod
+    def serialize(message: Any) -> bytes:
+        """The bytes to publish and to ``record``: ``encode_cdr(message)``."""
+        return encode_cdr(message)
 
     def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Logs ``data``, a message of ``topic`` serialized by ``serialize``."""
+        """Logs ``data``, a message of ``topic`` encoded by ``serialize``."""
         try:
             self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
         except BagWriteError as error:

@@ -24,23 +24,26 @@ import pytest
 import rclpy
 import yaml
 from ament_index_python.packages import get_package_share_directory
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
 from rclpy.qos import QoSProfile
+from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import JointState, Range
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
-from visualization_msgs.msg import MarkerArray
+from visualization_msgs.msg import Marker, MarkerArray
 
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import (
     DEFINITION_SEPARATOR,
     BagExistsError,
+    WRITE_BATCH,
     BagWriter,
     message_definition,
     package_version,
@@ -50,10 +53,9 @@ from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.recording import (
     Recorder,
-    cdr_length,
+    encode_cdr,
     offered_qos_profiles_yaml,
     ros_type_name,
-    serialize_exact,
 )
 from linkage_kinematics.replay import main as replay_main
 from node_process import (
@@ -152,23 +154,38 @@ def sample_messages() -> list[Any]:
     ]
 
 
+def encoded_by_rosbags(data: bytes, type_name: str) -> bytes:
+    """``data`` decoded and encoded again by rosbags: exact length, alignment padding zeroed."""
+    return bytes(TYPESTORE.serialize_cdr(TYPESTORE.deserialize_cdr(data, type_name), type_name))
+
+
+def assert_exact_encoding(data: bytes, message: Any) -> None:
+    """``data`` is ``message``: rclpy (Fast CDR) decodes it as it decodes its own serialization
+    of ``message`` (float32 fields rounded alike), and rosbags encodes what it decodes to the
+    very same bytes (exact length, zero padding)."""
+    msg_type = type(message)
+    assert deserialize_message(data, msg_type) == deserialize_message(
+        serialize_message(message), msg_type)
+    assert data == encoded_by_rosbags(data, ros_type_name(type(message)))
+
+
 @pytest.mark.parametrize("message", sample_messages(), ids=lambda m: type(m).__name__)
-def test_logged_cdr_has_exactly_the_length_independent_serializers_produce(message: Any) -> None:
-    type_name = ros_type_name(type(message))
-    logged = serialize_exact(message)
-    decoded = TYPESTORE.deserialize_cdr(logged, type_name)
-    assert len(logged) == cdr_length(message) == len(TYPESTORE.serialize_cdr(decoded, type_name))
-    if type_name == "std_msgs/msg/String":
+def test_encode_cdr_writes_every_logged_type_as_the_independent_serializers(message: Any) -> None:
+    logged = encode_cdr(message)
+    assert_exact_encoding(logged, message)
+    decoded = TYPESTORE.deserialize_cdr(logged, ros_type_name(type(message)))
+    if isinstance(message, String):
         assert decoded.data == message.data
-    elif type_name == "visualization_msgs/msg/MarkerArray":
-        assert len(decoded.markers) == len(message.markers)
+    elif isinstance(message, MarkerArray):
+        assert [(p.x, p.y) for m in decoded.markers for p in m.points] == [
+            (p.x, p.y) for m in message.markers for p in m.points]
     else:
         assert message_stamp_ns(decoded) == 1_234_567_890_123
 
 
-def test_joint_state_values_survive_exact_serialization() -> None:
+def test_joint_state_values_survive_encoding() -> None:
     message = sample_messages()[0]
-    decoded = TYPESTORE.deserialize_cdr(serialize_exact(message), "sensor_msgs/msg/JointState")
+    decoded = TYPESTORE.deserialize_cdr(encode_cdr(message), "sensor_msgs/msg/JointState")
     assert list(decoded.name) == list(message.name)
     assert list(decoded.position) == list(message.position)
     assert list(decoded.velocity) == list(message.velocity)
@@ -187,33 +204,44 @@ ros_text = st.text(st.characters(codec="utf-8", exclude_characters="\x00"), max_
     effort=st.lists(finite, max_size=4),
     frame_id=ros_text,
 )
-def test_exact_length_holds_for_any_sequence_and_string_lengths(
+def test_encoding_holds_for_any_sequence_and_string_lengths(
     names: list[str], position: list[float], velocity: list[float], effort: list[float],
     frame_id: str,
 ) -> None:
     message = JointState(name=names, position=position, velocity=velocity, effort=effort)
     message.header.frame_id = frame_id
-    logged = serialize_exact(message)
-    decoded = TYPESTORE.deserialize_cdr(logged, "sensor_msgs/msg/JointState")
-    assert len(logged) == len(TYPESTORE.serialize_cdr(decoded, "sensor_msgs/msg/JointState"))
-    assert (list(decoded.name), decoded.header.frame_id) == (names, frame_id)
-    assert list(decoded.effort) == effort
+    assert_exact_encoding(encode_cdr(message), message)
 
 
-def encoded_by_rosbags(data: bytes, type_name: str) -> bytes:
-    """``data`` decoded and encoded again by rosbags: exact length, alignment padding zeroed
-    (rclpy leaves padding bytes as it finds them, so two encodings of one message may differ
-    there)."""
-    return bytes(TYPESTORE.serialize_cdr(TYPESTORE.deserialize_cdr(data, type_name), type_name))
-
-
-def assert_exact_encoding(data: bytes, message: Any) -> None:
-    type_name = ros_type_name(type(message))
-    assert len(data) == len(serialize_exact(message))
-    assert encoded_by_rosbags(data, type_name) == encoded_by_rosbags(
-        serialize_exact(message), type_name
-    )
-    assert len(data) == len(encoded_by_rosbags(data, type_name))
+@settings(max_examples=40, deadline=None)
+@given(
+    level=st.integers(0, 3),
+    texts=st.lists(ros_text, min_size=4, max_size=4),
+    values=st.dictionaries(ros_text, ros_text, max_size=3),
+    points=st.lists(st.tuples(finite, finite, finite), max_size=3),
+    flags=st.lists(st.booleans(), min_size=1, max_size=3),
+)
+def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
+    level: int, texts: list[str], values: dict[str, str], points: list[tuple[float, float, float]],
+    flags: list[bool],
+) -> None:
+    """The other field kinds the node logs: a byte (the diagnostic level), a bool between wider
+    fields, sequences of messages inside sequences of messages, an empty uint8 sequence; and
+    a run of fixed-size fields (a uint8, then float32s) starting at every offset a string of
+    any length leaves."""
+    status = DiagnosticStatus(level=bytes([level]), name=texts[0], message=texts[1],
+                              hardware_id=texts[2],
+                              values=[KeyValue(key=k, value=v) for k, v in values.items()])
+    diagnostics = DiagnosticArray(status=[status, status])
+    assert_exact_encoding(encode_cdr(diagnostics), diagnostics)
+    markers = MarkerArray(markers=[
+        Marker(ns=texts[3], id=index, frame_locked=flag, points=[
+            Point(x=x, y=y, z=z) for x, y, z in points]) for index, flag in enumerate(flags)])
+    assert_exact_encoding(encode_cdr(markers), markers)
+    ranged = Range(radiation_type=Range.INFRARED, field_of_view=0.5, min_range=0.25,
+                   max_range=2.0, range=1.5)
+    ranged.header.frame_id = texts[0]
+    assert_exact_encoding(encode_cdr(ranged), ranged)
 
 
 def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: Path) -> None:
@@ -222,8 +250,7 @@ def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: P
     message = JointState(name=["abc", "c"], position=[1.0], velocity=[2.0])
     message.header.frame_id = "aaa"
     # Each step changes one field of the reused message, as a node would, and with it the exact
-    # length, so a length kept from the step before would be wrong. Two steps keep every Python
-    # length and change only the UTF-8 bytes.
+    # length. Two steps keep every Python length and change only the UTF-8 bytes.
     steps: list[Callable[[JointState], None]] = [
         lambda m: None,
         lambda m: setattr(m, "name", ["übc", "c"]),
@@ -231,14 +258,14 @@ def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: P
         lambda m: setattr(m.header, "frame_id", "üaa"),
         lambda m: setattr(m, "name", ["ab", "c"]),
         lambda m: setattr(m, "effort", [3.0]),
-        lambda m: setattr(m, "effort", []),  # the case rclpy pads
+        lambda m: setattr(m, "effort", []),  # where rclpy's serialize_message returned 4 too many
         lambda m: setattr(m, "position", [1.0, 4.0]),
         lambda m: setattr(m.header, "frame_id", "the_base_link"),
     ]
     lengths = []
     for step in steps:
         step(message)
-        data = recorder.serialize("/joint_states", message)
+        data = recorder.serialize(message)
         assert_exact_encoding(data, message)
         lengths.append(len(data))
     assert all(before != after for before, after in zip(lengths, lengths[1:])), lengths
@@ -258,7 +285,7 @@ few_texts = st.sampled_from(["", "base", "bäse", "the_base_link"])
     )
 )
 @example(shapes=[("base", ["a"], [(1, 0, 0, 0)]), ("base", ["a"], [(2, 0, 0, 0)])])
-def test_recorder_serialize_never_returns_a_stale_length(
+def test_recorder_serialize_follows_every_reshaping_of_a_trajectory(
     shapes: list[tuple[str, list[str], list[tuple[int, int, int, int]]]],
 ) -> None:
     """One JointTrajectory, reused and reshaped between calls, through one recorder topic."""
@@ -276,7 +303,7 @@ def test_recorder_serialize_never_returns_a_stale_length(
                 )
                 for sizes in points
             ]
-            assert_exact_encoding(recorder.serialize("/linkage/state", message), message)
+            assert_exact_encoding(recorder.serialize(message), message)
         recorder.close()
 
 
@@ -309,7 +336,7 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
         message_definition("std_msgs/msg/String"),
         offered_qos_profiles_yaml(QoSProfile(depth=7)),
     )
-    payload = serialize_exact(String(data="hello"))
+    payload = encode_cdr(String(data="hello"))
     writer.write(channel, payload, 1_000, 1_000)
     time.sleep(0.06)
     writer.write(channel, payload, 2_000, 2_000)  # the interval has passed: the chunk is flushed
@@ -342,6 +369,33 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
     information = bag_information(bag)
     assert information["message_count"] == 1_999
     assert information["custom_data"]["rate_hz"] == "200"
+
+
+@pytest.mark.parametrize("count", [1, WRITE_BATCH - 1, WRITE_BATCH, 3 * WRITE_BATCH + 1])
+def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: int) -> None:
+    """Messages wait in a queue before they enter the chunk; flush and close take them all, in
+    the order written, on their channels."""
+    writer = BagWriter(tmp_path / "queued", metadata={}, flush_interval=3600.0)
+    channels = [
+        writer.add_topic(topic, "std_msgs/msg/String", message_definition("std_msgs/msg/String"),
+                         offered_qos_profiles_yaml(QoSProfile(depth=10)))
+        for topic in ("/a", "/b")
+    ]
+    written = [(("/a", "/b")[index % 2], encode_cdr(String(data=f"m{index}")), 1_000 + index)
+               for index in range(count)]
+    for index, (_, data, log_time) in enumerate(written):
+        writer.write(channels[index % 2], data, log_time, log_time)
+    writer.flush()
+    flushed = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
+    assert flushed == written
+    writer.write(channels[0], encode_cdr(String(data="last")), 5_000, 5_000)
+    writer.close()
+    logged = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
+    assert logged == written + [("/a", encode_cdr(String(data="last")), 5_000)]
+    information = bag_information(writer.bag_path)
+    assert information["message_count"] == count + 1
+    assert information["starting_time"]["nanoseconds_since_epoch"] == 1_000
+    assert information["duration"]["nanoseconds"] == 4_000
 
 
 def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
@@ -411,7 +465,7 @@ def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any
         for message in received[topic]:
             logged_message = by_stamp[message_stamp_ns(message)]
             # every field equal, whatever the type
-            assert encoded_by_rosbags(serialize_exact(message), type_name) == bytes(
+            assert encode_cdr(message) == bytes(
                 TYPESTORE.serialize_cdr(logged_message, type_name)
             ), topic
             if topic == "/linkage/state":

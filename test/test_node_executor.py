@@ -1,9 +1,14 @@
-"""What the node's executor must deliver besides ticks: the list and describe parameter
-services, and a state timer re-created at run time (rate_hz changed) on simulated time, armed
-from /clock alone, with the old timer gone (removed with ``Node.destroy_timer``: a timer only
-``destroy()``ed stays in ``node.timers``, where an events executor keeps firing it). Other
-modules cover parameter changes (test_node_parameters.py, test_node_bad_input.py), signals
-(test_recording_faults.py) and long runs on simulated time (test_node_long_runs.py).
+"""linkage_node's executor: what it must deliver besides ticks.
+
+On wall time the node spins on rclpy.experimental.EventsExecutor, which dispatches timers from
+C++ and takes timers and services from the node when they change; on simulated time on rclpy's
+default executor (see node.main). Other modules cover parameter changes (test_node_parameters.py,
+test_node_bad_input.py), signals (test_recording_faults.py) and long runs on simulated time
+(test_node_long_runs.py). This one covers what they do not: the list/describe parameter
+services, and the state timer re-created at run time (rate_hz changed), on wall time and on
+simulated time: the old timer must stop (it keeps firing on the events executor if the node
+only calls ``Timer.destroy()``, which leaves it in ``node.timers``; ``Node.destroy_timer``
+removes it) and the new one run on its own period.
 """
 
 from __future__ import annotations
@@ -44,10 +49,46 @@ def _send_until_state(listener: Listener, clock, states: list, clock_ns: int) ->
         clock.publish(message)
         if listener.spin_until(ticked, timeout=0.5):
             return
-    raise AssertionError(f"no state stamped {clock_ns} ns; have {[(stamp_ns(m) - CLOCK_START) // 1_000_000 for m in states]}")
+    raise AssertionError(f"no state stamped {clock_ns} ns")
 
 
-def test_parameter_services_and_a_rate_change_on_sim_time(tmp_path):
+def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_path):
+    with ros_context(DOMAIN_ID) as context:
+        listener = Listener("executor_tester", context)
+        listener.subscribe("/linkage/state", JointTrajectory)
+        states = listener.received["/linkage/state"]
+        process = start_node({"end_behavior": "loop", "rate_hz": 100.0, "log.enabled": False},
+                             DOMAIN_ID, tmp_path / "node.log")
+        try:
+            client = AsyncParameterClient(listener.node, "linkage_node")
+            assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
+            listed = listener.result_of(client.list_parameters([], 0)).result.names
+            assert set(PARAMETER_NAMES) <= set(listed)
+            specs = {spec.name: spec for spec in parameter_specs("paper")}
+            (descriptor,) = listener.result_of(client.describe_parameters(["rate_hz"])).descriptors
+            assert descriptor.description == specs["rate_hz"].description
+            (interval,) = descriptor.floating_point_range
+            assert (interval.from_value, interval.to_value) == specs["rate_hz"].floating_range
+            assert listener.spin_until(lambda: len(states) > 5)
+
+            (result,) = listener.result_of(
+                client.set_parameters([Parameter("rate_hz", value=2.0)])).results
+            assert result.successful, result.reason
+            # One state of the old timer may still be on its way.
+            changed_at = len(states) + 1
+            assert listener.spin_until(lambda: len(states) >= changed_at + 3)
+            assert process.poll() is None
+        finally:
+            stop_process(process)
+            listener.destroy()
+
+    # Timers never fire early: only the new 0.5 s timer ticks (the old one ticked every 10 ms).
+    stamps = [stamp_ns(message) for message in states[changed_at:]]
+    assert all(later - earlier >= 250_000_000 for earlier, later in zip(stamps, stamps[1:])), [
+        (later - earlier) * 1e-6 for earlier, later in zip(stamps, stamps[1:])]
+
+
+def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
     bags = tmp_path / "bags"
     with ros_context(DOMAIN_ID) as context:
         listener = Listener("executor_tester", context)
@@ -61,14 +102,6 @@ def test_parameter_services_and_a_rate_change_on_sim_time(tmp_path):
         try:
             client = AsyncParameterClient(listener.node, "linkage_node")
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            listed = listener.result_of(client.list_parameters([], 0)).result.names
-            assert set(PARAMETER_NAMES) <= set(listed)
-            specs = {spec.name: spec for spec in parameter_specs("paper")}
-            (descriptor,) = listener.result_of(client.describe_parameters(["rate_hz"])).descriptors
-            assert descriptor.description == specs["rate_hz"].description
-            (interval,) = descriptor.floating_point_range
-            assert (interval.from_value, interval.to_value) == specs["rate_hz"].floating_range
-
             assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
             assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
             before = [CLOCK_START + n * STEP for n in range(6)]

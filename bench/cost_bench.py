@@ -1,0 +1,147 @@
+"""Section "cost": linkage_node against the rclpy node a lab would write by hand, side by side.
+
+Both run as processes at the same time, at the same timer rate, nothing subscribed:
+linkage_node at ``rate_hz`` with logging on (``end_behavior:=bounce``) and
+``minimal_publisher.py`` (one JointState per tick on rclpy's default executor). CPU is
+utime + stime from /proc/PID/stat over the same seconds. Then the highest timer rate at which
+the node, logging, misses under 1 % of its ticks (from its own /diagnostics), and timer jitter
+and latency to another process at 100 Hz, 1 kHz and that rate.
+"""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+import node_bench
+from timing import format_seconds, markdown_table
+
+MINIMAL_PUBLISHER = pathlib.Path(__file__).resolve().parent / "minimal_publisher.py"
+CPU_SECONDS = 5.0  # the window CPU time is measured over, after STARTUP_S
+RATES = (1000.0, 2000.0, 3000.0, 4000.0, 5000.0, 7500.0, 10000.0)
+MISSED_LIMIT = 0.01
+CLOCK_TICKS = os.sysconf("SC_CLK_TCK")
+
+
+def cpu_seconds(pid: int) -> float:
+    """utime + stime of a process so far (s)."""
+    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+        fields = stat.read().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / CLOCK_TICKS
+
+
+def start_minimal_publisher(rate: float, executor: str, domain: int) -> subprocess.Popen:
+    return subprocess.Popen([sys.executable, str(MINIMAL_PUBLISHER), f"{rate:g}", executor],
+                            cwd=node_bench.ROOT, env=node_bench.ros_environment(domain),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def side_by_side(rate: float, executor: str, domain_base: int) -> tuple[float, float]:
+    """CPU share of one core of (linkage_node logging, minimal publisher on ``executor``),
+    running at the same time at ``rate``, each alone on its ROS domain."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_cost_") as folder:
+        node = node_bench.start_node(
+            {"rate_hz": f"{rate:.1f}", "end_behavior": "bounce", "log.folder": folder},
+            domain_base + node_bench.DOMAIN_RATE)
+        minimal = start_minimal_publisher(rate, executor, domain_base + node_bench.DOMAIN_SPLIT)
+        try:
+            time.sleep(node_bench.STARTUP_S)
+            for process in (node, minimal):
+                if process.poll() is not None:
+                    raise RuntimeError(f"{process.args} exited early")
+            started = time.monotonic()
+            before = [cpu_seconds(process.pid) for process in (node, minimal)]
+            time.sleep(CPU_SECONDS)
+            after = [cpu_seconds(process.pid) for process in (node, minimal)]
+            elapsed = time.monotonic() - started
+        finally:
+            node_bench.stop(minimal)
+            node_bench.stop(node)
+    node_share, minimal_share = ((end - start) / elapsed for start, end in zip(before, after))
+    return node_share, minimal_share
+
+
+def missed_share(rate: float, seconds: float, domain_base: int) -> float:
+    """Share of ticks the node (logging on, nothing but /diagnostics subscribed) missed: 1 −
+    its achieved rate over its /diagnostics windows after the first ÷ ``rate``."""
+    with tempfile.TemporaryDirectory(prefix="linkage_bench_cost_rate_") as folder:
+        data = node_bench.observe(
+            {"rate_hz": f"{rate:.1f}", "end_behavior": "bounce", "log.folder": folder},
+            seconds, domain_base + node_bench.DOMAIN_RATE, topics=[])
+    windows = [float(d["achieved rate (Hz)"]) for d in data["diagnostics"]
+               if "achieved rate (Hz)" in d][1:]
+    if not windows:
+        raise RuntimeError(f"no /diagnostics windows from the node at {rate:g} Hz")
+    return max(0.0, 1.0 - statistics.mean(windows) / rate)
+
+
+def run(quick: bool, ros_domain: int) -> str:
+    """The section as markdown; ``ros_domain`` is the first of the node sections' domains."""
+    repetitions = 2 if quick else 3
+    rows = []
+    ratios = []
+    for executor in ("single",) * repetitions + ("events",):
+        node_share, minimal_share = side_by_side(1000.0, executor, ros_domain)
+        ratio = node_share / minimal_share
+        if executor == "single":
+            ratios.append(ratio)
+        rows.append([f"{100.0 * node_share:.1f} %",
+                     f"{100.0 * minimal_share:.1f} %",
+                     "SingleThreadedExecutor (rclpy's default)" if executor == "single"
+                     else "rclpy.experimental.EventsExecutor",
+                     f"{ratio:.2f}×"])
+    ratio = statistics.median(ratios)
+    lines = [
+        f"CPU at 1 kHz, one core = 100 %, utime + stime over {CPU_SECONDS:g} s, both processes "
+        "running at once, nothing subscribed (linkage_node: end_behavior:=bounce, logging on):",
+        "",
+        markdown_table(["linkage_node", "minimal publisher", "its executor",
+                        "linkage_node ÷ minimal"], rows),
+        "",
+        f"- linkage_node ÷ minimal publisher on the default executor: {ratio:.2f}× "
+        f"(median of {len(ratios)}; goal ≤ 1: {'met' if ratio <= 1.0 else 'missed'})",
+        "",
+    ]
+
+    seconds = 4.0 if quick else 8.0
+    rows = []
+    highest = None
+    below_limit = True
+    for rate in RATES:
+        fraction = missed_share(rate, seconds, ros_domain)
+        rows.append([f"{rate:g} Hz", f"{100.0 * fraction:.2f} %"])
+        below_limit = below_limit and fraction < MISSED_LIMIT
+        if below_limit:
+            highest = rate
+    lines += [
+        f"Sustained rate, logging on, {seconds:g} s per rate, missed share from the node's "
+        "/diagnostics (only /diagnostics subscribed); the highest rate counts if it and every "
+        "lower rate missed under the limit:",
+        "",
+        markdown_table(["timer rate", "ticks missed"], rows),
+        "",
+        f"- highest rate with < {100 * MISSED_LIMIT:g} % missed: "
+        f"{'none of the rates tried' if highest is None else f'{highest:g} Hz'} (goal 5 kHz)",
+        "",
+    ]
+
+    rows = []
+    for rate in sorted({100.0, 1000.0, highest or 1000.0}):
+        figures = node_bench.timing_figures(rate, seconds, ros_domain)
+        rows.append([f"{rate:g} Hz", format_seconds(figures["jitter_p50"]),
+                     format_seconds(figures["jitter_p99"]), format_seconds(figures["latency_p50"]),
+                     format_seconds(figures["latency_p99"]),
+                     f"{figures['received']} of {figures['expected']:.0f}"])
+    lines += [
+        "Timer jitter (|interval between header stamps − period|) and latency (receive time in "
+        "a listener process − header stamp), logging on, /joint_states subscribed:",
+        "",
+        markdown_table(["rate", "jitter p50", "jitter p99", "latency p50", "latency p99",
+                        "messages received"], rows),
+    ]
+    return "\n".join(lines)
