@@ -8,8 +8,8 @@ and rosbag2 stores) from the message's field types alone: one walk over the fiel
 ``struct`` format and its values, and one ``struct.pack`` writes them. Each run of consecutive
 fixed-size fields (primitives, and messages made only of them such as a Time or a Pose) is one
 step of the walk: one ``attrgetter`` reads all its values and its struct codes are prepared
-for each alignment it can start at. It is the encoding
-rosbags' serializer produces, byte for byte: alignment padding is zero and the length exact.
+for each alignment it can start at. It is the encoding rosbags' serializer produces, byte for
+byte: alignment padding is zero and the length exact.
 rclpy's ``serialize_message`` is not used because it builds a type support object per call (at
 a 1 kHz tick it cost more than the rest of the node's Python), can return a few bytes more
 than the message's encoding (after an empty ``effort`` in a JointState; rosbags rejects such
@@ -176,7 +176,7 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
         if kind == _FIXED:
             layout, length = detail[offset & 7]
             codes.append(layout)
-            values += value
+            values.extend(value)
             offset += length
         elif kind == _STRING:
             offset = _add_string(value, codes, values, offset)
@@ -189,17 +189,17 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
                 values.append(len(value))
                 offset += padding + 4
             if kind == _PRIMITIVE_LIST:
-                if value:
+                if len(value):  # a fixed-size array is a numpy array
                     code, size = detail
                     padding = -offset % size
                     codes.append(f"{_PADDING[padding]}{len(value)}{code}")
-                    values += value
+                    values.extend(value)
                     offset += padding + len(value) * size
             elif kind == _FIXED_LIST:
                 for element in value:
                     layout, length = detail[offset & 7]
                     codes.append(layout)
-                    values += extra(element)
+                    values.extend(extra(element))
                     offset += length
             elif kind == _STRING_LIST:
                 for text in value:
@@ -216,7 +216,7 @@ def _add_string(text: str, codes: list[str], values: list[Any], offset: int) -> 
     padding = -offset % 4
     length = len(encoded) + 1  # with the terminating NUL, which struct adds
     codes.append(f"{_PADDING[padding]}I{length}s")
-    values += (length, encoded)
+    values.extend((length, encoded))
     return offset + padding + 4 + length
 
 

@@ -34,7 +34,7 @@ from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import JointState, Range
+from sensor_msgs.msg import CameraInfo, JointState, Range
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
@@ -228,7 +228,7 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
     """The other field kinds the node logs: a byte (the diagnostic level), a bool between wider
     fields, sequences of messages inside sequences of messages, an empty uint8 sequence; and
     a run of fixed-size fields (a uint8, then float32s) starting at every offset a string of
-    any length leaves."""
+    any length leaves; fixed-size arrays (numpy arrays in rclpy)."""
     status = DiagnosticStatus(level=bytes([level]), name=texts[0], message=texts[1],
                               hardware_id=texts[2],
                               values=[KeyValue(key=k, value=v) for k, v in values.items()])
@@ -242,6 +242,11 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
                    max_range=2.0, range=1.5)
     ranged.header.frame_id = texts[0]
     assert_exact_encoding(encode_cdr(ranged), ranged)
+    camera = CameraInfo(distortion_model=texts[1], d=[x for point in points for x in point],
+                        k=[float(index) for index in range(9)], binning_x=level)
+    camera.header.frame_id = texts[0]
+    camera.roi.do_rectify = flags[0]
+    assert_exact_encoding(encode_cdr(camera), camera)
 
 
 def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: Path) -> None:
