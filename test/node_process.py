@@ -17,11 +17,13 @@ from pathlib import Path
 from typing import Any
 
 import rclpy
+from rosgraph_msgs.msg import Clock
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
+from linkage_kinematics import messages
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.parameters import parameter_specs
@@ -187,6 +189,21 @@ def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
             os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
         else:
             os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = previous
+
+
+def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int) -> None:
+    """Set simulated time to ``clock_ns`` and wait for the node's state of that instant (a lost
+    /clock message is sent again; the same time again makes no tick)."""
+    message = Clock(clock=messages.time_msg(clock_ns))
+
+    def ticked() -> bool:
+        return bool(states) and stamp_ns(states[-1]) == clock_ns
+
+    for _ in range(round(PROCESS_TIMEOUT / 0.5)):
+        clock.publish(message)
+        if listener.spin_until(ticked, timeout=0.5):
+            return
+    raise AssertionError(f"no state stamped {clock_ns} ns")
 
 
 def stamp_ns(message: Any) -> int:

@@ -24,6 +24,7 @@ from trajectory_msgs.msg import JointTrajectory
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.parameters import PARAMETER_NAMES, parameter_specs
 from node_process import (
+    drive_sim_clock,
     PROCESS_TIMEOUT,
     Listener,
     ros_context,
@@ -35,21 +36,6 @@ from node_process import (
 DOMAIN_ID = 77
 CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick
 STEP = 10_000_000  # ns of simulated time per /clock step: one period at 100 Hz, half at 50 Hz
-
-
-def _send_until_state(listener: Listener, clock, states: list, clock_ns: int) -> None:
-    """Set simulated time to ``clock_ns`` and wait for the node's state of that instant (a lost
-    /clock message is sent again; the same time again makes no tick)."""
-    message = Clock(clock=messages.time_msg(clock_ns))
-
-    def ticked() -> bool:
-        return bool(states) and stamp_ns(states[-1]) == clock_ns
-
-    for _ in range(round(PROCESS_TIMEOUT / 0.5)):
-        clock.publish(message)
-        if listener.spin_until(ticked, timeout=0.5):
-            return
-    raise AssertionError(f"no state stamped {clock_ns} ns")
 
 
 def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_path):
@@ -106,7 +92,7 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
             assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
             before = [CLOCK_START + n * STEP for n in range(6)]
             for clock_ns in before:
-                _send_until_state(listener, clock, states, clock_ns)
+                drive_sim_clock(listener, clock, states, clock_ns)
 
             (result,) = listener.result_of(
                 client.set_parameters([Parameter("rate_hz", value=50.0)])).results
@@ -122,7 +108,7 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
                 if n % 2:
                     clock.publish(Clock(clock=messages.time_msg(clock_ns)))
                 else:
-                    _send_until_state(listener, clock, states, clock_ns)
+                    drive_sim_clock(listener, clock, states, clock_ns)
                     after.append(clock_ns)
             assert process.poll() is None
             process.send_signal(signal.SIGINT)

@@ -15,12 +15,11 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
-from linkage_kinematics import messages
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import TWO_PI, preset
 from linkage_kinematics.kinematics import solve
 from node_process import (
-    PROCESS_TIMEOUT,
+    drive_sim_clock,
     Listener,
     ros_context,
     stamp_ns,
@@ -42,21 +41,6 @@ def _seconds(nanoseconds: int) -> float:
     return nanoseconds * 1e-9
 
 
-def _drive_clock(listener: Listener, clock, states: list, clock_ns: int) -> None:
-    """Set simulated time to ``clock_ns`` and wait for the node's state of that instant (a lost
-    /clock message is sent again; the same time again makes no tick)."""
-    message = Clock(clock=messages.time_msg(clock_ns))
-
-    def ticked() -> bool:
-        return bool(states) and stamp_ns(states[-1]) == clock_ns
-
-    for _ in range(round(PROCESS_TIMEOUT / 0.5)):
-        clock.publish(message)
-        if listener.spin_until(ticked, timeout=0.5):
-            return
-    raise AssertionError(f"no state stamped {clock_ns} ns")
-
-
 def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path):
     with ros_context(DOMAIN_ID) as context:
         listener = Listener("long_run_tester", context)
@@ -76,7 +60,7 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
                       [CLOCK_START + JUMP + n * STEP for n in range(STEPS + 1)]]
             for phase in phases:
                 for clock_ns in phase:
-                    _drive_clock(listener, clock, states, clock_ns)
+                    drive_sim_clock(listener, clock, states, clock_ns)
             assert listener.spin_until(
                 lambda: len(listener.received["/joint_states"]) >= len(states))
             assert process.poll() is None, (tmp_path / "node.log").read_text()
@@ -167,7 +151,7 @@ def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_pa
                        for n in range(9)]]
             for phase in phases:
                 for clock_ns in phase:
-                    _drive_clock(listener, clock, states, clock_ns)
+                    drive_sim_clock(listener, clock, states, clock_ns)
             assert listener.spin_until(
                 lambda: len(listener.received["/joint_states"]) >= len(states))
             assert process.poll() is None, (tmp_path / "node.log").read_text()
