@@ -41,23 +41,22 @@ def _seconds(nanoseconds: int) -> float:
     return nanoseconds * 1e-9
 
 
-def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path):
+def _run_on_sim_time(
+    tmp_path, parameters: dict, phases: list[list[int]]
+) -> tuple[list, list]:
+    """Run a node with ``parameters`` on simulated time, stepping the clock through ``phases``
+    (a state for each step); return the /linkage/state and /joint_states messages received."""
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("long_run_tester", context)
+        listener = Listener("sim_time_tester", context)
         listener.subscribe("/linkage/state", JointTrajectory)
         listener.subscribe("/joint_states", JointState)
         clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
         states = listener.received["/linkage/state"]
-        process = start_node(
-            {"preset": "grashof_crank_rocker", "end_behavior": "loop", "alpha_start": 0.0,
-             "alpha_end": TWO_PI, "omega0": DRIVE.omega0, "rate_hz": 100.0,
-             "use_sim_time": True, "log.enabled": False},
-            DOMAIN_ID, tmp_path / "node.log")
+        process = start_node({**parameters, "use_sim_time": True, "log.enabled": False},
+                             DOMAIN_ID, tmp_path / "node.log")
         try:
             assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
             assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
-            phases = [[CLOCK_START + n * STEP for n in range(STEPS + 1)],
-                      [CLOCK_START + JUMP + n * STEP for n in range(STEPS + 1)]]
             for phase in phases:
                 for clock_ns in phase:
                     drive_sim_clock(listener, clock, states, clock_ns)
@@ -67,6 +66,17 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
         finally:
             stop_process(process)
             listener.destroy()
+    return states, listener.received["/joint_states"]
+
+
+def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path):
+    phases = [[CLOCK_START + n * STEP for n in range(STEPS + 1)],
+              [CLOCK_START + JUMP + n * STEP for n in range(STEPS + 1)]]
+    states, joint_states = _run_on_sim_time(
+        tmp_path,
+        {"preset": "grashof_crank_rocker", "end_behavior": "loop", "alpha_start": 0.0,
+         "alpha_end": TWO_PI, "omega0": DRIVE.omega0, "rate_hz": 100.0},
+        phases)
 
     by_stamp = {stamp_ns(message): message.points[0] for message in states}
     # Simulated time drives the node: a state for every clock step and for nothing else.
@@ -101,7 +111,7 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
 
     # /joint_states: the crank joint is α itself (it keeps counting), the coupler and rocker
     # joints move by what the library's angles move, never by a whole turn.
-    joints = {stamp_ns(message): message.position for message in listener.received["/joint_states"]}
+    joints = {stamp_ns(message): message.position for message in joint_states}
     assert sorted(joints) == sorted(by_stamp)
     for phase in phases:
         for before, after in zip(phase, phase[1:]):
@@ -132,32 +142,13 @@ def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_pa
     """OA = BC, AB = OC: both cranks turn fully, and at α = 90° and 270° (where every tick of
     this run lands) the two assemblies meet. The node never ends a pass there: the parallelogram
     stays a parallelogram (γ = 0, ω_AB = 0, ω_BC = ω), α keeps counting, joints stay continuous."""
-    with ros_context(DOMAIN_ID) as context:
-        listener = Listener("parallelogram_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        listener.subscribe("/joint_states", JointState)
-        clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
-        states = listener.received["/linkage/state"]
-        process = start_node(
-            {"preset": "", **PARALLELOGRAM, "branch": -1, "end_behavior": "loop",
-             "alpha_start": 0.0, "alpha_end": TWO_PI, "omega0": DRIVE.omega0,
-             "use_sim_time": True, "log.enabled": False},
-            DOMAIN_ID, tmp_path / "node.log")
-        try:
-            assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
-            assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
-            phases = [[CLOCK_START + n * QUARTER for n in range(9)],
-                      [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER
-                       for n in range(9)]]
-            for phase in phases:
-                for clock_ns in phase:
-                    drive_sim_clock(listener, clock, states, clock_ns)
-            assert listener.spin_until(
-                lambda: len(listener.received["/joint_states"]) >= len(states))
-            assert process.poll() is None, (tmp_path / "node.log").read_text()
-        finally:
-            stop_process(process)
-            listener.destroy()
+    phases = [[CLOCK_START + n * QUARTER for n in range(9)],
+              [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER for n in range(9)]]
+    states, joint_states = _run_on_sim_time(
+        tmp_path,
+        {"preset": "", **PARALLELOGRAM, "branch": -1, "end_behavior": "loop",
+         "alpha_start": 0.0, "alpha_end": TWO_PI, "omega0": DRIVE.omega0},
+        phases)
 
     by_stamp = {stamp_ns(message): message.points[0] for message in states}
     assert sorted(by_stamp) == [clock_ns for phase in phases for clock_ns in phase]
@@ -168,7 +159,7 @@ def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_pa
             point.positions[2], point.velocities[0], point.velocities[2], point.velocities[7])
         assert abs(gamma) <= 1e-12 and abs(omega_ab) <= 1e-12 * omega
         assert omega_bc == pytest.approx(omega, rel=1e-12)
-    joints = {stamp_ns(message): message.position for message in listener.received["/joint_states"]}
+    joints = {stamp_ns(message): message.position for message in joint_states}
     for phase in phases:
         for before, after in zip(phase, phase[1:]):
             step = [now - then for now, then in zip(joints[after], joints[before])]
