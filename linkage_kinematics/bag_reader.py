@@ -170,10 +170,14 @@ def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
             "rosbag2_bagfile_information"
         ]
     except (OSError, ValueError, yaml.YAMLError, KeyError, TypeError) as error:
-        raise BagError(
-            f"{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: "
-            f"{_one_line(error)})"
-        ) from None
+        raise _not_metadata(metadata_path, error) from None
+
+
+def _not_metadata(metadata_path: Path, error: BaseException) -> BagError:
+    return BagError(
+        f"{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: "
+        f"{_one_line(error)})"
+    )
 
 
 def _folder_files(folder: Path) -> list[Path]:
@@ -183,16 +187,12 @@ def _folder_files(folder: Path) -> list[Path]:
         if not paths:
             raise BagError(f"{folder} is not a bag: no metadata.yaml and no .mcap file")
         return paths
+    information = bag_information(folder)
     try:
-        metadata = yaml.safe_load(metadata_path.read_text(encoding="utf-8"))
-        information = metadata["rosbag2_bagfile_information"]
         storage = information.get("storage_identifier", "mcap")
         relative_paths = information["relative_file_paths"]
-    except (OSError, ValueError, yaml.YAMLError, KeyError, TypeError, AttributeError) as error:
-        raise BagError(
-            f"{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: "
-            f"{_one_line(error)})"
-        ) from None
+    except (KeyError, TypeError, AttributeError) as error:
+        raise _not_metadata(metadata_path, error) from None
     if storage != "mcap":
         raise BagError(f"{folder} stores its messages in {storage!r}; only MCAP bags can be read")
     if not isinstance(relative_paths, list) or not relative_paths:
