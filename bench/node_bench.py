@@ -175,13 +175,13 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             elapsed = [i * 1e-3 for i in range(count)]
             samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
             state = solve_sample(config, samples[0])
-            stamp = clock.now().to_msg()
-            joint_state = messages.joint_state(state, stamp)
-            trajectory = messages.linkage_state(config.linkage, state, stamp, 0.0,
-                                                config.frame_id)
-            bare_message = messages.joint_state(state, stamp)
-            joint_state_data = recorder.serialize(joint_state)
-            trajectory_data = recorder.serialize(trajectory)
+            stamp = clock.now()
+            bare_message = messages.joint_state(state, stamp.to_msg())
+            joint_state_encoder = messages.JointStateEncoder()
+            state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
+            positions = messages.joint_positions(state)
+            joint_state_data = joint_state_encoder.encode(state, stamp.nanoseconds, positions)
+            trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 
             def compute() -> int:
@@ -194,33 +194,17 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
                     solve(config.linkage, sample.alpha, config.drive, config.branch)
                 return count
 
-            def build() -> int:
-                nonlocal joint_state, trajectory
+            def encode() -> int:
                 for _ in range(count):
-                    now = clock.now()
-                    stamp = now.to_msg()
-                    joint_state = messages.joint_state(state, stamp, joint_state.position,
-                                                       out=joint_state)
-                    trajectory = messages.linkage_state(config.linkage, state, stamp, 0.0,
-                                                        config.frame_id, out=trajectory)
+                    nanoseconds = clock.now().nanoseconds
+                    joint_state_encoder.encode(state, nanoseconds, positions)
+                    state_encoder.encode(state, nanoseconds, 0.0)
                 return count
 
-            def serialize() -> int:
-                for _ in range(count):
-                    recorder.serialize(joint_state)
-                    recorder.serialize(trajectory)
-                return count
-
-            def publish_serialized() -> int:
+            def publish() -> int:
                 for _ in range(count):
                     publishers["/joint_states"].publish(joint_state_data)
                     publishers["/linkage/state"].publish(trajectory_data)
-                return count
-
-            def publish_messages() -> int:
-                for _ in range(count):
-                    publishers["/joint_states"].publish(joint_state)
-                    publishers["/linkage/state"].publish(trajectory)
                 return count
 
             def record() -> int:
@@ -242,11 +226,9 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             parts = {
                 "compute: sample_at_time + solve_sample (kinematics.solve)": compute,
                 "  of which kinematics.solve alone": solve_only,
-                "build: messages.joint_state + messages.linkage_state": build,
-                "serialize: Recorder.serialize (encode_cdr) of both messages": serialize,
-                "publish: both serialized messages (logging on)": publish_serialized,
-                "log: Recorder.record of both serialized messages": record,
-                "publish: both messages as objects (logging off)": publish_messages,
+                "encode: the node's encoders of both messages, with clock.now()": encode,
+                "publish: both encoded messages": publish,
+                "log: Recorder.record of both encoded messages": record,
                 "whole tick, logging on (LinkageNode._tick)": lambda: tick(logging_node),
                 "whole tick, logging off (LinkageNode._tick)": lambda: tick(quiet_node),
                 "bare rclpy publish of the same JointState": bare,

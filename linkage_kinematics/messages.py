@@ -1,9 +1,10 @@
 """ROS messages built from a LinkageState: the node's topics, reusable by benchmarks and tools.
 
 Each builder is a plain function of the library's state (plus a stamp); none computes any
-kinematics. The per-tick builders take an optional ``out`` message that they fill in place, so
-the node's hot path reuses one message per topic instead of constructing a new one every tick
-(publishing and recording serialise the message before the builder runs again).
+kinematics. The node does not build its per-tick messages and the scene: their encoders
+(``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write the same bytes
+as ``encode_cdr`` of the builders' messages straight from the state, from the same value
+functions, into a layout prepared once per geometry (``recording.FixedShapeEncoder``).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from visualization_msgs.msg import Marker, MarkerArray
 from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
+from linkage_kinematics.recording import FixedShapeEncoder
 
 JOINT_NAMES = ("crank_joint", "coupler_joint", "rocker_joint")
 MARKER_NAMESPACE = "linkage"
@@ -53,8 +55,17 @@ def time_msg(nanoseconds: int) -> Time:
 
 def duration_msg(seconds: float) -> Duration:
     """A builtin_interfaces/Duration from (non-negative) seconds."""
-    nanoseconds = round(seconds * 1e9)
-    return Duration(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+    sec, nanosec = duration_fields(seconds)
+    return Duration(sec=sec, nanosec=nanosec)
+
+
+def duration_fields(seconds: float) -> tuple[int, int]:
+    """(sec, nanosec) of a builtin_interfaces/Duration of (non-negative) ``seconds``."""
+    return divmod(round(seconds * 1e9), 1_000_000_000)
+
+
+def _stamp_paths(prefix: str) -> list[str]:
+    return [f"{prefix}header.stamp.sec", f"{prefix}header.stamp.nanosec"]
 
 
 def joint_positions(
@@ -81,14 +92,54 @@ def joint_state(
     state: LinkageState,
     stamp: Time,
     previous_positions: Sequence[float] = (0.0, 0.0, 0.0),
-    out: JointState | None = None,
 ) -> JointState:
     """/joint_states: the URDF's three joints; frame_id stays empty as joint_state_publisher's."""
-    message = out if out is not None else JointState(name=list(JOINT_NAMES))
+    message = JointState(name=list(JOINT_NAMES))
     message.header.stamp = stamp
     message.position = joint_positions(state, previous_positions)
     message.velocity = joint_velocities(state)
     return message
+
+
+class JointStateEncoder:
+    """The bytes of ``joint_state`` (encode_cdr), straight from a state."""
+
+    def __init__(self) -> None:
+        template = JointState(name=list(JOINT_NAMES), position=[0.0] * 3, velocity=[0.0] * 3)
+        self._encoder = FixedShapeEncoder(template, [*_stamp_paths(""), "position", "velocity"])
+
+    def encode(self, state: LinkageState, stamp_ns: int, positions: Sequence[float]) -> bytes:
+        """``positions`` are ``joint_positions`` of ``state``, unwrapped as the caller keeps them."""
+        return self._encoder.encode(
+            (*divmod(stamp_ns, 1_000_000_000), *positions, *joint_velocities(state))
+        )
+
+
+def state_coordinates(
+    linkage: FourBar, state: LinkageState
+) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """The positions, velocities and accelerations of ``STATE_JOINT_NAMES`` (see
+    ``linkage_state``)."""
+    crank = linkage.crank_length
+    rocker = linkage.rocker_length
+    return (
+        (
+            state.alpha, state.beta, state.gamma,
+            state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y,
+            math.pi - state.beta, crank * state.alpha, rocker * state.beta,
+        ),
+        (
+            state.omega, -state.omega_bc, state.omega_ab,
+            state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
+            state.omega_bc, crank * state.omega, -rocker * state.omega_bc,
+        ),
+        (
+            state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
+            state.acceleration_a_x, state.acceleration_a_y,
+            state.acceleration_b_x, state.acceleration_b_y,
+            state.omega_dot_bc, crank * state.omega_dot, -rocker * state.omega_dot_bc,
+        ),
+    )
 
 
 def linkage_state(
@@ -97,7 +148,6 @@ def linkage_state(
     stamp: Time,
     motion_time: float,
     frame_id: str,
-    out: JointTrajectory | None = None,
 ) -> JointTrajectory:
     """/linkage/state: the full state as one trajectory point (see README, "Topics").
 
@@ -108,31 +158,41 @@ def linkage_state(
     every quantity of the paper is one plain field. ``motion_time`` (s) is the drive-law time
     since the motion left alpha_start.
     """
-    if out is None:
-        out = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[JointTrajectoryPoint()])
-    out.header.stamp = stamp
-    out.header.frame_id = frame_id
-    crank = linkage.crank_length
-    rocker = linkage.rocker_length
-    point = out.points[0]
-    point.positions = (
-        state.alpha, state.beta, state.gamma,
-        state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y,
-        math.pi - state.beta, crank * state.alpha, rocker * state.beta,
+    positions, velocities, accelerations = state_coordinates(linkage, state)
+    point = JointTrajectoryPoint(
+        positions=positions,
+        velocities=velocities,
+        accelerations=accelerations,
+        time_from_start=duration_msg(motion_time),
     )
-    point.velocities = (
-        state.omega, -state.omega_bc, state.omega_ab,
-        state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
-        state.omega_bc, crank * state.omega, -rocker * state.omega_bc,
-    )
-    point.accelerations = (
-        state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
-        state.acceleration_a_x, state.acceleration_a_y,
-        state.acceleration_b_x, state.acceleration_b_y,
-        state.omega_dot_bc, crank * state.omega_dot, -rocker * state.omega_dot_bc,
-    )
-    point.time_from_start = duration_msg(motion_time)
-    return out
+    message = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[point])
+    message.header.stamp = stamp
+    message.header.frame_id = frame_id
+    return message
+
+
+class LinkageStateEncoder:
+    """The bytes of ``linkage_state`` (encode_cdr) of one linkage and frame, straight from a
+    state."""
+
+    def __init__(self, linkage: FourBar, frame_id: str) -> None:
+        self._linkage = linkage
+        zeros = [0.0] * len(STATE_JOINT_NAMES)
+        point = JointTrajectoryPoint(positions=zeros, velocities=zeros, accelerations=zeros)
+        template = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[point])
+        template.header.frame_id = frame_id
+        self._encoder = FixedShapeEncoder(template, [
+            *_stamp_paths(""), "points[0].positions", "points[0].velocities",
+            "points[0].accelerations", "points[0].time_from_start.sec",
+            "points[0].time_from_start.nanosec",
+        ])
+
+    def encode(self, state: LinkageState, stamp_ns: int, motion_time: float) -> bytes:
+        positions, velocities, accelerations = state_coordinates(self._linkage, state)
+        return self._encoder.encode((
+            *divmod(stamp_ns, 1_000_000_000), *positions, *velocities, *accelerations,
+            *duration_fields(motion_time),
+        ))
 
 
 def _marker(marker_id: int, marker_type: int, frame_id: str, color: ColorRGBA) -> Marker:
@@ -143,18 +203,22 @@ def _marker(marker_id: int, marker_type: int, frame_id: str, color: ColorRGBA) -
     return marker
 
 
+def disk_orientation(state: LinkageState) -> tuple[float, float]:
+    """(z, w) of the disk's quaternion: the disk is symmetric about O, and turning it shows the
+    crank angle on the disk itself."""
+    return math.sin(0.5 * state.alpha), math.cos(0.5 * state.alpha)
+
+
 def marker_array(
     linkage: FourBar,
     state: LinkageState,
     stamp: Time,
     frame_id: str,
-    out: MarkerArray | None = None,
 ) -> MarkerArray:
     """/linkage/markers: disk (CYLINDER at O), the three bars (one LINE_LIST coloured per bar),
     pins A and B (SPHEREs) and the ground pivots O and C (CUBEs), in namespace ``linkage``."""
-    if out is None:
-        out = _new_marker_array(linkage, frame_id)
-    disk, bars, pin_a, pin_b, pivot_o, pivot_c = out.markers
+    message = _new_marker_array(linkage, frame_id)
+    disk, bars, pin_a, pin_b, pivot_o, pivot_c = message.markers
     pin_a_point = Point(x=state.pin_a_x, y=state.pin_a_y)
     pin_b_point = Point(x=state.pin_b_x, y=state.pin_b_y)
     bars.points[1] = pin_a_point
@@ -163,12 +227,40 @@ def marker_array(
     bars.points[4] = pin_b_point
     pin_a.pose.position = pin_a_point
     pin_b.pose.position = pin_b_point
-    # The disk is symmetric about O; turning it shows the crank angle on the disk itself.
-    disk.pose.orientation.z = math.sin(0.5 * state.alpha)
-    disk.pose.orientation.w = math.cos(0.5 * state.alpha)
-    for marker in out.markers:
+    disk.pose.orientation.z, disk.pose.orientation.w = disk_orientation(state)
+    for marker in message.markers:
         marker.header.stamp = stamp
-    return out
+    return message
+
+
+class MarkerArrayEncoder:
+    """The bytes of ``marker_array`` (encode_cdr) of one linkage and frame, straight from a
+    state."""
+
+    _PIN_A_PATHS = (f"markers[{BARS_ID}].points[1]", f"markers[{BARS_ID}].points[2]",
+                    f"markers[{PIN_A_ID}].pose.position")
+    _PIN_B_PATHS = (f"markers[{BARS_ID}].points[3]", f"markers[{BARS_ID}].points[4]",
+                    f"markers[{PIN_B_ID}].pose.position")
+
+    def __init__(self, linkage: FourBar, frame_id: str) -> None:
+        template = _new_marker_array(linkage, frame_id)
+        self._marker_count = len(template.markers)
+        varying = [path for index in range(self._marker_count)
+                   for path in _stamp_paths(f"markers[{index}].")]
+        varying += [f"{point}.{axis}" for point in self._PIN_A_PATHS + self._PIN_B_PATHS
+                    for axis in "xy"]
+        varying += [f"markers[{DISK_ID}].pose.orientation.z",
+                    f"markers[{DISK_ID}].pose.orientation.w"]
+        self._encoder = FixedShapeEncoder(template, varying)
+
+    def encode(self, state: LinkageState, stamp_ns: int) -> bytes:
+        pin_a = (state.pin_a_x, state.pin_a_y)
+        pin_b = (state.pin_b_x, state.pin_b_y)
+        return self._encoder.encode((
+            *divmod(stamp_ns, 1_000_000_000) * self._marker_count,
+            *pin_a * len(self._PIN_A_PATHS), *pin_b * len(self._PIN_B_PATHS),
+            *disk_orientation(state),
+        ))
 
 
 def _new_marker_array(linkage: FourBar, frame_id: str) -> MarkerArray:

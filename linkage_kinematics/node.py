@@ -61,7 +61,7 @@ from linkage_kinematics.parameters import (
     describe_value,
     parameter_specs,
 )
-from linkage_kinematics.recording import Recorder
+from linkage_kinematics.recording import Recorder, encode_cdr
 from linkage_kinematics.urdf import urdf_text
 
 DIAGNOSTIC_TASK = "crank motion"
@@ -163,9 +163,13 @@ class LinkageNode(Node):
         self._described_linkage: FourBar | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = self.config.frame_prefix + self.config.frame_id
-        self._joint_state = JointState(name=list(messages.JOINT_NAMES), position=[0.0] * 3)
-        self._linkage_state: JointTrajectory | None = None
-        self._markers: MarkerArray | None = None
+        # The per-tick messages and the scene are encoded straight from the state; the
+        # encoders of the state and the scene are prepared for each geometry.
+        self._joint_state_encoder = messages.JointStateEncoder()
+        self._joint_positions: tuple[float, float, float] = (0.0, 0.0, 0.0)
+        self._encoded_linkage: FourBar | None = None
+        self._state_encoder: messages.LinkageStateEncoder | None = None
+        self._marker_encoder: messages.MarkerArrayEncoder | None = None
         self._window_start: Time | None = None
         self._window_ticks = 0
         self._achieved_rate = 0.0
@@ -311,12 +315,14 @@ class LinkageNode(Node):
         return recorder
 
     def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
-        if self._recorder is None or self._recording_error is not None:
-            self._topic_publishers[topic].publish(message)
-            return
-        # Serialized once: subscribers get the very bytes that are logged.
-        data = self._recorder.serialize(message)
+        self._send(topic, encode_cdr(message), log_time_ns)
+
+    def _send(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Publish a message encoded by ``encode_cdr`` (or an encoder equal to it) and log it:
+        subscribers get the very bytes that are logged."""
         self._topic_publishers[topic].publish(data)
+        if self._recorder is None or self._recording_error is not None:
+            return
         try:
             self._recorder.record(topic, data, log_time_ns)
         except OSError as error:
@@ -451,22 +457,31 @@ class LinkageNode(Node):
         self._state = state
         self._state_time = at
         if first:
+            if self._encoded_linkage != self.config.linkage:
+                self._prepare_encoders()
             self._publish_markers()
             if self._described_linkage != self.config.linkage:
                 self._publish_robot_description(at)
             self._activity = "moving"
             self._publish_diagnostics()
-        stamp = at.to_msg()
         nanoseconds = at.nanoseconds
-        joint_state = messages.joint_state(
-            state, stamp, self._joint_state.position, out=self._joint_state
+        self._joint_positions = messages.joint_positions(state, self._joint_positions)
+        self._send(
+            self._joint_states_topic,
+            self._joint_state_encoder.encode(state, nanoseconds, self._joint_positions),
+            nanoseconds,
         )
-        self._publish(self._joint_states_topic, joint_state, nanoseconds)
-        self._linkage_state = messages.linkage_state(
-            self.config.linkage, state, stamp, motion_time, self._frame_id,
-            out=self._linkage_state,
+        self._send(
+            self._state_topic,
+            self._state_encoder.encode(state, nanoseconds, motion_time),
+            nanoseconds,
         )
-        self._publish(self._state_topic, self._linkage_state, nanoseconds)
+
+    def _prepare_encoders(self) -> None:
+        linkage = self.config.linkage
+        self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
+        self._marker_encoder = messages.MarkerArrayEncoder(linkage, self._frame_id)
+        self._encoded_linkage = linkage
 
     def _finish_at_end(self) -> None:
         self._activity = (
@@ -499,11 +514,11 @@ class LinkageNode(Node):
         """The scene of the latest state, stamped with that state's time."""
         if self._state is None:
             return
-        self._markers = messages.marker_array(
-            self.config.linkage, self._state, self._state_time.to_msg(), self._frame_id,
-            out=self._markers,
+        nanoseconds = self._state_time.nanoseconds
+        self._send(
+            self._markers_topic, self._marker_encoder.encode(self._state, nanoseconds),
+            nanoseconds,
         )
-        self._publish(self._markers_topic, self._markers, self._state_time.nanoseconds)
 
     def _publish_diagnostics(self, event: str | None = None, at: Time | None = None) -> None:
         """Publish the status, stamped ``at`` (by default the latest state's time, so that log

@@ -1,7 +1,8 @@
 """The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
 
-The node encodes each message once (``Recorder.serialize``, which is ``encode_cdr``), publishes
-those bytes and logs the same bytes, so subscribers receive exactly what the bag holds.
+The node encodes each message once (``encode_cdr``, or for its per-tick messages and its
+scene a ``FixedShapeEncoder`` that writes the same bytes), publishes those bytes and logs the
+same bytes, so subscribers receive exactly what the bag holds.
 
 ``encode_cdr`` writes a message as little-endian XCDR1 (the encoding rmw_fastrtps publishes
 and rosbag2 stores) from the message's field types alone: one walk over the fields collects a
@@ -228,6 +229,89 @@ def encode_cdr(message: Any) -> bytes:
     return ENCAPSULATION_HEADER + struct.pack("".join(codes), *values)
 
 
+class _Slot:
+    """Stands for a value of a varying field while a template is walked."""
+
+    __slots__ = ("path",)
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+
+class _Template:
+    """A message seen through ``_walk``: the fields named in ``varying`` read as slots (one per
+    element of a sequence), every other field as the message's own value."""
+
+    __slots__ = ("_message", "_path", "_varying")
+
+    def __init__(self, message: Any, path: str, varying: frozenset[str]) -> None:
+        self._message = message
+        self._path = path
+        self._varying = varying
+
+    def __getattr__(self, name: str) -> Any:
+        path = f"{self._path}.{name}" if self._path else name
+        value = getattr(self._message, name)
+        if path in self._varying:
+            return [_Slot(path)] * len(value) if _is_sequence(value) else _Slot(path)
+        if hasattr(value, "SLOT_TYPES"):
+            return _Template(value, path, self._varying)
+        if isinstance(value, list) and value and hasattr(value[0], "SLOT_TYPES"):
+            return [_Template(element, f"{path}[{index}]", self._varying)
+                    for index, element in enumerate(value)]
+        return value
+
+
+def _is_sequence(value: Any) -> bool:
+    return hasattr(value, "__len__") and not isinstance(value, (str, bytes))
+
+
+class FixedShapeEncoder:
+    """``encode_cdr`` for a stream of messages that differ from ``template`` only in the
+    fixed-size fields named by ``varying`` (attribute paths such as ``header.stamp.sec``,
+    ``position`` or ``markers[1].points[2].x``; a sequence keeps the template's length).
+
+    The template is walked once: its struct format and constant values are kept, so encoding
+    a message is one ``struct.pack`` of the constants and the new values, without building the
+    message. ``encode`` takes the new values path by path in the order of ``varying``, a
+    sequence's elements in order; the bytes equal ``encode_cdr`` of the message they describe.
+    """
+
+    def __init__(self, template: Any, varying: list[str]) -> None:
+        codes: list[str] = ["<"]
+        values: list[Any] = []
+        _walk(_Template(template, "", frozenset(varying)), _plan(type(template)), codes, values,
+              0)
+        constants = [value for value in values if not isinstance(value, _Slot)]
+        argument = {path: [] for path in varying}
+        for index, value in enumerate(values):
+            if isinstance(value, _Slot):
+                argument[value.path].append(index)
+        unused = [path for path, indices in argument.items() if not indices]
+        if unused:
+            raise ValueError(f"{ros_type_name(type(template))} has no fixed-size field {unused}")
+        # struct argument i is element order[i] of constants + given values
+        given = [index for path in varying for index in argument[path]]
+        order = [0] * len(values)
+        constant_index = 0
+        for index, value in enumerate(values):
+            if not isinstance(value, _Slot):
+                order[index] = constant_index
+                constant_index += 1
+        for position, index in enumerate(given):
+            order[index] = len(constants) + position
+        self.value_count = len(given)
+        self._constants = tuple(constants)
+        # itemgetter of one index returns the element itself, not a 1-tuple
+        self._order = (operator.itemgetter(*order) if len(order) > 1
+                       else lambda arguments: (arguments[order[0]],))
+        self._struct = struct.Struct("".join(codes))
+
+    def encode(self, values: tuple) -> bytes:
+        """The message with ``values`` (``value_count`` of them) in the varying fields."""
+        return ENCAPSULATION_HEADER + self._struct.pack(*self._order(self._constants + values))
+
+
 def _duration(nanoseconds: int) -> dict[str, int]:
     return {"sec": nanoseconds // 1_000_000_000, "nsec": nanoseconds % 1_000_000_000}
 
@@ -286,13 +370,8 @@ class Recorder:
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
 
-    @staticmethod
-    def serialize(message: Any) -> bytes:
-        """The bytes to publish and to ``record``: ``encode_cdr(message)``."""
-        return encode_cdr(message)
-
     def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Logs ``data``, a message of ``topic`` encoded by ``serialize``."""
+        """Logs ``data``, a message of ``topic`` encoded by ``encode_cdr``."""
         try:
             self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
         except BagWriteError as error:

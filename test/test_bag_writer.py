@@ -35,7 +35,7 @@ from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
 from sensor_msgs.msg import CameraInfo, JointState, Range
-from std_msgs.msg import String
+from std_msgs.msg import Float64, String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -52,6 +52,7 @@ from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.recording import (
+    FixedShapeEncoder,
     Recorder,
     encode_cdr,
     offered_qos_profiles_yaml,
@@ -249,9 +250,7 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
     assert_exact_encoding(encode_cdr(camera), camera)
 
 
-def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: Path) -> None:
-    recorder = Recorder(tmp_path, metadata={})
-    recorder.add_topic("/joint_states", JointState, QoSProfile(depth=10))
+def test_encode_cdr_follows_every_change_of_a_reused_message() -> None:
     message = JointState(name=["abc", "c"], position=[1.0], velocity=[2.0])
     message.header.frame_id = "aaa"
     # Each step changes one field of the reused message, as a node would, and with it the exact
@@ -270,11 +269,10 @@ def test_recorder_serialize_follows_every_change_of_a_reused_message(tmp_path: P
     lengths = []
     for step in steps:
         step(message)
-        data = recorder.serialize(message)
+        data = encode_cdr(message)
         assert_exact_encoding(data, message)
         lengths.append(len(data))
     assert all(before != after for before, after in zip(lengths, lengths[1:])), lengths
-    recorder.close()
 
 
 point_lengths = st.tuples(*[st.integers(0, 3)] * 4)  # positions, velocities, accelerations, effort
@@ -290,26 +288,62 @@ few_texts = st.sampled_from(["", "base", "bäse", "the_base_link"])
     )
 )
 @example(shapes=[("base", ["a"], [(1, 0, 0, 0)]), ("base", ["a"], [(2, 0, 0, 0)])])
-def test_recorder_serialize_follows_every_reshaping_of_a_trajectory(
+def test_encode_cdr_follows_every_reshaping_of_a_trajectory(
     shapes: list[tuple[str, list[str], list[tuple[int, int, int, int]]]],
 ) -> None:
-    """One JointTrajectory, reused and reshaped between calls, through one recorder topic."""
-    with tempfile.TemporaryDirectory(prefix="linkage_test_shapes_") as folder:
-        recorder = Recorder(Path(folder), metadata={})
-        recorder.add_topic("/linkage/state", JointTrajectory, QoSProfile(depth=10))
-        message = JointTrajectory()
-        for frame_id, joint_names, points in shapes:
-            message.header.frame_id = frame_id
-            message.joint_names = joint_names
-            message.points = [
-                JointTrajectoryPoint(
-                    positions=[0.5] * sizes[0], velocities=[1.5] * sizes[1],
-                    accelerations=[2.5] * sizes[2], effort=[3.5] * sizes[3],
-                )
-                for sizes in points
-            ]
-            assert_exact_encoding(recorder.serialize(message), message)
-        recorder.close()
+    """One JointTrajectory, reused and reshaped between calls."""
+    message = JointTrajectory()
+    for frame_id, joint_names, points in shapes:
+        message.header.frame_id = frame_id
+        message.joint_names = joint_names
+        message.points = [
+            JointTrajectoryPoint(
+                positions=[0.5] * sizes[0], velocities=[1.5] * sizes[1],
+                accelerations=[2.5] * sizes[2], effort=[3.5] * sizes[3],
+            )
+            for sizes in points
+        ]
+        assert_exact_encoding(encode_cdr(message), message)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    preset_name=st.sampled_from(["paper", "paper_full_turn", "grashof_crank_rocker"]),
+    alpha=st.floats(-10.0, 10.0),
+    stamp=st.integers(0, 2**62),
+    motion_time=st.floats(0.0, 1e6),
+    frame_id=st.sampled_from(["", "linkage_base", "ü/base", "left/linkage_base"]),
+    previous=st.tuples(*[st.floats(-100.0, 100.0)] * 3),
+)
+def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_messages(
+    preset_name: str, alpha: float, stamp: int, motion_time: float, frame_id: str,
+    previous: tuple[float, float, float],
+) -> None:
+    """The per-tick messages and the scene, encoded straight from the state, are byte for byte
+    encode_cdr of the messages the builders make (frame ids of any length shift the alignment
+    of everything after them)."""
+    linkage = preset(preset_name).geometry
+    try:
+        state = solve(linkage, alpha, DriveLaw(2.0, 0.3))
+    except ValueError:  # an unreachable or dead-point angle has no state to encode
+        return
+    stamp_msg = messages.time_msg(stamp)
+    positions = messages.joint_positions(state, previous)
+    assert messages.JointStateEncoder().encode(state, stamp, positions) == encode_cdr(
+        messages.joint_state(state, stamp_msg, previous))
+    assert messages.LinkageStateEncoder(linkage, frame_id).encode(
+        state, stamp, motion_time) == encode_cdr(
+        messages.linkage_state(linkage, state, stamp_msg, motion_time, frame_id))
+    assert messages.MarkerArrayEncoder(linkage, frame_id).encode(state, stamp) == encode_cdr(
+        messages.marker_array(linkage, state, stamp_msg, frame_id))
+
+
+def test_a_fixed_shape_encoder_of_one_field_and_one_naming_no_field() -> None:
+    encoder = FixedShapeEncoder(Float64(data=0.0), ["data"])
+    assert encoder.value_count == 1
+    assert encoder.encode((2.5,)) == encode_cdr(Float64(data=2.5))
+    with pytest.raises(ValueError, match=r"std_msgs/msg/Float64 has no fixed-size field \['dat'\]"):
+        FixedShapeEncoder(Float64(data=0.0), ["dat"])
 
 
 def test_schema_names_dependencies_as_the_referencing_field_spells_them() -> None:
