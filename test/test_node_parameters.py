@@ -11,10 +11,12 @@ from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
+from visualization_msgs.msg import MarkerArray
 
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics import solve
+from linkage_kinematics.messages import DISK_ID, PIN_A_ID
 from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
     ConfigurationError,
@@ -197,6 +199,7 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
             assert speeds == {4.0}
 
             listener.subscribe("/robot_description", String, transient_local=True)
+            listener.subscribe("/linkage/markers", MarkerArray)
             assert _set(client, listener, "crank_length", 0.25) == (True, "")
             smaller = FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, PAPER.ground_x)
             descriptions = listener.received["/robot_description"]
@@ -210,6 +213,16 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
                     math.copysign(4.0, message.velocity[0])))
                 assert tuple(message.velocity)[0] == state.omega
                 assert message.velocity[1] == state.omega_ab - state.omega
+            # The scene follows the new geometry: the disk's diameter and pin A's circle.
+            scenes = listener.received["/linkage/markers"]
+            assert listener.spin_until(
+                lambda: scenes and scenes[-1].markers[DISK_ID].scale.x == 0.5)
+            changed_at = len(scenes) - 1
+            assert listener.spin_until(lambda: len(scenes) > changed_at + 3)
+            for scene in scenes[changed_at:]:
+                pin_a = scene.markers[PIN_A_ID].pose.position
+                assert math.hypot(pin_a.x, pin_a.y) == pytest.approx(0.25, abs=1e-12)
+                assert scene.markers[DISK_ID].scale.x == 0.5
             assert process.poll() is None
         finally:
             stop_process(process)
