@@ -22,7 +22,6 @@ import functools
 import importlib
 import operator
 import struct
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -38,12 +37,8 @@ from rosidl_parser.definition import (
     NamespacedType,
 )
 
-from linkage_kinematics.bag_writer import (
-    BagExistsError,
-    BagWriteError,
-    BagWriter,
-    message_definition,
-)
+from linkage_kinematics.bag_writer import BagWriteError, message_definition
+from linkage_kinematics.bag_writer_process import BagWriterProcess
 
 # XCDR1, little endian: the representation identifier and two option bytes.
 ENCAPSULATION_HEADER = b"\x00\x01\x00\x00"
@@ -333,32 +328,20 @@ def offered_qos_profiles_yaml(qos: QoSProfile) -> str:
 
 
 class Recorder:
-    """Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one)."""
+    """Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one),
+    written by a BagWriter in a process of its own (bag_writer_process)."""
 
     def __init__(self, folder: Path, *, metadata: dict[str, str]) -> None:
-        folder = Path(folder)
         try:
-            folder.mkdir(parents=True, exist_ok=True)
-        except OSError as error:
-            raise RecordingError(
-                f"cannot create log folder {folder}: {error.strerror or error}"
-            ) from None
-        base_name = time.strftime("rosbag2_%Y_%m_%d-%H_%M_%S")
-        suffix = 0
-        while True:
-            name = base_name if suffix == 0 else f"{base_name}_{suffix}"
-            try:
-                self._writer = BagWriter(folder / name, metadata=metadata)
-                break
-            except BagExistsError:
-                suffix += 1
-            except BagWriteError as error:
-                raise RecordingError(f"cannot log into folder {folder}: {error}") from None
+            self._writer = BagWriterProcess(folder, metadata=metadata)
+        except BagWriteError as error:
+            raise RecordingError(str(error)) from None
         self.bag_path: Path = self._writer.bag_path
         self._channels: dict[str, int] = {}
 
     @property
     def size_bytes(self) -> int:
+        """The MCAP file's size as the writer last reported it (every 0.25 s at most)."""
         return self._writer.size_bytes
 
     def add_topic(self, topic: str, msg_type: type, qos: QoSProfile) -> None:
@@ -378,6 +361,7 @@ class Recorder:
             raise RecordingError(str(error)) from None
 
     def close(self) -> None:
+        """Finishes the bag: waits until its writer has written everything it was given."""
         try:
             self._writer.close()
         except BagWriteError as error:

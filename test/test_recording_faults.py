@@ -3,6 +3,7 @@ folder that cannot be created, a bag name already taken, and a disk that fills d
 from __future__ import annotations
 
 import hashlib
+import os
 import resource
 import signal
 import subprocess
@@ -41,8 +42,10 @@ from test_bag_writer import (
 )
 
 LOOP_PARAMETERS = {"rate_hz": 200.0, "end_behavior": "loop"}
-# Flush interval (1 s) plus one tick and scheduling slack.
+# The bag writer's flush interval (1 s) plus one tick and scheduling slack.
 MAX_LOSS_AT_KILL_NS = 1_500_000_000
+# The node's last batch (16 messages, at most 50 ms old) plus scheduling slack.
+MAX_LOSS_AT_NODE_KILL_NS = 500_000_000
 FILE_SIZE_LIMIT_BYTES = 256 * 1024
 
 
@@ -88,28 +91,89 @@ def recover(bag: Path) -> subprocess.CompletedProcess:
     )
 
 
-def test_sigkill_keeps_complete_chunks_and_recovery_completes_the_bag(tmp_path: Path) -> None:
-    folder = tmp_path / "bags"
-    with ros_context(35) as context:
+def bag_writer_pid(node_pid: int) -> int:
+    """The process id of the node's bag writer (bag_writer_process), its child."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            cmdline = (stat.parent / "cmdline").read_bytes()
+        except OSError:
+            continue  # a process that ended meanwhile
+        if int(fields[1]) == node_pid and b"linkage_kinematics.bag_writer_process" in cmdline:
+            return int(stat.parent.name)
+    raise AssertionError(f"no bag writer process under the node (pid {node_pid})")
+
+
+def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
+                                    kill_writer: bool) -> tuple[Path, int, int]:
+    """Runs a logging node until complete chunks hold every topic and a listener has heard
+    them all, then SIGKILLs the node (and first its bag writer, if ``kill_writer``). The bag,
+    the stamp of the last /joint_states heard and the wall time of the kill (ns)."""
+    with ros_context(domain) as context:
         listener = listen_to_node_topics(context, "sigkill_listener")
         process = start_node(
-            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 35, tmp_path / "node.log"
+            {**LOOP_PARAMETERS, "log.folder": str(folder)}, domain, tmp_path / "node.log"
         )
         try:
             bag = wait_for_bag(folder, process)
             (mcap_path,) = bag.glob("*.mcap")
-            # Killed once complete chunks hold every topic and the listener has heard them all.
             assert listener.spin_until(
                 lambda: listener.heard_every_topic()
                 and stream_topics(mcap_path) == set(NODE_TOPICS)
             ), (tmp_path / "node.log").read_text()
             last_heard_ns = stamp_ns(listener.received["/joint_states"][-1])
             killed_at_ns = time.time_ns()
+            if kill_writer:
+                writer = bag_writer_pid(process.pid)
+                os.kill(writer, signal.SIGKILL)
+                wait_until_gone(writer)
             process.kill()
             process.wait(timeout=PROCESS_TIMEOUT)
         finally:
             stop_process(process)
             listener.destroy()
+    return bag, last_heard_ns, killed_at_ns
+
+
+def wait_until_gone(pid: int) -> None:
+    deadline = time.monotonic() + PROCESS_TIMEOUT
+    while Path(f"/proc/{pid}").exists() and b") Z" not in Path(f"/proc/{pid}/stat").read_bytes():
+        assert time.monotonic() < deadline, f"process {pid} still runs"
+        time.sleep(0.05)
+
+
+def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
+    tmp_path: Path,
+) -> None:
+    """The bag writer outlives a killed node: it writes what the node handed over (all but the
+    last batch of at most 16 messages or 50 ms), the summary and the final metadata.yaml."""
+    folder = tmp_path / "bags"
+    bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
+        tmp_path, folder, 35, kill_writer=False)
+    deadline = time.monotonic() + PROCESS_TIMEOUT
+    while bag_reader.bag_files(bag)[0].truncated or not bag_information(bag)["message_count"]:
+        assert time.monotonic() < deadline, "the bag writer did not finish the bag"
+        time.sleep(0.1)
+
+    logged = list(bag_reader.iter_messages(bag))
+    assert {message.topic for message in logged} == set(NODE_TOPICS)
+    assert last_heard_ns - MAX_LOSS_AT_NODE_KILL_NS < logged[-1].log_time_ns < killed_at_ns
+    with open(bag_reader.bag_files(bag)[0].path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics.message_count == len(logged)
+    information = bag_information(bag)
+    assert information["message_count"] == len(logged)
+    by_rosbags = read_with_rosbags(bag)
+    assert topic_counts(information) == {topic: len(entries)
+                                         for topic, entries in by_rosbags.items()}
+
+
+def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes_the_bag(
+    tmp_path: Path,
+) -> None:
+    folder = tmp_path / "bags"
+    bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
+        tmp_path, folder, 34, kill_writer=True)
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.truncated
@@ -118,7 +182,7 @@ def test_sigkill_keeps_complete_chunks_and_recovery_completes_the_bag(tmp_path: 
     assert {message.topic for message in survivors} == set(NODE_TOPICS)
     for message in survivors:
         TYPESTORE.deserialize_cdr(message.data, message.schema_name)
-    # What the node had recorded (and published) before the kill is kept up to the last chunk.
+    # What the writer had flushed before the kill is kept up to the last chunk.
     assert last_heard_ns - MAX_LOSS_AT_KILL_NS < survivors[-1].log_time_ns < killed_at_ns
 
     recovery = recover(bag)
