@@ -283,6 +283,38 @@ def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_pa
         assert {p.name: p.read_bytes() for p in (folder / name).iterdir()} == files
 
 
+def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_on(
+    tmp_path: Path,
+) -> None:
+    folder = tmp_path / "bags"
+    with ros_context(33) as context:
+        listener = listen_to_node_topics(context, "writer_death_listener")
+        process = start_node(
+            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 33, tmp_path / "node.log"
+        )
+        try:
+            assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+            os.kill(bag_writer_pid(process.pid), signal.SIGKILL)
+            assert listener.spin_until(lambda: any(
+                status.level == DiagnosticStatus.ERROR
+                and "recording stopped" in status.message and "ended unexpectedly" in status.message
+                for array in listener.received["/diagnostics"] for status in array.status
+            ))
+            states_then = len(listener.received["/linkage/state"])
+            assert listener.spin_until(
+                lambda: len(listener.received["/linkage/state"]) > states_then + 100)
+            process.send_signal(signal.SIGINT)
+            status = process.wait(timeout=PROCESS_TIMEOUT)
+        finally:
+            stop_process(process)
+            listener.destroy()
+    output = (tmp_path / "node.log").read_text()
+    # The log could not be finalized: status 1, and the one error that says so.
+    assert status == 1, output
+    assert "could not finalize the log" in output and "Traceback" not in output
+    assert recover(only_bag(folder)).returncode == 0
+
+
 def _limit_file_size() -> None:
     # Writes past the limit then fail with EFBIG instead of killing the process with SIGXFSZ.
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
