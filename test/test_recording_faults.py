@@ -294,7 +294,10 @@ def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_o
         )
         try:
             assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
-            os.kill(bag_writer_pid(process.pid), signal.SIGKILL)
+            writer = bag_writer_pid(process.pid)
+            # a batch task: it never preempts the node when a batch wakes it
+            assert os.sched_getscheduler(writer) == os.SCHED_BATCH
+            os.kill(writer, signal.SIGKILL)
             assert listener.spin_until(lambda: any(
                 status.level == DiagnosticStatus.ERROR
                 and "recording stopped" in status.message and "ended unexpectedly" in status.message
