@@ -2,6 +2,7 @@
 folder that cannot be created, a bag name already taken, and a disk that fills during the run."""
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import resource
@@ -9,7 +10,9 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from diagnostic_msgs.msg import DiagnosticStatus
@@ -21,6 +24,7 @@ from rosbags.rosbag2 import Reader
 
 from linkage_kinematics import bag_reader
 from node_process import (
+    Listener,
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
@@ -47,6 +51,22 @@ MAX_LOSS_AT_KILL_NS = 1_500_000_000
 # The node's last batch (16 messages, at most 50 ms old) plus scheduling slack.
 MAX_LOSS_AT_NODE_KILL_NS = 500_000_000
 FILE_SIZE_LIMIT_BYTES = 256 * 1024
+
+
+@contextlib.contextmanager
+def node_with_listener(
+    parameters: dict[str, Any], domain: int, output: Path, **start_options: Any
+) -> Iterator[tuple[Listener, subprocess.Popen]]:
+    """A node process (``start_node``'s arguments) and a listener to all its topics, on their
+    own ROS domain; both ended on leaving."""
+    with ros_context(domain) as context:
+        listener = listen_to_node_topics(context, f"faults_listener_{domain}")
+        process = start_node(parameters, domain, output, **start_options)
+        try:
+            yield listener, process
+        finally:
+            stop_process(process)
+            listener.destroy()
 
 
 def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0) -> Path:
@@ -109,29 +129,23 @@ def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
     """Runs a logging node until complete chunks hold every topic and a listener has heard
     them all, then SIGKILLs the node (and first its bag writer, if ``kill_writer``). The bag,
     the stamp of the last /joint_states heard and the wall time of the kill (ns)."""
-    with ros_context(domain) as context:
-        listener = listen_to_node_topics(context, "sigkill_listener")
-        process = start_node(
-            {**LOOP_PARAMETERS, "log.folder": str(folder)}, domain, tmp_path / "node.log"
-        )
-        try:
-            bag = wait_for_bag(folder, process)
-            (mcap_path,) = bag.glob("*.mcap")
-            assert listener.spin_until(
-                lambda: listener.heard_every_topic()
-                and stream_topics(mcap_path) == set(NODE_TOPICS)
-            ), (tmp_path / "node.log").read_text()
-            last_heard_ns = stamp_ns(listener.received["/joint_states"][-1])
-            killed_at_ns = time.time_ns()
-            if kill_writer:
-                writer = bag_writer_pid(process.pid)
-                os.kill(writer, signal.SIGKILL)
-                wait_until_gone(writer)
-            process.kill()
-            process.wait(timeout=PROCESS_TIMEOUT)
-        finally:
-            stop_process(process)
-            listener.destroy()
+    with node_with_listener(
+        {**LOOP_PARAMETERS, "log.folder": str(folder)}, domain, tmp_path / "node.log"
+    ) as (listener, process):
+        bag = wait_for_bag(folder, process)
+        (mcap_path,) = bag.glob("*.mcap")
+        assert listener.spin_until(
+            lambda: listener.heard_every_topic()
+            and stream_topics(mcap_path) == set(NODE_TOPICS)
+        ), (tmp_path / "node.log").read_text()
+        last_heard_ns = stamp_ns(listener.received["/joint_states"][-1])
+        killed_at_ns = time.time_ns()
+        if kill_writer:
+            writer = bag_writer_pid(process.pid)
+            os.kill(writer, signal.SIGKILL)
+            wait_until_gone(writer)
+        process.kill()
+        process.wait(timeout=PROCESS_TIMEOUT)
     return bag, last_heard_ns, killed_at_ns
 
 
@@ -205,19 +219,13 @@ def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes
 @pytest.mark.parametrize("stop_signal", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
 def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal.Signals) -> None:
     folder = tmp_path / "bags"
-    with ros_context(36) as context:
-        listener = listen_to_node_topics(context, "signal_listener")
-        process = start_node(
-            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log"
-        )
-        try:
-            bag = wait_for_bag(folder, process)
-            assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
-            process.send_signal(stop_signal)
-            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / "node.log").read_text()
-        finally:
-            stop_process(process)
-            listener.destroy()
+    with node_with_listener(
+        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log"
+    ) as (listener, process):
+        bag = wait_for_bag(folder, process)
+        assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+        process.send_signal(stop_signal)
+        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / "node.log").read_text()
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
@@ -237,17 +245,11 @@ def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(tmp_
     blocker = tmp_path / "afile"
     blocker.write_text("not a folder")
     folder = blocker / "bags"
-    with ros_context(37) as context:
-        listener = listen_to_node_topics(context, "unwritable_folder_listener")
-        process = start_node(
-            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 37, tmp_path / "node.log"
-        )
-        try:
-            assert listener.spin_until(stopped(process))
-            listener.spin_until(lambda: False, timeout=1.0)  # anything published arrives by now
-        finally:
-            stop_process(process)
-            listener.destroy()
+    with node_with_listener(
+        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 37, tmp_path / "node.log"
+    ) as (listener, process):
+        assert listener.spin_until(stopped(process))
+        listener.spin_until(lambda: False, timeout=1.0)  # anything published arrives by now
     output = (tmp_path / "node.log").read_text()
     assert process.returncode != 0
     assert str(folder) in output
@@ -287,30 +289,24 @@ def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_o
     tmp_path: Path,
 ) -> None:
     folder = tmp_path / "bags"
-    with ros_context(33) as context:
-        listener = listen_to_node_topics(context, "writer_death_listener")
-        process = start_node(
-            {**LOOP_PARAMETERS, "log.folder": str(folder)}, 33, tmp_path / "node.log"
-        )
-        try:
-            assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
-            writer = bag_writer_pid(process.pid)
-            # a batch task: it never preempts the node when a batch wakes it
-            assert os.sched_getscheduler(writer) == os.SCHED_BATCH
-            os.kill(writer, signal.SIGKILL)
-            assert listener.spin_until(lambda: any(
-                status.level == DiagnosticStatus.ERROR
-                and "recording stopped" in status.message and "ended unexpectedly" in status.message
-                for array in listener.received["/diagnostics"] for status in array.status
-            ))
-            states_then = len(listener.received["/linkage/state"])
-            assert listener.spin_until(
-                lambda: len(listener.received["/linkage/state"]) > states_then + 100)
-            process.send_signal(signal.SIGINT)
-            status = process.wait(timeout=PROCESS_TIMEOUT)
-        finally:
-            stop_process(process)
-            listener.destroy()
+    with node_with_listener(
+        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 33, tmp_path / "node.log"
+    ) as (listener, process):
+        assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+        writer = bag_writer_pid(process.pid)
+        # a batch task: it never preempts the node when a batch wakes it
+        assert os.sched_getscheduler(writer) == os.SCHED_BATCH
+        os.kill(writer, signal.SIGKILL)
+        assert listener.spin_until(lambda: any(
+            status.level == DiagnosticStatus.ERROR
+            and "recording stopped" in status.message and "ended unexpectedly" in status.message
+            for array in listener.received["/diagnostics"] for status in array.status
+        ))
+        states_then = len(listener.received["/linkage/state"])
+        assert listener.spin_until(
+            lambda: len(listener.received["/linkage/state"]) > states_then + 100)
+        process.send_signal(signal.SIGINT)
+        status = process.wait(timeout=PROCESS_TIMEOUT)
     output = (tmp_path / "node.log").read_text()
     # The log could not be finalized: status 1, and the one error that says so.
     assert status == 1, output
@@ -334,25 +330,17 @@ def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path:
             for status in array.status
         )
 
-    with ros_context(39) as context:
-        listener = listen_to_node_topics(context, "full_disk_listener")
-        process = start_node(
-            {"log.folder": str(folder), "rate_hz": 1000.0, "end_behavior": "loop"},
-            39,
-            tmp_path / "node.log",
-            preexec_fn=_limit_file_size,
+    with node_with_listener(
+        {"log.folder": str(folder), "rate_hz": 1000.0, "end_behavior": "loop"}, 39,
+        tmp_path / "node.log", preexec_fn=_limit_file_size,
+    ) as (listener, process):
+        assert listener.spin_until(lambda: recording_failed(listener.received))
+        states_at_failure = len(listener.received["/linkage/state"])
+        assert listener.spin_until(
+            lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200
         )
-        try:
-            assert listener.spin_until(lambda: recording_failed(listener.received))
-            states_at_failure = len(listener.received["/linkage/state"])
-            assert listener.spin_until(
-                lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200
-            )
-            process.send_signal(signal.SIGINT)
-            process.wait(timeout=PROCESS_TIMEOUT)
-        finally:
-            stop_process(process)
-            listener.destroy()
+        process.send_signal(signal.SIGINT)
+        process.wait(timeout=PROCESS_TIMEOUT)
     output = (tmp_path / "node.log").read_text()
     assert "File too large" in output and "Traceback" not in output
 
