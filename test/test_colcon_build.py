@@ -11,6 +11,7 @@ from pathlib import Path
 
 from sensor_msgs.msg import JointState
 
+from linkage_kinematics import bag_reader
 from node_process import (
     PROCESS_TIMEOUT,
     REPOSITORY,
@@ -92,7 +93,8 @@ def test_colcon_build_installs_a_node_that_publishes(tmp_path):
         listener = Listener("colcon_listener", context)
         listener.subscribe("/joint_states", JointState)
         process = start_node(
-            {"end_behavior": "loop", "log.enabled": False}, DOMAIN_ID, tmp_path / "node.log",
+            {"end_behavior": "loop", "log.folder": str(tmp_path / "bags")}, DOMAIN_ID,
+            tmp_path / "node.log",
             executable=[str(executable)], environment=environment, cwd=tmp_path,
         )
         try:
@@ -105,3 +107,10 @@ def test_colcon_build_installs_a_node_that_publishes(tmp_path):
             listener.destroy()
     assert list(listener.received["/joint_states"][0].name) == [
         "crank_joint", "coupler_joint", "rocker_joint"]
+    # The installed package's bag writer process finished the log.
+    (bag,) = (tmp_path / "bags").iterdir()
+    (mcap_file,) = bag_reader.bag_files(bag)
+    assert mcap_file.complete
+    count = bag_reader.bag_information(bag)["message_count"]
+    assert count >= 5
+    assert f"bag finalized: {bag}, {count} messages" in (tmp_path / "node.log").read_text()
