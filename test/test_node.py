@@ -76,12 +76,16 @@ def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
 
     The node first loops; once the listener hears it (discovery may take seconds), switching
     end_behavior to 'stop' restarts the motion from alpha_start, so the listener sees the whole
-    run. The restart is where time_from_start, counting up through the loop, starts again.
+    run. The restart is where time_from_start, counting up through the loop, starts again; so
+    the switch waits until the listener has heard a time after the first, which the restart's
+    zero is below even if the listener joined at the node's very first state.
     """
     process = start_node({**parameters, "end_behavior": "loop"}, DOMAIN_ID, output)
     trajectories = listener.received["/linkage/state"]
     try:
-        assert listener.spin_until(lambda: trajectories), output.read_text()
+        assert listener.spin_until(
+            lambda: trajectories and _seconds(trajectories[-1].points[0].time_from_start) > 0.0
+        ), output.read_text()
         client = AsyncParameterClient(listener.node, "linkage_node")
         assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
         future = client.set_parameters([Parameter("end_behavior", value="stop")])
