@@ -30,7 +30,7 @@ import struct
 import subprocess
 import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Set
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -51,19 +51,39 @@ SIZE_REPORT_INTERVAL = 0.25  # s between the child's reports of the file size
 CLOSE_TIMEOUT = 60.0  # s for the child to write the summary once the pipe is closed
 
 
+def set_process_affinity(pid: int, cpus: Set[int]) -> None:
+    """Let every thread of process ``pid`` run only on ``cpus`` (threads it starts later
+    inherit their starter's CPUs). A process that has ended meanwhile is left alone: whoever
+    waits for it learns how it ended."""
+    try:
+        threads = os.listdir(f"/proc/{pid}/task")
+    except FileNotFoundError:
+        return
+    for thread in threads:
+        try:
+            os.sched_setaffinity(int(thread), cpus)
+        except ProcessLookupError:
+            pass  # the thread ended meanwhile
+
+
 class BagWriterProcess:
     """The node's handle on a ``BagWriter`` in a child process: a new bag folder in
     ``folder`` named after the local time (``rosbag2_%Y_%m_%d-%H_%M_%S``, ``_1``, … if taken).
 
     Errors of the child's writer come back as BagWriteError from the next ``write`` (or
-    ``close``) after the child reported them.
+    ``close``) after the child reported them. ``cpus``, if given, are the CPUs the child may
+    run on (the node's ``cpu_affinity`` keeps it off the node's CPU).
     """
 
-    def __init__(self, folder: Path | str, *, metadata: Mapping[str, str]) -> None:
+    def __init__(
+        self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None
+    ) -> None:
         self._process = subprocess.Popen(
             [sys.executable, "-m", __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             bufsize=0, start_new_session=True,
         )
+        if cpus is not None:
+            self.run_on(cpus)
         self._input = self._process.stdin.fileno()
         self._replies = b""
         self._queued = bytearray()
@@ -90,6 +110,10 @@ class BagWriterProcess:
             "offered_qos_profiles": offered_qos_profiles,
         })
         return int(reply["channel"])
+
+    def run_on(self, cpus: Set[int]) -> None:
+        """Let the child run only on ``cpus``."""
+        set_process_affinity(self._process.pid, cpus)
 
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
         """Queues one serialized message; a full or old batch goes to the child."""

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import signal
 import sys
 import time
@@ -39,6 +40,7 @@ from visualization_msgs.msg import MarkerArray
 
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import package_version
+from linkage_kinematics.bag_writer_process import set_process_affinity
 from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
 from linkage_kinematics.motion import (
@@ -52,6 +54,7 @@ from linkage_kinematics.motion import (
 )
 from linkage_kinematics.parameters import (
     NODE_NAME,
+    NO_CPU_AFFINITY,
     PARAMETER_NAMES,
     REAL_PARAMETERS,
     ConfigurationError,
@@ -194,6 +197,11 @@ class LinkageNode(Node):
             self._markers_topic,
             self._diagnostics_topic,
         ) = self._topic_publishers
+        self._available_cpus = (
+            os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else set()
+        )
+        self._bag_writer_cpus: set[int] | None = None
+        self._bag_writer_cpus = self._place(self.config.cpu_affinity)
         self._recorder = self._open_recorder() if self.config.log_enabled else None
         if self._recorder is not None:
             self.get_logger().info(f"recording to {self._recorder.bag_path}")
@@ -260,6 +268,7 @@ class LinkageNode(Node):
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
             config = build_configuration({**current, **updates})
+            self._check_cpu(config.cpu_affinity)
         except ConfigurationError as error:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
@@ -287,11 +296,53 @@ class LinkageNode(Node):
             self.destroy_timer(self._marker_timer)
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
                                                    self._publish_markers)
+        if new.cpu_affinity != old.cpu_affinity:
+            self._bag_writer_cpus = self._place(new.cpu_affinity)
+            if self._recorder is not None:
+                self._recorder.run_writer_on(self._bag_writer_cpus or self._available_cpus)
         if restarts:
             self._restart_motion()
             self.destroy_timer(self._state_timer)
             self._state_timer = self.create_timer(self._timer_period(), self._tick)
             self._tick()
+
+    # placement
+
+    def _check_cpu(self, cpu: int) -> None:
+        """ConfigurationError naming cpu_affinity unless this process may be pinned to ``cpu``."""
+        if cpu == NO_CPU_AFFINITY:
+            return
+        if not hasattr(os, "sched_setaffinity"):
+            raise ConfigurationError("cpu_affinity", "CPU affinity is not supported here")
+        if cpu not in self._available_cpus:
+            raise ConfigurationError(
+                "cpu_affinity",
+                f"CPU {cpu} is not one this process may run on (it may run on "
+                f"{', '.join(map(str, sorted(self._available_cpus)))})",
+            )
+
+    def _place(self, cpu: int) -> set[int] | None:
+        """Pin every thread of this process (Fast DDS's included; threads started later
+        inherit it) to ``cpu``, or give a pinned process back every CPU it could use for -1;
+        return the CPUs for the bag writer process, None when the node is not pinned.
+
+        On one CPU the executor's timer thread and the thread running the callbacks wake each
+        other without crossing CPUs, and the bag writer cannot delay either
+        (docs/benchmarks.md, section 3)."""
+        self._check_cpu(cpu)
+        if cpu == NO_CPU_AFFINITY and self._bag_writer_cpus is None:
+            return None  # never pinned: the process stays as it was started
+        node_cpus = self._available_cpus if cpu == NO_CPU_AFFINITY else {cpu}
+        set_process_affinity(os.getpid(), node_cpus)
+        if cpu == NO_CPU_AFFINITY:
+            self.get_logger().info("no longer pinned to a CPU")
+            return None
+        bag_writer_cpus = (self._available_cpus - node_cpus) or node_cpus
+        self.get_logger().info(
+            f"running on CPU {cpu}; the bag writer on CPU "
+            f"{', '.join(map(str, sorted(bag_writer_cpus)))}"
+        )
+        return bag_writer_cpus
 
     # recording
 
@@ -303,7 +354,9 @@ class LinkageNode(Node):
             "package_version": package_version(),
         }
         try:
-            recorder = Recorder(self.config.log_folder, metadata=metadata)
+            recorder = Recorder(
+                self.config.log_folder, metadata=metadata, cpus=self._bag_writer_cpus
+            )
         except OSError as error:
             raise ConfigurationError("log.folder", str(error)) from None
         try:

@@ -32,6 +32,8 @@ MODES = ("real_time", "fixed_step")
 GEOMETRY_PARAMETERS = ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")
 MAX_RATE_HZ = 10000.0
 MAX_DISPLAY_RATE_HZ = 1000.0
+MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
+NO_CPU_AFFINITY = -1
 MAX_LENGTH = 1e6  # m; lengths and ground coordinates, far beyond any mechanism
 MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
 MAX_OMEGA0 = 1e4  # rad/s
@@ -82,6 +84,7 @@ class RunConfiguration:
     dead_point_warning: float
     log_enabled: bool
     log_folder: Path
+    cpu_affinity: int
     direction: int
     segment_end: float
     blocked_at: float | None
@@ -97,13 +100,14 @@ class RunConfiguration:
 
     def restarts_motion(self, other: RunConfiguration) -> bool:
         """Whether switching from ``other`` to this configuration changes the motion itself."""
-        display_only = replace(
+        same_motion = replace(
             other,
             min_transmission_angle=self.min_transmission_angle,
             dead_point_warning=self.dead_point_warning,
             display_rate_hz=self.display_rate_hz,
+            cpu_affinity=self.cpu_affinity,
         )
-        return display_only != self
+        return same_motion != self
 
 
 @dataclass(frozen=True)
@@ -191,6 +195,11 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec("log.folder", "bags",
                       "folder that receives a new bag per run (relative to the working "
                       "directory)", read_only=True),
+        ParameterSpec("cpu_affinity", NO_CPU_AFFINITY,
+                      "CPU that every thread of the node's process runs on, its bag writer "
+                      "process on the others (as ros2_control's cpu_affinity); -1 leaves "
+                      "both to the operating system",
+                      integer_range=(NO_CPU_AFFINITY, MAX_CPU, 1)),
     )
 
 
@@ -258,6 +267,18 @@ def _flag(values: Mapping[str, Any], name: str) -> bool:
     value = values.get(name)
     if not isinstance(value, bool):
         raise ConfigurationError(name, f"must be true or false, got {describe_value(value)}")
+    return value
+
+
+def _cpu(values: Mapping[str, Any]) -> int:
+    value = values.get("cpu_affinity")
+    if (isinstance(value, bool) or not isinstance(value, int)
+            or not NO_CPU_AFFINITY <= value <= MAX_CPU):
+        raise ConfigurationError(
+            "cpu_affinity",
+            f"must be {NO_CPU_AFFINITY} (no pinning) or a CPU number in [0, {MAX_CPU}], got "
+            f"{describe_value(value)}",
+        )
     return value
 
 
@@ -357,6 +378,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     dead_point_warning = _within(values, "diagnostics.dead_point_warning", 0.0, math.pi)
     log_enabled = _flag(values, "log.enabled")
     log_folder = Path(_text(values, "log.folder"))
+    cpu_affinity = _cpu(values)
     blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
     segment_end = alpha_end if blocked_at is None else blocked_at
     travel = abs(segment_end - alpha_start)
@@ -382,6 +404,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         dead_point_warning=dead_point_warning,
         log_enabled=log_enabled,
         log_folder=log_folder,
+        cpu_affinity=cpu_affinity,
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,
         blocked_at=blocked_at,

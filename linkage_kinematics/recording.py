@@ -22,7 +22,7 @@ import functools
 import importlib
 import operator
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Set
 from pathlib import Path
 from typing import Any
 
@@ -331,9 +331,11 @@ class Recorder:
     """Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one),
     written by a BagWriter in a process of its own (bag_writer_process)."""
 
-    def __init__(self, folder: Path, *, metadata: dict[str, str]) -> None:
+    def __init__(
+        self, folder: Path, *, metadata: dict[str, str], cpus: Set[int] | None = None
+    ) -> None:
         try:
-            self._writer = BagWriterProcess(folder, metadata=metadata)
+            self._writer = BagWriterProcess(folder, metadata=metadata, cpus=cpus)
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
         self.bag_path: Path = self._writer.bag_path
@@ -352,6 +354,10 @@ class Recorder:
             )
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
+
+    def run_writer_on(self, cpus: Set[int]) -> None:
+        """Let the bag writer process run only on ``cpus``."""
+        self._writer.run_on(cpus)
 
     def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         """Logs ``data``, a message of ``topic`` encoded by ``encode_cdr``."""

@@ -20,6 +20,8 @@ import rclpy
 from rosgraph_msgs.msg import Clock
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
+from rclpy.parameter import Parameter, parameter_value_to_python
+from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
 
@@ -107,6 +109,19 @@ def run_node(parameters: Mapping[str, Any], domain_id: int, output: Path) -> tup
     finally:
         stop_process(process)
     return status, output.read_text()
+
+
+def bag_writer_pid(node_pid: int) -> int:
+    """The process id of the node's bag writer (bag_writer_process), its child."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            cmdline = (stat.parent / "cmdline").read_bytes()
+        except OSError:
+            continue  # a process that ended meanwhile
+        if int(fields[1]) == node_pid and b"linkage_kinematics.bag_writer_process" in cmdline:
+            return int(stat.parent.name)
+    raise AssertionError(f"no bag writer process under the node (pid {node_pid})")
 
 
 class Listener:
@@ -233,3 +248,21 @@ def configuration_values(**overrides: Any) -> dict[str, Any]:
     """The node's default parameter values (preset 'paper') with ``overrides``, by name; dotted
     names are passed as ``**{"log.enabled": False}``."""
     return {**{spec.name: spec.default for spec in parameter_specs("paper")}, **overrides}
+
+
+def set_parameter(
+    client: AsyncParameterClient, listener: Listener, name: str, value: Any
+) -> tuple[bool, str]:
+    """Set one parameter of the node over its service: (successful, reason)."""
+    future = client.set_parameters([Parameter(name, value=value)])
+    assert listener.spin_until(future.done)
+    (result,) = future.result().results
+    return result.successful, result.reason
+
+
+def get_parameter(client: AsyncParameterClient, listener: Listener, name: str) -> Any:
+    """One parameter's value, got from the node over its service."""
+    future = client.get_parameters([name])
+    assert listener.spin_until(future.done)
+    (value,) = future.result().values
+    return parameter_value_to_python(value)

@@ -87,6 +87,7 @@ ACCEPTED = {
     "diagnostics.dead_point_warning": {"zero"},
     "log.enabled": set(),
     "log.folder": set(),
+    "cpu_affinity": {"zero", "negative"},    # CPU 0; −1 is no pinning; at most 1023
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
 ACCEPTED_IN_CONTEXT = [{"ground_x": 0.0, "ground_y": -1.3}, {"ground_x": 0, "ground_y": -1.3}]
@@ -101,6 +102,7 @@ CONFIGURED = {
     "alpha_end": lambda config: config.alpha_end,
     "diagnostics.min_transmission_angle": lambda config: config.min_transmission_angle,
     "diagnostics.dead_point_warning": lambda config: config.dead_point_warning,
+    "cpu_affinity": lambda config: config.cpu_affinity,
 }
 
 

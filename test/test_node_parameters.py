@@ -28,8 +28,10 @@ from node_process import (
     PROCESS_TIMEOUT,
     Listener,
     configuration_values,
+    get_parameter,
     ros_context,
     run_node,
+    set_parameter,
     start_node,
     stop_process,
 )
@@ -114,7 +116,7 @@ def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
 def test_only_motion_changes_restart_the_motion():
     config = build_configuration(configuration_values())
     display = build_configuration(configuration_values(
-        display_rate_hz=10.0, **{"diagnostics.dead_point_warning": 0.1}))
+        display_rate_hz=10.0, cpu_affinity=0, **{"diagnostics.dead_point_warning": 0.1}))
     faster = build_configuration(configuration_values(omega0=3.0))
     assert not display.restarts_motion(config)
     assert faster.restarts_motion(config)
@@ -145,20 +147,6 @@ def test_unwritable_log_folder_is_a_start_up_error(tmp_path):
     assert blocker.read_text() == ""
 
 
-def _set(client: AsyncParameterClient, listener: Listener, name: str, value) -> tuple[bool, str]:
-    future = client.set_parameters([Parameter(name, value=value)])
-    assert listener.spin_until(future.done)
-    (result,) = future.result().results
-    return result.successful, result.reason
-
-
-def _get(client: AsyncParameterClient, listener: Listener, name: str):
-    future = client.get_parameters([name])
-    assert listener.spin_until(future.done)
-    (value,) = future.result().values
-    return parameter_value_to_python(value)
-
-
 def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
     with ros_context(DOMAIN_ID) as context:
         listener = Listener("parameter_tester", context)
@@ -181,16 +169,16 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
                 "preset": "",              # read-only
             }
             for name, value in rejected.items():
-                before = _get(client, listener, name)
-                successful, reason = _set(client, listener, name, value)
+                before = get_parameter(client, listener, name)
+                successful, reason = set_parameter(client, listener, name, value)
                 assert not successful
                 assert name in reason
-                assert _get(client, listener, name) == before
+                assert get_parameter(client, listener, name) == before
 
             count = len(listener.received["/joint_states"])
             assert listener.spin_until(lambda: len(listener.received["/joint_states"]) > count + 5)
 
-            assert _set(client, listener, "omega0", 4.0) == (True, "")
+            assert set_parameter(client, listener, "omega0", 4.0) == (True, "")
             states = listener.received["/linkage/state"]
             assert listener.spin_until(lambda: states[-1].points[0].velocities[0] == 4.0)
             changed_at = len(states)
@@ -200,7 +188,7 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
 
             listener.subscribe("/robot_description", String, transient_local=True)
             listener.subscribe("/linkage/markers", MarkerArray)
-            assert _set(client, listener, "crank_length", 0.25) == (True, "")
+            assert set_parameter(client, listener, "crank_length", 0.25) == (True, "")
             smaller = FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, PAPER.ground_x)
             descriptions = listener.received["/robot_description"]
             assert listener.spin_until(
@@ -262,10 +250,10 @@ def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change
                 return parameter_value_to_python(value)
 
             assert rate() == 50.0 and isinstance(rate(), float)
-            assert _set(client, listener, "rate_hz", 60) == (True, "")
+            assert set_parameter(client, listener, "rate_hz", 60) == (True, "")
             assert rate() == 60.0 and isinstance(rate(), float)
-            successful, reason = _set(client, listener, "rate_hz", 0)
-            assert not successful and reason == _set(client, listener, "rate_hz", 0.0)[1]
+            successful, reason = set_parameter(client, listener, "rate_hz", 0)
+            assert not successful and reason == set_parameter(client, listener, "rate_hz", 0.0)[1]
 
             # Setting every writable parameter to its current value (as `ros2 param load` of the
             # node's own dump does) restarts nothing: time_from_start keeps counting.

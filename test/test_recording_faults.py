@@ -27,6 +27,7 @@ from node_process import (
     Listener,
     PROCESS_TIMEOUT,
     REPOSITORY,
+    bag_writer_pid,
     ros_context,
     ros_environment,
     run_node,
@@ -109,19 +110,6 @@ def recover(bag: Path) -> subprocess.CompletedProcess:
         [sys.executable, "-m", "linkage_kinematics.replay", "--recover", str(bag)],
         cwd=REPOSITORY, env=ros_environment(35), capture_output=True, text=True, timeout=60,
     )
-
-
-def bag_writer_pid(node_pid: int) -> int:
-    """The process id of the node's bag writer (bag_writer_process), its child."""
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-            cmdline = (stat.parent / "cmdline").read_bytes()
-        except OSError:
-            continue  # a process that ended meanwhile
-        if int(fields[1]) == node_pid and b"linkage_kinematics.bag_writer_process" in cmdline:
-            return int(stat.parent.name)
-    raise AssertionError(f"no bag writer process under the node (pid {node_pid})")
 
 
 def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
