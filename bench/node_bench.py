@@ -305,11 +305,14 @@ def sustained_rate(
     return max(0.0, 1.0 - statistics.mean(windows) / rate), missed
 
 
-def timing_figures(rate: float, seconds: float, domain_base: int) -> dict[str, float]:
-    """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99."""
+def timing_figures(
+    rate: float, seconds: float, domain_base: int, parameters: dict[str, str] | None = None
+) -> dict[str, float]:
+    """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99, of a
+    node with ``parameters`` besides the rate."""
     with tempfile.TemporaryDirectory(prefix="linkage_bench_timing_") as folder:
-        data = observe({"rate_hz": f"{rate:.1f}", "log.folder": folder}, seconds,
-                       domain_base + DOMAIN_TIMING)
+        data = observe({"rate_hz": f"{rate:.1f}", "log.folder": folder, **(parameters or {})},
+                       seconds, domain_base + DOMAIN_TIMING)
     samples = data["received"]["/joint_states"]
     stamps = [stamp for stamp, _ in samples]
     period_ns = 1e9 / rate
@@ -337,7 +340,7 @@ def log_size(seconds: float, domain_base: int) -> tuple[float, float, int]:
     return size / elapsed, size / messages, messages
 
 
-def _rate_text(rate: float | None) -> str:
+def rate_text(rate: float | None) -> str:
     return "none of the rates tried" if rate is None else f"{rate:g} Hz"
 
 
@@ -367,8 +370,8 @@ def run(quick: bool, repetitions: int, domain_base: int) -> str:
               "/diagnostics achieved rate):", "",
               markdown_table(["timer rate", "logging", "ticks missed", "missed deadlines "
                               "(node's count)"], rows), "",
-              f"- highest rate tried with < 1 % missed: {_rate_text(sustained[True])} with "
-              f"logging, {_rate_text(sustained[False])} without", ""]
+              f"- highest rate tried with < 1 % missed: {rate_text(sustained[True])} with "
+              f"logging, {rate_text(sustained[False])} without", ""]
     rows = []
     for rate in (100.0, 1000.0):
         figures = timing_figures(rate, seconds, domain_base)
