@@ -2,9 +2,10 @@
 
 Sections: kinematics (cost per configuration against error), drive (the drive law in time),
 node (the ROS node's tick, rates, jitter, latency and log size), cost (the node's CPU side by
-side with a minimal hand-written rclpy publisher, its highest sustained rate) and memory (the
-node's resident memory over a long 1 kHz run). Every section prints markdown tables for
-docs/benchmarks.md; the kinematics section also draws docs/benchmark_speed_error.png.
+side with a minimal hand-written rclpy publisher, its highest sustained rate with the default
+placement and with cpu_affinity:=0) and memory (the node's resident memory over a long 1 kHz
+run). Every section prints markdown tables for docs/benchmarks.md; the kinematics section also
+draws docs/benchmark_speed_error.png.
 """
 
 from __future__ import annotations
