@@ -2,32 +2,32 @@ from glob import glob
 
 from setuptools import find_packages, setup
 
-package_name = "linkage_kinematics"
+package_name = 'linkage_kinematics'
 
 setup(
     name=package_name,
-    version="0.1.0",
-    packages=find_packages(exclude=["test", "bench"]),
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'bench']),
     data_files=[
-        ("share/ament_index/resource_index/packages", ["resource/" + package_name]),
-        ("share/" + package_name, ["package.xml"]),
-        ("share/" + package_name + "/launch", glob("launch/*.launch.py") + glob("launch/*.launch.xml")),
-        ("share/" + package_name + "/config", glob("config/*.yaml")),
-        ("share/" + package_name + "/urdf", glob("urdf/*.urdf")),
-        ("share/" + package_name + "/foxglove", glob("foxglove/*.json")),
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/launch', glob('launch/*.launch.py') + glob('launch/*.launch.xml')),
+        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/urdf', glob('urdf/*.urdf')),
+        ('share/' + package_name + '/foxglove', glob('foxglove/*.json')),
     ],
-    install_requires=["setuptools", "numpy"],
+    install_requires=['setuptools', 'numpy'],
     zip_safe=True,
-    maintainer="linkage_kinematics maintainers",
-    maintainer_email="linkage-kinematics@example.org",
-    description="Exact kinematics of a planar four-bar linkage, published by a ROS 2 node",
-    license="Apache-2.0",
+    maintainer='linkage_kinematics maintainers',
+    maintainer_email='linkage-kinematics@example.org',
+    description='Exact kinematics of a planar four-bar linkage, published by a ROS 2 node',
+    license='Apache-2.0',
     entry_points={
-        "console_scripts": [
-            "linkage_node = linkage_kinematics.node:main",
-            "linkage-sweep = linkage_kinematics.sweep:main",
-            "linkage-replay = linkage_kinematics.replay:main",
-            "linkage-demo = linkage_kinematics.demo:main",
+        'console_scripts': [
+            'linkage_node = linkage_kinematics.node:main',
+            'linkage-sweep = linkage_kinematics.sweep:main',
+            'linkage-replay = linkage_kinematics.replay:main',
+            'linkage-demo = linkage_kinematics.demo:main',
         ],
     },
 )

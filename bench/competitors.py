@@ -18,7 +18,7 @@ from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import continued_branch, solve_many
 
-QUANTITIES = ("beta", "gamma", "omega_ab", "omega_bc", "omega_dot_ab", "omega_dot_bc")
+QUANTITIES = ('beta', 'gamma', 'omega_ab', 'omega_bc', 'omega_dot_ab', 'omega_dot_bc')
 States = dict[str, list[float]]
 
 
@@ -188,7 +188,7 @@ def scipy_root_states(
             lambda x: loop_residual(linkage, alpha, x[0], x[1]),
             guess,
             jac=lambda x: np.reshape(loop_jacobian(linkage, x[0], x[1]), (2, 2)),
-            method="hybr",
+            method='hybr',
             tol=tolerance,
         )
         guess = solution.x
@@ -241,22 +241,22 @@ def finite_difference_states(
     omega = drive.omega0 + drive.k * alphas
     omega_dot = drive.k * omega
     derivatives = {}
-    for name in ("beta", "gamma"):
+    for name in ('beta', 'gamma'):
         values = getattr(positions, name)
         f0, f1, f2 = values[:size], values[size:2 * size], values[2 * size:]
         first = np.where(central, (f2 - f0) / (2.0 * step),
                          (-3.0 * f0 + 4.0 * f1 - f2) / (2.0 * step))
         second = (f2 - 2.0 * f1 + f0) / step**2
         derivatives[name] = (np.where(central, f1, f0), first, second)
-    beta, beta_1, beta_2 = derivatives["beta"]
-    gamma, gamma_1, gamma_2 = derivatives["gamma"]
+    beta, beta_1, beta_2 = derivatives['beta']
+    gamma, gamma_1, gamma_2 = derivatives['gamma']
     return {
-        "beta": list(beta),
-        "gamma": list(gamma),
-        "omega_ab": list(gamma_1 * omega),
-        "omega_bc": list(-beta_1 * omega),
-        "omega_dot_ab": list(gamma_2 * omega**2 + gamma_1 * omega_dot),
-        "omega_dot_bc": list(-(beta_2 * omega**2 + beta_1 * omega_dot)),
+        'beta': list(beta),
+        'gamma': list(gamma),
+        'omega_ab': list(gamma_1 * omega),
+        'omega_bc': list(-beta_1 * omega),
+        'omega_dot_ab': list(gamma_2 * omega**2 + gamma_1 * omega_dot),
+        'omega_dot_bc': list(-(beta_2 * omega**2 + beta_1 * omega_dot)),
     }
 
 
@@ -274,13 +274,13 @@ class PylinkageModel:
         import pylinkage
 
         self.linkage = linkage
-        self.ground_o = pylinkage.Ground(0.0, 0.0, name="O")
-        self.ground_c = pylinkage.Ground(linkage.ground_x, linkage.ground_y, name="C")
+        self.ground_o = pylinkage.Ground(0.0, 0.0, name='O')
+        self.ground_c = pylinkage.Ground(linkage.ground_x, linkage.ground_y, name='C')
         self.crank = pylinkage.Crank(self.ground_o, linkage.crank_length,
                                      angular_velocity=step, initial_angle=start - math.pi / 2)
         self.pin_b = pylinkage.RRRDyad(self.crank.output, self.ground_c,
                                        distance1=linkage.coupler_length,
-                                       distance2=linkage.rocker_length, name="B")
+                                       distance2=linkage.rocker_length, name='B')
         # start B on the requested branch at the start angle (the paper's: left of A→C)
         placed = minimal_closed_form(linkage.crank_length, linkage.coupler_length,
                                      linkage.rocker_length, linkage.ground_x, linkage.ground_y,
@@ -307,8 +307,8 @@ class PylinkageModel:
         c_x, c_y = self.linkage.ground_x, self.linkage.ground_y
         coupler_x, coupler_y = b_x - a_x, b_y - a_y
         rocker_x, rocker_y = b_x - c_x, b_y - c_y
-        result["beta"].append(atan2(rocker_y, -rocker_x))
-        result["gamma"].append(atan2(coupler_y, coupler_x))
+        result['beta'].append(atan2(rocker_y, -rocker_x))
+        result['gamma'].append(atan2(coupler_y, coupler_x))
         if velocities[3] is None or accelerations[3] is None:
             for name in QUANTITIES[2:]:
                 result[name].append(math.nan)
@@ -319,13 +319,13 @@ class PylinkageModel:
         coupler_squared = coupler_x**2 + coupler_y**2
         rocker_squared = rocker_x**2 + rocker_y**2
         # ω = (r × v)/|r|² about the bar's other end; the centripetal part of a is along r.
-        result["omega_ab"].append((coupler_x * relative_v[1] - coupler_y * relative_v[0])
+        result['omega_ab'].append((coupler_x * relative_v[1] - coupler_y * relative_v[0])
                                   / coupler_squared)
-        result["omega_bc"].append((rocker_x * velocities[3][1] - rocker_y * velocities[3][0])
+        result['omega_bc'].append((rocker_x * velocities[3][1] - rocker_y * velocities[3][0])
                                   / rocker_squared)
-        result["omega_dot_ab"].append((coupler_x * relative_a[1] - coupler_y * relative_a[0])
+        result['omega_dot_ab'].append((coupler_x * relative_a[1] - coupler_y * relative_a[0])
                                       / coupler_squared)
-        result["omega_dot_bc"].append(
+        result['omega_dot_bc'].append(
             (rocker_x * accelerations[3][1] - rocker_y * accelerations[3][0]) / rocker_squared)
 
     def sweep(self, count: int, drive: DriveLaw) -> int:

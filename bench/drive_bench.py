@@ -16,7 +16,7 @@ from mpmath import mp, mpf
 from linkage_kinematics.drive import DriveError, DriveLaw
 from timing import format_seconds, interleaved_medians, markdown_table
 
-LAWS = {"ω = 0.10 + 2.3·α": DriveLaw(0.1, 2.3), "constant ω = 2 rad/s": DriveLaw(2.0)}
+LAWS = {'ω = 0.10 + 2.3·α': DriveLaw(0.1, 2.3), 'constant ω = 2 rad/s': DriveLaw(2.0)}
 RATES_HZ = (10, 100, 1000)
 HOUR_S = 3600.0
 
@@ -61,17 +61,17 @@ def exact_flow(law: DriveLaw, rate: int, ticks: int) -> tuple[float | str, None]
     try:
         return law.alpha_at(0.0, ticks / rate), None
     except DriveError as error:
-        return f"DriveError: {error}", None
+        return f'DriveError: {error}', None
 
 
 def _cell(value: float | str, overflow_tick: int | None, rate: int, exact: mpf) -> str:
     if isinstance(value, str):
-        return value.split(":")[0] + " (overflow)"
+        return value.split(':')[0] + ' (overflow)'
     if overflow_tick is not None:
-        return f"{value} from t = {overflow_tick / rate:.1f} s"
+        return f'{value} from t = {overflow_tick / rate:.1f} s'
     with mp.workdps(50):
         error = abs(mpf(value) - exact)
-        return f"{float(error):.1e} rad ({float(error / abs(exact)):.0e} rel.)"
+        return f'{float(error):.1e} rad ({float(error / abs(exact)):.0e} rel.)'
 
 
 def run(quick: bool, repetitions: int) -> str:
@@ -79,7 +79,7 @@ def run(quick: bool, repetitions: int) -> str:
     rows = []
     for law_name, law in LAWS.items():
         turn = law.time_to(0.0, math.pi / 2)
-        for horizon_name, horizon in (("90° turn", turn), ("1 h", HOUR_S)):
+        for horizon_name, horizon in (('90° turn', turn), ('1 h', HOUR_S)):
             for rate in RATES_HZ:
                 ticks = round(horizon * rate)
                 with mp.workdps(50):
@@ -88,26 +88,26 @@ def run(quick: bool, repetitions: int) -> str:
                 euler = integrate(euler_step, law, rate, ticks)
                 rk4 = integrate(rk4_step, law, rate, ticks)
                 rows.append([
-                    law_name, horizon_name, f"{rate} Hz", str(ticks),
+                    law_name, horizon_name, f'{rate} Hz', str(ticks),
                     mp.nstr(exact, 6),
                     _cell(*flow, rate, exact), _cell(*euler, rate, exact), _cell(*rk4, rate, exact),
                 ])
     accuracy = markdown_table(
-        ["law", "until", "timer", "ticks", "exact α (rad)", "exact flow (alpha_at)",
-         "explicit Euler", "classical RK4"], rows)
-    law = LAWS["ω = 0.10 + 2.3·α"]
+        ['law', 'until', 'timer', 'ticks', 'exact α (rad)', 'exact flow (alpha_at)',
+         'explicit Euler', 'classical RK4'], rows)
+    law = LAWS['ω = 0.10 + 2.3·α']
     ticks = 2000 if quick else 20000
     rate = 1000
     times = interleaved_medians({
-        "exact flow": lambda: _flow_ticks(law, rate, ticks),
-        "explicit Euler": lambda: integrate(euler_step, law, rate, ticks) and ticks,
-        "classical RK4": lambda: integrate(rk4_step, law, rate, ticks) and ticks,
+        'exact flow': lambda: _flow_ticks(law, rate, ticks),
+        'explicit Euler': lambda: integrate(euler_step, law, rate, ticks) and ticks,
+        'classical RK4': lambda: integrate(rk4_step, law, rate, ticks) and ticks,
     }, repetitions)
-    cost = markdown_table(["method", "time per tick (median)", "relative to the exact flow"], [
+    cost = markdown_table(['method', 'time per tick (median)', 'relative to the exact flow'], [
         [name, format_seconds(seconds), f"{seconds / times['exact flow']:.2f}×"]
         for name, seconds in times.items()
     ])
-    return accuracy + "\n\nCost per tick (variable law, 1 kHz ticks from α = 0):\n\n" + cost
+    return accuracy + '\n\nCost per tick (variable law, 1 kHz ticks from α = 0):\n\n' + cost
 
 
 def _flow_ticks(law: DriveLaw, rate: int, ticks: int) -> int:

@@ -18,7 +18,7 @@ from reference import continued_sides, reference_state
 from seed_formulation import seed_state
 from timing import format_error, format_seconds, interleaved_medians, markdown_table
 
-LAWS = {"constant ω = 2 rad/s": DriveLaw(2.0), "ω = 0.10 + 2.3·α": DriveLaw(0.1, 2.3)}
+LAWS = {'constant ω = 2 rad/s': DriveLaw(2.0), 'ω = 0.10 + 2.3·α': DriveLaw(0.1, 2.3)}
 # Closest approach to the dead point: 1e-13 rad, just outside the library's refusal zone (a
 # one-ulp change of α moves the exact accelerations by more than 0.1 % within ~1e-14 rad).
 NEAR_DEAD_CLOSEST = 1e-13
@@ -29,9 +29,9 @@ CHANGE_START = math.radians(80.0)
 # An error this small or smaller is drawn at this height on the log plot (0 cannot be drawn).
 PLOT_FLOOR = 1e-17
 # Label placements (points) that keep the clustered exact methods' labels apart.
-LABEL_OFFSETS = {"solve": (-10, -16), "minimal": (-30, 8), "Newton 1e-08": (-20, 10),
-                 "Newton 1e-12": (4, -14), "root 1e-12": (6, 4), "pylinkage": (6, 6),
-                 "solve_many": (-20, 10), "fsolve": (6, 4), "root 1e-08": (6, -10)}
+LABEL_OFFSETS = {'solve': (-10, -16), 'minimal': (-30, 8), 'Newton 1e-08': (-20, 10),
+                 'Newton 1e-12': (4, -14), 'root 1e-12': (6, 4), 'pylinkage': (6, 6),
+                 'solve_many': (-20, 10), 'fsolve': (6, 4), 'root 1e-08': (6, -10)}
 
 
 @dataclass
@@ -58,7 +58,7 @@ class Method:
     family: str
     states: Callable[[AngleSet, DriveLaw], States]
     workload: Callable[[], int]
-    note: str = ""
+    note: str = ''
 
 
 @dataclass
@@ -92,14 +92,14 @@ def angle_sets(linkage: FourBar, quick: bool) -> dict[str, AngleSet]:
     start_state = solve(PARALLELOGRAM, CHANGE_START, DriveLaw(1.0), 1)
     change_guess = (start_state.gamma, start_state.beta)
     return {
-        "0°–90° sweep": AngleSet(linkage, [float(a) for a in sweep], 0.0, 1,
-                                 [1] * sweep.size, paper_guess, "paper mechanism"),
-        "near the dead point": AngleSet(linkage, near_dead, 0.0, 1, [1] * len(near_dead),
-                                        paper_guess, "paper mechanism"),
-        "through a change point": AngleSet(
+        '0°–90° sweep': AngleSet(linkage, [float(a) for a in sweep], 0.0, 1,
+                                 [1] * sweep.size, paper_guess, 'paper mechanism'),
+        'near the dead point': AngleSet(linkage, near_dead, 0.0, 1, [1] * len(near_dead),
+                                        paper_guess, 'paper mechanism'),
+        'through a change point': AngleSet(
             PARALLELOGRAM, through_change, CHANGE_START, 1,
             continued_sides(PARALLELOGRAM, CHANGE_START, 1, through_change), change_guess,
-            "crossed parallelogram"),
+            'crossed parallelogram'),
     }
 
 
@@ -123,7 +123,7 @@ def measure_errors(
     position = rate = acceleration = 0.0
     missing = 0
     per_point = [0.0] * len(sets[set_name].alphas)
-    provided = QUANTITIES[:2] if method.note == "no rates" else QUANTITIES
+    provided = QUANTITIES[:2] if method.note == 'no rates' else QUANTITIES
     with mp.workdps(30):
         for law_name, law in LAWS.items():
             states = method.states(sets[set_name], law)
@@ -134,13 +134,13 @@ def measure_errors(
                     per_point[index] = math.inf
                     continue
                 angle_error = max(
-                    float(abs(_wrap(mpf(values[name]) - exact[name]))) for name in ("beta", "gamma")
+                    float(abs(_wrap(mpf(values[name]) - exact[name]))) for name in ('beta', 'gamma')
                 )
                 rate_error = acceleration_error = 0.0
-                if method.note != "no rates":
-                    rate_error = _relative(values, exact, ("omega_ab", "omega_bc"))
+                if method.note != 'no rates':
+                    rate_error = _relative(values, exact, ('omega_ab', 'omega_bc'))
                     acceleration_error = _relative(values, exact,
-                                                   ("omega_dot_ab", "omega_dot_bc"))
+                                                   ('omega_dot_ab', 'omega_dot_bc'))
                 position = max(position, angle_error)
                 rate = max(rate, rate_error)
                 acceleration = max(acceleration, acceleration_error)
@@ -162,7 +162,7 @@ def _relative(values: dict[str, float], exact: dict[str, mpf], names: tuple[str,
 
 def methods(linkage: FourBar, quick: bool) -> list[Method]:
     """Every method and setting, each with a timing workload on the seed's sweep."""
-    variable = LAWS["ω = 0.10 + 2.3·α"]
+    variable = LAWS['ω = 0.10 + 2.3·α']
     scalar_count = 3000 if quick else 10000
     vector_count = 200_000 if quick else 1_000_000
     iterative_count = 200 if quick else 500
@@ -216,41 +216,41 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
         return len(scalar_alphas)
 
     result = [
-        Method("closed form, scalar: kinematics.solve", "closed form (this library)",
+        Method('closed form, scalar: kinematics.solve', 'closed form (this library)',
                library_states, library_loop),
-        Method("closed form, vectorised: kinematics.solve_many", "closed form (this library)",
+        Method('closed form, vectorised: kinematics.solve_many', 'closed form (this library)',
                library_many_states,
                lambda: (solve_many(linkage, sweep, variable), sweep.size)[1]),
-        Method("minimal hand-written closed form (bench code, no checks, tuple out)",
-               "closed form (bench yardstick)",
+        Method('minimal hand-written closed form (bench code, no checks, tuple out)',
+               'closed form (bench yardstick)',
                lambda angle_set, drive: competitors.minimal_states(
                    angle_set.linkage, angle_set.alphas, drive, angle_set.sides),
                minimal_loop),
-        Method("seed paper's Eqs. (2)–(19)", "seed formulation",
+        Method("seed paper's Eqs. (2)–(19)", 'seed formulation',
                lambda angle_set, drive: _seed_states(angle_set, drive),
                scalar_loop(lambda alpha: seed_state(linkage, alpha, variable), scalar_alphas)),
     ]
     for tolerance in (1e-4, 1e-8, 1e-12):
         result.append(Method(
-            f"Newton on the loop equations, step size < {tolerance:g}", "generic solver",
+            f'Newton on the loop equations, step size < {tolerance:g}', 'generic solver',
             continued(competitors.newton_states, tolerance),
             lambda tolerance=tolerance: len(competitors.newton_states(
-                linkage, iterative_alphas, variable, tolerance, start)["beta"])))
+                linkage, iterative_alphas, variable, tolerance, start)['beta'])))
     for tolerance in (1e-4, 1e-8, 1e-12):
         result.append(Method(
-            f"scipy.optimize.root (hybr, analytic Jacobian), tol = {tolerance:g}",
-            "generic solver",
+            f'scipy.optimize.root (hybr, analytic Jacobian), tol = {tolerance:g}',
+            'generic solver',
             continued(competitors.scipy_root_states, tolerance),
             lambda tolerance=tolerance: len(competitors.scipy_root_states(
-                linkage, iterative_alphas, variable, tolerance, start)["beta"])))
+                linkage, iterative_alphas, variable, tolerance, start)['beta'])))
     result.append(Method(
-        "scipy.optimize.fsolve, defaults", "generic solver",
+        'scipy.optimize.fsolve, defaults', 'generic solver',
         continued(competitors.fsolve_states),
         lambda: len(competitors.fsolve_states(linkage, iterative_alphas, variable,
-                                              start)["beta"])))
+                                              start)['beta'])))
     for step in (1e-2, 1e-4, 1e-6, 1e-8):
         result.append(Method(
-            f"finite differences of exact positions, h = {step:g} rad", "finite differences",
+            f'finite differences of exact positions, h = {step:g} rad', 'finite differences',
             lambda angle_set, drive, step=step: competitors.finite_difference_states(
                 angle_set.linkage, np.array(angle_set.alphas), drive, step, angle_set.start,
                 angle_set.branch),
@@ -269,7 +269,7 @@ def _library_branches(angle_set: AngleSet) -> list[int]:
 def _seed_states(angle_set: AngleSet, drive: DriveLaw) -> States:
     """The seed's equations hold for its own mechanism only (OA = BC, C level with O, the
     α = 0 start): no result for another linkage."""
-    if angle_set.linkage != preset("paper").geometry:
+    if angle_set.linkage != preset('paper').geometry:
         return {name: [math.nan] * len(angle_set.alphas) for name in QUANTITIES}
     rows = [seed_state(angle_set.linkage, alpha, drive) for alpha in angle_set.alphas]
     return {name: [row[name] for row in rows] for name in QUANTITIES}
@@ -279,11 +279,11 @@ def _pylinkage_methods(linkage: FourBar, count: int) -> list[Method]:
     try:
         import pylinkage
     except ImportError as error:
-        print(f"pylinkage is not installed ({error}); its rows are left out")
+        print(f'pylinkage is not installed ({error}); its rows are left out')
         return []
     step = (math.pi / 2) / count
     sweeper = competitors.PylinkageModel(linkage, step)
-    constant = LAWS["constant ω = 2 rad/s"]
+    constant = LAWS['constant ω = 2 rad/s']
 
     def states(angle_set: AngleSet, drive: DriveLaw) -> States:
         # a model per set, assembled at the set's start on its branch
@@ -292,20 +292,20 @@ def _pylinkage_methods(linkage: FourBar, count: int) -> list[Method]:
         return model.states(angle_set.alphas, drive)
 
     return [
-        Method(f"pylinkage {pylinkage.__version__} step_with_derivatives", "other package",
+        Method(f'pylinkage {pylinkage.__version__} step_with_derivatives', 'other package',
                states, lambda: sweeper.sweep(count, constant),
-               "timed on its own constant-ω loop"),
-        Method(f"pylinkage {pylinkage.__version__} step (positions only)", "other package",
+               'timed on its own constant-ω loop'),
+        Method(f'pylinkage {pylinkage.__version__} step (positions only)', 'other package',
                lambda angle_set, drive: {**states(angle_set, drive),
                                          **{name: [math.nan] * len(angle_set.alphas)
                                             for name in QUANTITIES[2:]}},
-               lambda: sweeper.sweep_positions(count), "no rates"),
+               lambda: sweeper.sweep_positions(count), 'no rates'),
     ]
 
 
 def run(quick: bool, repetitions: int) -> tuple[str, dict[str, object]]:
     """Measure, print and return the section's markdown and the figures the goals need."""
-    linkage = preset("paper").geometry
+    linkage = preset('paper').geometry
     sets = angle_sets(linkage, quick)
     reference = references(sets)
     all_methods = methods(linkage, quick)
@@ -315,34 +315,34 @@ def run(quick: bool, repetitions: int) -> tuple[str, dict[str, object]]:
         for set_name in sets
     }
     times = interleaved_medians({m.name: m.workload for m in all_methods}, repetitions)
-    header = ["method", "time / configuration"]
+    header = ['method', 'time / configuration']
     for set_name in sets:
-        header += [f"{set_name}: angles (rad)", "rates (rel.)", "accelerations (rel.)"]
+        header += [f'{set_name}: angles (rad)', 'rates (rel.)', 'accelerations (rel.)']
     rows = []
     for method in all_methods:
-        row = [method.name + (f" ({method.note})" if method.note else ""),
+        row = [method.name + (f' ({method.note})' if method.note else ''),
                format_seconds(times[method.name])]
         for set_name in sets:
             error = errors[(method.name, set_name)]
             cells = [format_error(error.position), format_error(error.rate),
                      format_error(error.acceleration)]
             if error.missing and not math.isnan(error.position):
-                cells[0] += (f" ({error.missing} of {len(sets[set_name].alphas) * len(LAWS)} "
-                             "failed)")
-            if method.note == "no rates":
-                cells[1] = cells[2] = "no rates"
+                cells[0] += (f' ({error.missing} of {len(sets[set_name].alphas) * len(LAWS)} '
+                             'failed)')
+            if method.note == 'no rates':
+                cells[1] = cells[2] = 'no rates'
             row += cells
         rows.append(row)
     table = markdown_table(header, rows)
     figures = _goal_figures(all_methods, errors, times, sets)
-    return table, {"methods": all_methods, "errors": errors, "times": times, "sets": sets,
+    return table, {'methods': all_methods, 'errors': errors, 'times': times, 'sets': sets,
                    **figures}
 
 
 def _goal_figures(all_methods, errors, times, sets) -> dict[str, object]:
-    scalar = "closed form, scalar: kinematics.solve"
-    vector = "closed form, vectorised: kinematics.solve_many"
-    minimal = "minimal hand-written closed form (bench code, no checks, tuple out)"
+    scalar = 'closed form, scalar: kinematics.solve'
+    vector = 'closed form, vectorised: kinematics.solve_many'
+    minimal = 'minimal hand-written closed form (bench code, no checks, tuple out)'
     exactness = {}
     for set_name in sets:
         library = errors[(scalar, set_name)].per_point
@@ -351,7 +351,7 @@ def _goal_figures(all_methods, errors, times, sets) -> dict[str, object]:
             best_other = min(
                 errors[(method.name, set_name)].per_point[index]
                 for method in all_methods
-                if not method.family.startswith("closed form") and method.note != "no rates"
+                if not method.family.startswith('closed form') and method.note != 'no rates'
             )
             worse_by.append((library_error / best_other if best_other > 0.0
                              else (1.0 if library_error == 0.0 else math.inf), index))
@@ -360,10 +360,10 @@ def _goal_figures(all_methods, errors, times, sets) -> dict[str, object]:
                                sum(ratio > 2.0 for ratio, _ in worse_by), len(library),
                                worst_ratio, sets[set_name].alphas[worst_index])
     return {
-        "scalar_over_minimal": times[scalar] / times[minimal],
-        "vector_rate": 1.0 / times[vector],
-        "scalar_time": times[scalar],
-        "exactness": exactness,
+        'scalar_over_minimal': times[scalar] / times[minimal],
+        'vector_rate': 1.0 / times[vector],
+        'scalar_time': times[scalar],
+        'exactness': exactness,
     }
 
 
@@ -371,53 +371,53 @@ def plot(results: dict[str, object], path: str) -> None:
     """Log-log time per configuration against worst error, one panel per angle set."""
     import matplotlib
 
-    matplotlib.use("Agg")
+    matplotlib.use('Agg')
     import matplotlib.pyplot as plt
 
-    sets = results["sets"]
-    markers = {"closed form (this library)": ("o", "tab:green"),
-               "closed form (bench yardstick)": ("s", "tab:olive"),
-               "seed formulation": ("X", "tab:red"),
-               "generic solver": ("^", "tab:blue"),
-               "finite differences": ("v", "tab:purple"),
-               "other package": ("D", "tab:orange")}
+    sets = results['sets']
+    markers = {'closed form (this library)': ('o', 'tab:green'),
+               'closed form (bench yardstick)': ('s', 'tab:olive'),
+               'seed formulation': ('X', 'tab:red'),
+               'generic solver': ('^', 'tab:blue'),
+               'finite differences': ('v', 'tab:purple'),
+               'other package': ('D', 'tab:orange')}
     figure, axes = plt.subplots(1, len(sets), figsize=(17, 6.5), sharey=True)
     for axis, set_name in zip(axes, sets):
         no_result = []
         finite_differences_labelled = False
-        for method in results["methods"]:
-            error = results["errors"][(method.name, set_name)]
+        for method in results['methods']:
+            error = results['errors'][(method.name, set_name)]
             worst = error.worst
-            if method.note == "no rates":
+            if method.note == 'no rates':
                 continue
             if math.isnan(worst):
                 no_result.append(_short_label(method))
                 continue
             marker, colour = markers[method.family]
-            x = results["times"][method.name]
+            x = results['times'][method.name]
             y = max(worst, PLOT_FLOOR)
-            axis.loglog(x, y, marker=marker, color=colour, markersize=9, linestyle="none",
+            axis.loglog(x, y, marker=marker, color=colour, markersize=9, linestyle='none',
                         label=method.family)
             label = _short_label(method)
-            if method.family == "finite differences" and worst > 0.1 and set_name != "0°–90° sweep":
+            if method.family == 'finite differences' and worst > 0.1 and set_name != '0°–90° sweep':
                 # every step size fails here; one label for the overlapping markers
                 if finite_differences_labelled:
                     continue
-                label, finite_differences_labelled = "FD, every h", True
+                label, finite_differences_labelled = 'FD, every h', True
             offset = LABEL_OFFSETS.get(label, (6, 4))
-            axis.annotate(label, (x, y), textcoords="offset points", xytext=offset, fontsize=8)
+            axis.annotate(label, (x, y), textcoords='offset points', xytext=offset, fontsize=8)
         if no_result:
-            axis.text(0.03, 0.97, "no result: " + ", ".join(no_result), transform=axis.transAxes,
-                      va="top", fontsize=9)
-        axis.set_title(f"{set_name}\n({sets[set_name].title}, both drive laws)", fontsize=10)
-        axis.set_xlabel("time per configuration (s), median")
-        axis.grid(True, which="major", alpha=0.4)
+            axis.text(0.03, 0.97, 'no result: ' + ', '.join(no_result), transform=axis.transAxes,
+                      va='top', fontsize=9)
+        axis.set_title(f'{set_name}\n({sets[set_name].title}, both drive laws)', fontsize=10)
+        axis.set_xlabel('time per configuration (s), median')
+        axis.grid(True, which='major', alpha=0.4)
         axis.set_xlim(3e-8, 3e-3)
-    axes[0].set_ylabel("max error: angles (rad), rates and accelerations (relative)")
+    axes[0].set_ylabel('max error: angles (rad), rates and accelerations (relative)')
     handles, labels = axes[0].get_legend_handles_labels()
     unique = dict(zip(labels, handles))
-    figure.legend(unique.values(), unique.keys(), loc="lower center", ncol=6, fontsize=9)
-    figure.suptitle("Speed against error (lower left is better; errors of 0 drawn at 1e-17)")
+    figure.legend(unique.values(), unique.keys(), loc='lower center', ncol=6, fontsize=9)
+    figure.suptitle('Speed against error (lower left is better; errors of 0 drawn at 1e-17)')
     figure.tight_layout(rect=(0, 0.06, 1, 0.96))
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -426,41 +426,41 @@ def plot(results: dict[str, object], path: str) -> None:
 def _short_label(method: Method) -> str:
     name = method.name
     replacements = {
-        "closed form, scalar: kinematics.solve": "solve",
-        "closed form, vectorised: kinematics.solve_many": "solve_many",
-        "minimal hand-written closed form (bench code, no checks, tuple out)": "minimal",
-        "seed paper's Eqs. (2)–(19)": "seed Eqs.",
-        "scipy.optimize.fsolve, defaults": "fsolve",
+        'closed form, scalar: kinematics.solve': 'solve',
+        'closed form, vectorised: kinematics.solve_many': 'solve_many',
+        'minimal hand-written closed form (bench code, no checks, tuple out)': 'minimal',
+        "seed paper's Eqs. (2)–(19)": 'seed Eqs.',
+        'scipy.optimize.fsolve, defaults': 'fsolve',
     }
     if name in replacements:
         return replacements[name]
-    if name.startswith("Newton"):
-        return "Newton " + name.rsplit("< ", 1)[1]
-    if name.startswith("scipy.optimize.root"):
-        return "root " + name.rsplit("= ", 1)[1]
-    if name.startswith("finite"):
-        return "FD h=" + name.split("h = ")[1].split(" ")[0]
-    if name.startswith("pylinkage"):
-        return "pylinkage" + (" (pos.)" if "positions" in name else "")
+    if name.startswith('Newton'):
+        return 'Newton ' + name.rsplit('< ', 1)[1]
+    if name.startswith('scipy.optimize.root'):
+        return 'root ' + name.rsplit('= ', 1)[1]
+    if name.startswith('finite'):
+        return 'FD h=' + name.split('h = ')[1].split(' ')[0]
+    if name.startswith('pylinkage'):
+        return 'pylinkage' + (' (pos.)' if 'positions' in name else '')
     return name
 
 
 def goals(results: dict[str, object]) -> str:
     """The kinematics goals, each with its measured figure."""
-    ratio = results["scalar_over_minimal"]
-    rate = results["vector_rate"]
+    ratio = results['scalar_over_minimal']
+    rate = results['vector_rate']
     lines = [
         f"- scalar path: {format_seconds(results['scalar_time'])} per configuration, "
-        f"{ratio:.2f}× the minimal hand-written closed form (goal ≤ 1.5×: "
+        f'{ratio:.2f}× the minimal hand-written closed form (goal ≤ 1.5×: '
         f"{'met' if ratio <= 1.5 else 'missed'})",
-        f"- vectorised path: {rate / 1e6:.1f} million configurations per second on "
-        f"a 0°–90° sweep (goal ≥ 5: "
+        f'- vectorised path: {rate / 1e6:.1f} million configurations per second on '
+        f'a 0°–90° sweep (goal ≥ 5: '
         f"{'met' if rate >= 5e6 else 'missed'})",
     ]
-    for set_name, (better, much_better, total, worst, alpha) in results["exactness"].items():
+    for set_name, (better, much_better, total, worst, alpha) in results['exactness'].items():
         lines.append(
-            f"- {set_name}: some other method is more exact than the closed form at {better} "
+            f'- {set_name}: some other method is more exact than the closed form at {better} '
             f"of {total} angles, by more than 2× at {much_better}; at worst the closed form's "
             f"error is {worst:.2g}× the best other method's (α = {math.degrees(alpha):.9f}°); "
-            "per angle: the worst of angles, rates and accelerations over both laws")
-    return "\n".join(lines)
+            'per angle: the worst of angles, rates and accelerations over both laws')
+    return '\n'.join(lines)

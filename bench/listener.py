@@ -24,7 +24,7 @@ from sensor_msgs.msg import JointState
 def main(argv: list[str]) -> int:
     output, seconds, *topics = argv
     rclpy.init()
-    node = rclpy.create_node("bench_listener")
+    node = rclpy.create_node('bench_listener')
     received: dict[str, list[tuple[int, int]]] = {topic: [] for topic in topics}
     diagnostics: list[dict[str, str]] = []
     matched: set[str] = set()
@@ -42,7 +42,7 @@ def main(argv: list[str]) -> int:
         return callback
 
     def on_diagnostics(message: DiagnosticArray) -> None:
-        matched.add("/diagnostics")
+        matched.add('/diagnostics')
         if recording:
             for status in message.status:
                 diagnostics.append({value.key: value.value for value in status.values})
@@ -50,24 +50,24 @@ def main(argv: list[str]) -> int:
     # Depth matches the node's publishers; a slow listener then drops, it does not stall them.
     for topic in topics:
         node.create_subscription(JointState, topic, on_state(topic), QoSProfile(depth=10))
-    node.create_subscription(DiagnosticArray, "/diagnostics", on_diagnostics, QoSProfile(depth=10))
+    node.create_subscription(DiagnosticArray, '/diagnostics', on_diagnostics, QoSProfile(depth=10))
     executor = SingleThreadedExecutor()
     executor.add_node(node)
-    print("listening", flush=True)
+    print('listening', flush=True)
     give_up = time.monotonic() + 30.0
-    awaited = set(topics) or {"/diagnostics"}
+    awaited = set(topics) or {'/diagnostics'}
     while not awaited <= matched and time.monotonic() < give_up:
         executor.spin_once(timeout_sec=0.05)
     recording = True
     deadline = time.monotonic() + float(seconds)
     while time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.05)
-    with open(output, "w", encoding="utf-8") as file:
-        json.dump({"received": received, "diagnostics": diagnostics}, file)
+    with open(output, 'w', encoding='utf-8') as file:
+        json.dump({'received': received, 'diagnostics': diagnostics}, file)
     node.destroy_node()
     rclpy.try_shutdown()
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main(sys.argv[1:]))

@@ -23,13 +23,13 @@ from rclpy.experimental import EventsExecutor
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 
-EXECUTORS = {"single": SingleThreadedExecutor, "events": EventsExecutor}
+EXECUTORS = {'single': SingleThreadedExecutor, 'events': EventsExecutor}
 
 
 class MinimalPublisher(Node):
     def __init__(self, rate_hz: float) -> None:
-        super().__init__("bench_minimal_publisher")
-        self._publisher = self.create_publisher(JointState, "/bench/joint_states", 10)
+        super().__init__('bench_minimal_publisher')
+        self._publisher = self.create_publisher(JointState, '/bench/joint_states', 10)
         self._ticks = 0
         self._period = 1.0 / rate_hz
         self.create_timer(self._period, self._tick)
@@ -39,7 +39,7 @@ class MinimalPublisher(Node):
         self._ticks += 1
         message = JointState()
         message.header.stamp = self.get_clock().now().to_msg()
-        message.name = ["crank_joint", "coupler_joint", "rocker_joint"]
+        message.name = ['crank_joint', 'coupler_joint', 'rocker_joint']
         message.position = [angle, math.sin(angle), math.cos(angle)]
         message.velocity = [1.0, math.cos(angle), -math.sin(angle)]
         self._publisher.publish(message)
@@ -47,13 +47,13 @@ class MinimalPublisher(Node):
 
 def main(argv: list[str]) -> int:
     rate_hz = float(argv[0])
-    executor_name = argv[1] if len(argv) > 1 else "single"
+    executor_name = argv[1] if len(argv) > 1 else 'single'
     rclpy.init()
     node = MinimalPublisher(rate_hz)
     executor = EXECUTORS[executor_name]()
     executor.add_node(node)
     try:
-        if executor_name == "single":
+        if executor_name == 'single':
             executor.spin()
         else:
             while rclpy.ok():
@@ -66,5 +66,5 @@ def main(argv: list[str]) -> int:
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main(sys.argv[1:]))

@@ -22,7 +22,7 @@ from typing import Any
 from timing import format_seconds, interleaved_medians, markdown_table
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-LISTENER = pathlib.Path(__file__).resolve().parent / "listener.py"
+LISTENER = pathlib.Path(__file__).resolve().parent / 'listener.py'
 # Each kind of run has its own ROS_DOMAIN_ID (the base given to run() plus this offset), so that
 # none sees another's nodes.
 DOMAIN_SPLIT, DOMAIN_RATE, DOMAIN_TIMING, DOMAIN_LOG, DOMAIN_MEMORY = range(5)
@@ -32,17 +32,17 @@ STARTUP_S = 4.0  # time for a node process to start, discover and settle before 
 def ros_environment(domain: int) -> dict[str, str]:
     environment = dict(os.environ)
     environment.update({
-        "ROS_DOMAIN_ID": str(domain),
-        "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
-        "AMENT_PREFIX_PATH": os.environ.get("AMENT_PREFIX_PATH", sys.prefix),
+        'ROS_DOMAIN_ID': str(domain),
+        'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST',
+        'AMENT_PREFIX_PATH': os.environ.get('AMENT_PREFIX_PATH', sys.prefix),
     })
     return environment
 
 
 def start_node(parameters: dict[str, str], domain: int) -> subprocess.Popen:
-    arguments = [sys.executable, "-m", "linkage_kinematics.node", "--ros-args"]
+    arguments = [sys.executable, '-m', 'linkage_kinematics.node', '--ros-args']
     for name, value in parameters.items():
-        arguments += ["-p", f"{name}:={value}"]
+        arguments += ['-p', f'{name}:={value}']
     return subprocess.Popen(arguments, cwd=ROOT, env=ros_environment(domain),
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
@@ -59,7 +59,7 @@ def stop(process: subprocess.Popen) -> None:
 
 
 def listen(seconds: float, topics: list[str], domain: int) -> tuple[subprocess.Popen, str]:
-    output = tempfile.mktemp(suffix=".json", prefix="linkage_bench_")
+    output = tempfile.mktemp(suffix='.json', prefix='linkage_bench_')
     process = subprocess.Popen([sys.executable, str(LISTENER), output, str(seconds), *topics],
                                cwd=ROOT, env=ros_environment(domain),
                                stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
@@ -69,7 +69,7 @@ def listen(seconds: float, topics: list[str], domain: int) -> tuple[subprocess.P
 
 def collect(process: subprocess.Popen, output: str) -> dict[str, Any]:
     process.wait(timeout=120)
-    with open(output, encoding="utf-8") as file:
+    with open(output, encoding='utf-8') as file:
         data = json.load(file)
     os.unlink(output)
     return data
@@ -78,9 +78,9 @@ def collect(process: subprocess.Popen, output: str) -> dict[str, Any]:
 def with_children(pid: int) -> list[int]:
     """``pid`` and its child processes (a logging node's is its bag writer)."""
     children = []
-    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+    for stat in pathlib.Path('/proc').glob('[0-9]*/stat'):
         try:
-            parent = int(stat.read_text(encoding="ascii").rsplit(")", 1)[1].split()[1])
+            parent = int(stat.read_text(encoding='ascii').rsplit(')', 1)[1].split()[1])
         except (OSError, ValueError):
             continue  # a process that ended meanwhile
         if parent == pid:
@@ -92,9 +92,9 @@ def rss_mib(pid: int) -> float:
     """Resident memory of ``pid`` and its children."""
     total = 0.0
     for process in with_children(pid):
-        with open(f"/proc/{process}/status", encoding="utf-8") as status:
+        with open(f'/proc/{process}/status', encoding='utf-8') as status:
             total += next(int(line.split()[1]) for line in status
-                          if line.startswith("VmRSS:")) / 1024.0
+                          if line.startswith('VmRSS:')) / 1024.0
     return total
 
 
@@ -104,11 +104,11 @@ def bag_figures(folder: pathlib.Path) -> tuple[int, int]:
 
     bags = [path for path in folder.iterdir() if path.is_dir()]
     if len(bags) != 1:
-        raise RuntimeError(f"expected one bag in {folder}, found {len(bags)}")
+        raise RuntimeError(f'expected one bag in {folder}, found {len(bags)}')
     size = sum(path.stat().st_size for path in bags[0].iterdir())
     messages = 0
-    for path in bags[0].glob("*.mcap"):
-        with open(path, "rb") as file:
+    for path in bags[0].glob('*.mcap'):
+        with open(path, 'rb') as file:
             summary = make_reader(file).get_summary()
             messages += summary.statistics.message_count
     return size, messages
@@ -119,9 +119,9 @@ def bag_figures(folder: pathlib.Path) -> tuple[int, int]:
 def memory_run(minutes: float, domain_base: int) -> str:
     """Resident memory of a 1 kHz node, logging on, with its bag writer, from start to
     ``minutes`` later."""
-    with tempfile.TemporaryDirectory(prefix="linkage_bench_memory_") as folder:
-        node = start_node({"rate_hz": "1000.0", "end_behavior": "loop",
-                           "log.folder": folder}, domain_base + DOMAIN_MEMORY)
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_memory_') as folder:
+        node = start_node({'rate_hz': '1000.0', 'end_behavior': 'loop',
+                           'log.folder': folder}, domain_base + DOMAIN_MEMORY)
         try:
             time.sleep(STARTUP_S)
             start = time.monotonic()
@@ -130,21 +130,21 @@ def memory_run(minutes: float, domain_base: int) -> str:
             while time.monotonic() - start < minutes * 60.0:
                 time.sleep(interval)
                 if node.poll() is not None:
-                    raise RuntimeError(f"the node exited early: {node.stderr.read()}")
+                    raise RuntimeError(f'the node exited early: {node.stderr.read()}')
                 samples.append((time.monotonic() - start, rss_mib(node.pid)))
         finally:
             stop(node)
         size, messages = bag_figures(pathlib.Path(folder))
     elapsed = samples[-1][0]
     half = [rss for seconds, rss in samples if seconds >= elapsed / 2.0]
-    rows = [[f"{seconds:.0f} s", f"{rss:.1f} MiB"] for seconds, rss in samples]
-    table = markdown_table(["time since start (after {:.0f} s warm-up)".format(STARTUP_S),
-                            "resident memory (node + bag writer)"], rows)
+    rows = [[f'{seconds:.0f} s', f'{rss:.1f} MiB'] for seconds, rss in samples]
+    table = markdown_table(['time since start (after {:.0f} s warm-up)'.format(STARTUP_S),
+                            'resident memory (node + bag writer)'], rows)
     return (
-        f"{table}\n\nResident memory: {samples[0][1]:.1f} MiB at start, {samples[-1][1]:.1f} MiB "
-        f"after {elapsed / 60.0:.1f} min (growth {samples[-1][1] - samples[0][1]:+.1f} MiB; "
+        f'{table}\n\nResident memory: {samples[0][1]:.1f} MiB at start, {samples[-1][1]:.1f} MiB '
+        f'after {elapsed / 60.0:.1f} min (growth {samples[-1][1] - samples[0][1]:+.1f} MiB; '
         f"{max(half) - min(half):.1f} MiB spread over the second half). The run's log: "
-        f"{size / 1e6:.1f} MB, {messages} messages, {size / (elapsed + STARTUP_S) / 1e3:.0f} kB/s."
+        f'{size / 1e6:.1f} MB, {messages} messages, {size / (elapsed + STARTUP_S) / 1e3:.0f} kB/s.'
     )
 
 
@@ -167,23 +167,23 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     from linkage_kinematics.node import LinkageNode
 
     count = 300 if quick else 1500
-    listener, output = listen(60.0, ["/joint_states", "/bench/joint_states"],
+    listener, output = listen(60.0, ['/joint_states', '/bench/joint_states'],
                               domain_base + DOMAIN_SPLIT)
-    with tempfile.TemporaryDirectory(prefix="linkage_bench_split_") as folder:
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_split_') as folder:
         rclpy.init()
         nodes = []
         try:
             logging_node = LinkageNode(parameter_overrides=[
-                Parameter("rate_hz", value=1000.0), Parameter("end_behavior", value="loop"),
-                Parameter("log.folder", value=folder)])
+                Parameter('rate_hz', value=1000.0), Parameter('end_behavior', value='loop'),
+                Parameter('log.folder', value=folder)])
             nodes.append(logging_node)
             quiet_node = LinkageNode(parameter_overrides=[
-                Parameter("rate_hz", value=1000.0), Parameter("end_behavior", value="loop"),
-                Parameter("log.enabled", value=False)])
+                Parameter('rate_hz', value=1000.0), Parameter('end_behavior', value='loop'),
+                Parameter('log.enabled', value=False)])
             nodes.append(quiet_node)
-            bare_node = rclpy.create_node("bench_bare_publisher")
+            bare_node = rclpy.create_node('bench_bare_publisher')
             nodes.append(bare_node)
-            bare_publisher = bare_node.create_publisher(JointState, "/bench/joint_states", 10)
+            bare_publisher = bare_node.create_publisher(JointState, '/bench/joint_states', 10)
             config = logging_node.config
             recorder = logging_node._recorder
             publishers = logging_node._topic_publishers
@@ -219,14 +219,14 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
 
             def publish() -> int:
                 for _ in range(count):
-                    publishers["/joint_states"].publish(joint_state_data)
-                    publishers["/linkage/state"].publish(trajectory_data)
+                    publishers['/joint_states'].publish(joint_state_data)
+                    publishers['/linkage/state'].publish(trajectory_data)
                 return count
 
             def record() -> int:
                 for index in range(count):
-                    recorder.record("/joint_states", joint_state_data, index)
-                    recorder.record("/linkage/state", trajectory_data, index)
+                    recorder.record('/joint_states', joint_state_data, index)
+                    recorder.record('/linkage/state', trajectory_data, index)
                 return count
 
             def tick(node: LinkageNode) -> int:
@@ -240,14 +240,14 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
                 return count
 
             parts = {
-                "compute: sample_at_time + solve_sample (kinematics.solve)": compute,
-                "  of which kinematics.solve alone": solve_only,
+                'compute: sample_at_time + solve_sample (kinematics.solve)': compute,
+                '  of which kinematics.solve alone': solve_only,
                 "encode: the node's encoders of both messages, with clock.now()": encode,
-                "publish: both encoded messages": publish,
-                "log: Recorder.record of both encoded messages": record,
-                "whole tick, logging on (LinkageNode._tick)": lambda: tick(logging_node),
-                "whole tick, logging off (LinkageNode._tick)": lambda: tick(quiet_node),
-                "bare rclpy publish of the same JointState": bare,
+                'publish: both encoded messages': publish,
+                'log: Recorder.record of both encoded messages': record,
+                'whole tick, logging on (LinkageNode._tick)': lambda: tick(logging_node),
+                'whole tick, logging off (LinkageNode._tick)': lambda: tick(quiet_node),
+                'bare rclpy publish of the same JointState': bare,
             }
             times = interleaved_medians(parts, repetitions)
         finally:
@@ -259,10 +259,10 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     stop(listener)
     if os.path.exists(output):
         os.unlink(output)
-    bare_time = times["bare rclpy publish of the same JointState"]
-    rows = [[name, format_seconds(seconds), f"{seconds / bare_time:.2f}×"]
+    bare_time = times['bare rclpy publish of the same JointState']
+    rows = [[name, format_seconds(seconds), f'{seconds / bare_time:.2f}×']
             for name, seconds in times.items()]
-    table = markdown_table(["part of a tick", "time (median)", "× bare publish"], rows)
+    table = markdown_table(['part of a tick', 'time (median)', '× bare publish'], rows)
     return table, times
 
 
@@ -274,10 +274,10 @@ def _percentile(values: list[float], fraction: float) -> float:
 
 
 def observe(parameters: dict[str, str], seconds: float, domain: int,
-            topics: tuple[str, ...] | list[str] = ("/joint_states",)) -> dict[str, Any]:
+            topics: tuple[str, ...] | list[str] = ('/joint_states',)) -> dict[str, Any]:
     """Run a node with ``parameters`` and a listener on /diagnostics and ``topics`` for
     ``seconds``."""
-    node = start_node({"end_behavior": "loop", **parameters}, domain)
+    node = start_node({'end_behavior': 'loop', **parameters}, domain)
     try:
         time.sleep(STARTUP_S)
         listener, output = listen(seconds, list(topics), domain)
@@ -292,14 +292,14 @@ def sustained_rate(
 ) -> tuple[float, int]:
     """Fraction of ticks missed (1 − achieved/requested over the node's diagnostics windows
     after the first) and the node's missed-deadline count."""
-    with tempfile.TemporaryDirectory(prefix="linkage_bench_rate_") as folder:
-        data = observe({"rate_hz": f"{rate:.1f}", "log.enabled": str(logging).lower(),
-                        "log.folder": folder}, seconds, domain_base + DOMAIN_RATE)
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_rate_') as folder:
+        data = observe({'rate_hz': f'{rate:.1f}', 'log.enabled': str(logging).lower(),
+                        'log.folder': folder}, seconds, domain_base + DOMAIN_RATE)
     # the first window may still hold the listener's start-up
-    windows = [float(d["achieved rate (Hz)"]) for d in data["diagnostics"]
-               if "achieved rate (Hz)" in d][1:]
-    missed = max((int(d["missed deadlines"]) for d in data["diagnostics"]
-                  if "missed deadlines" in d), default=-1)
+    windows = [float(d['achieved rate (Hz)']) for d in data['diagnostics']
+               if 'achieved rate (Hz)' in d][1:]
+    missed = max((int(d['missed deadlines']) for d in data['diagnostics']
+                  if 'missed deadlines' in d), default=-1)
     if not windows:
         return math.nan, missed
     return max(0.0, 1.0 - statistics.mean(windows) / rate), missed
@@ -310,10 +310,10 @@ def timing_figures(
 ) -> dict[str, float]:
     """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99, of a
     node with ``parameters`` besides the rate."""
-    with tempfile.TemporaryDirectory(prefix="linkage_bench_timing_") as folder:
-        data = observe({"rate_hz": f"{rate:.1f}", "log.folder": folder, **(parameters or {})},
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_timing_') as folder:
+        data = observe({'rate_hz': f'{rate:.1f}', 'log.folder': folder, **(parameters or {})},
                        seconds, domain_base + DOMAIN_TIMING)
-    samples = data["received"]["/joint_states"]
+    samples = data['received']['/joint_states']
     stamps = [stamp for stamp, _ in samples]
     period_ns = 1e9 / rate
     jitter = [abs((later - earlier) - period_ns) * 1e-9
@@ -321,16 +321,16 @@ def timing_figures(
     latency = [(arrival - stamp) * 1e-9 for stamp, arrival in samples]
     expected = (stamps[-1] - stamps[0]) / period_ns + 1
     return {
-        "received": len(samples), "expected": expected,
-        "jitter_p50": _percentile(jitter, 0.5), "jitter_p99": _percentile(jitter, 0.99),
-        "latency_p50": _percentile(latency, 0.5), "latency_p99": _percentile(latency, 0.99),
+        'received': len(samples), 'expected': expected,
+        'jitter_p50': _percentile(jitter, 0.5), 'jitter_p99': _percentile(jitter, 0.99),
+        'latency_p50': _percentile(latency, 0.5), 'latency_p99': _percentile(latency, 0.99),
     }
 
 
 def log_size(seconds: float, domain_base: int) -> tuple[float, float, int]:
     """(bytes per second, bytes per message, messages) of a run at the default settings."""
-    with tempfile.TemporaryDirectory(prefix="linkage_bench_log_") as folder:
-        node = start_node({"end_behavior": "loop", "log.folder": folder},
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_log_') as folder:
+        node = start_node({'end_behavior': 'loop', 'log.folder': folder},
                           domain_base + DOMAIN_LOG)
         started = time.monotonic()
         time.sleep(seconds)
@@ -341,20 +341,20 @@ def log_size(seconds: float, domain_base: int) -> tuple[float, float, int]:
 
 
 def rate_text(rate: float | None) -> str:
-    return "none of the rates tried" if rate is None else f"{rate:g} Hz"
+    return 'none of the rates tried' if rate is None else f'{rate:g} Hz'
 
 
 def run(quick: bool, repetitions: int, domain_base: int) -> str:
     """The node section as markdown."""
     split, times = tick_split(quick, repetitions, domain_base)
-    with_logging = times["whole tick, logging on (LinkageNode._tick)"]
-    ratio = with_logging / times["bare rclpy publish of the same JointState"]
-    logging_share = with_logging / times["whole tick, logging off (LinkageNode._tick)"]
-    lines = ["Cost per tick (one process; a listener in another process subscribes to "
-             "/joint_states and the bare topic):", "", split, "",
-             f"- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: "
+    with_logging = times['whole tick, logging on (LinkageNode._tick)']
+    ratio = with_logging / times['bare rclpy publish of the same JointState']
+    logging_share = with_logging / times['whole tick, logging off (LinkageNode._tick)']
+    lines = ['Cost per tick (one process; a listener in another process subscribes to '
+             '/joint_states and the bare topic):', '', split, '',
+             f'- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: '
              f"{'met' if ratio <= 2.0 else 'missed'})",
-             f"- whole tick with logging / without = {logging_share:.2f}×", ""]
+             f'- whole tick with logging / without = {logging_share:.2f}×', '']
     seconds = 4.0 if quick else 8.0
     rates = (100.0, 500.0, 1000.0) if quick else (100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0)
     rows = []
@@ -362,29 +362,29 @@ def run(quick: bool, repetitions: int, domain_base: int) -> str:
     for logging in (True, False):
         for rate in rates:
             fraction, missed = sustained_rate(rate, logging, seconds, domain_base)
-            rows.append([f"{rate:g} Hz", "on" if logging else "off",
-                         f"{100.0 * fraction:.2f} %", str(missed)])
+            rows.append([f'{rate:g} Hz', 'on' if logging else 'off',
+                         f'{100.0 * fraction:.2f} %', str(missed)])
             if fraction < 0.01:
                 sustained[logging] = max(sustained[logging] or 0.0, rate)
     lines += [f"Sustained rate ({seconds:g} s per run, missed share from the node's "
-              "/diagnostics achieved rate):", "",
-              markdown_table(["timer rate", "logging", "ticks missed", "missed deadlines "
-                              "(node's count)"], rows), "",
-              f"- highest rate tried with < 1 % missed: {rate_text(sustained[True])} with "
-              f"logging, {rate_text(sustained[False])} without", ""]
+              '/diagnostics achieved rate):', '',
+              markdown_table(['timer rate', 'logging', 'ticks missed', 'missed deadlines '
+                              "(node's count)"], rows), '',
+              f'- highest rate tried with < 1 % missed: {rate_text(sustained[True])} with '
+              f'logging, {rate_text(sustained[False])} without', '']
     rows = []
     for rate in (100.0, 1000.0):
         figures = timing_figures(rate, seconds, domain_base)
-        rows.append([f"{rate:g} Hz", format_seconds(figures["jitter_p50"]),
-                     format_seconds(figures["jitter_p99"]), format_seconds(figures["latency_p50"]),
-                     format_seconds(figures["latency_p99"]),
+        rows.append([f'{rate:g} Hz', format_seconds(figures['jitter_p50']),
+                     format_seconds(figures['jitter_p99']), format_seconds(figures['latency_p50']),
+                     format_seconds(figures['latency_p99']),
                      f"{figures['received']} of {figures['expected']:.0f}"])
-    lines += ["Timer jitter (|interval between header stamps − period|) and latency (listener "
-              "receive time − header stamp, another process), logging on:", "",
-              markdown_table(["rate", "jitter p50", "jitter p99", "latency p50", "latency p99",
-                              "messages received"], rows), ""]
+    lines += ['Timer jitter (|interval between header stamps − period|) and latency (listener '
+              'receive time − header stamp, another process), logging on:', '',
+              markdown_table(['rate', 'jitter p50', 'jitter p99', 'latency p50', 'latency p99',
+                              'messages received'], rows), '']
     per_second, per_message, messages = log_size(seconds + 2.0, domain_base)
-    lines.append(f"Log at the default settings (100 Hz state, 30 Hz markers, 1 Hz "
-                 f"diagnostics): {per_second / 1e3:.1f} kB/s, {per_message:.0f} B per message "
-                 f"({messages} messages in {seconds + 2.0:g} s).")
-    return "\n".join(lines)
+    lines.append(f'Log at the default settings (100 Hz state, 30 Hz markers, 1 Hz '
+                 f'diagnostics): {per_second / 1e3:.1f} kB/s, {per_message:.0f} B per message '
+                 f'({messages} messages in {seconds + 2.0:g} s).')
+    return '\n'.join(lines)

@@ -18,77 +18,77 @@ import time
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 # The high-precision reference lives with the tests; the library is imported from the tree.
-sys.path[1:1] = [str(ROOT), str(ROOT / "test")]
+sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ("kinematics", "drive", "node", "cost", "memory")
+SECTIONS = ('kinematics', 'drive', 'node', 'cost', 'memory')
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true",
-                        help="fewer angles, shorter timings and node runs (about a minute)")
-    parser.add_argument("--repetitions", type=int, default=None,
-                        help="timing repetitions per method (default 7, 5 with --quick)")
-    parser.add_argument("--only", choices=SECTIONS, action="append",
-                        help="run only this section (may be repeated)")
-    parser.add_argument("--plot", default=str(ROOT / "docs" / "benchmark_speed_error.png"),
-                        help="where to write the speed-against-error plot")
-    parser.add_argument("--memory-minutes", type=float, default=None,
+    parser.add_argument('--quick', action='store_true',
+                        help='fewer angles, shorter timings and node runs (about a minute)')
+    parser.add_argument('--repetitions', type=int, default=None,
+                        help='timing repetitions per method (default 7, 5 with --quick)')
+    parser.add_argument('--only', choices=SECTIONS, action='append',
+                        help='run only this section (may be repeated)')
+    parser.add_argument('--plot', default=str(ROOT / 'docs' / 'benchmark_speed_error.png'),
+                        help='where to write the speed-against-error plot')
+    parser.add_argument('--memory-minutes', type=float, default=None,
                         help="length of the node's resident-memory run at 1 kHz "
-                             "(default 10, 0.5 with --quick)")
-    parser.add_argument("--ros-domain", type=int, default=50,
-                        help="first of the five ROS_DOMAIN_IDs the node, cost and memory "
-                             "sections use (default 50, so 50–54)")
+                             '(default 10, 0.5 with --quick)')
+    parser.add_argument('--ros-domain', type=int, default=50,
+                        help='first of the five ROS_DOMAIN_IDs the node, cost and memory '
+                             'sections use (default 50, so 50–54)')
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
-        parser.error("--repetitions must be at least 1")
+        parser.error('--repetitions must be at least 1')
     if not 0 <= arguments.ros_domain <= 228:
-        parser.error("--ros-domain must be between 0 and 228 (five IDs up to 232)")
+        parser.error('--ros-domain must be between 0 and 228 (five IDs up to 232)')
     repetitions = arguments.repetitions or (5 if arguments.quick else 7)
     sections = arguments.only or SECTIONS
     started = time.perf_counter()
-    print(f"machine: {machine_description()}")
+    print(f'machine: {machine_description()}')
     print(f"command: python bench/run.py {' '.join(sys.argv[1:])}".rstrip())
-    if "kinematics" in sections:
+    if 'kinematics' in sections:
         import kinematics_bench
 
         table, results = kinematics_bench.run(arguments.quick, repetitions)
-        print("\n## Kinematics: time per configuration and largest error\n")
+        print('\n## Kinematics: time per configuration and largest error\n')
         print(table)
         print()
         print(kinematics_bench.goals(results))
         kinematics_bench.plot(results, arguments.plot)
-        print(f"\nplot written to {arguments.plot}")
-    if "drive" in sections:
+        print(f'\nplot written to {arguments.plot}')
+    if 'drive' in sections:
         import drive_bench
 
-        print("\n## Drive law in time\n")
+        print('\n## Drive law in time\n')
         print(drive_bench.run(arguments.quick, repetitions))
-    if "node" in sections:
+    if 'node' in sections:
         import node_bench
 
-        print("\n## Node\n")
+        print('\n## Node\n')
         print(node_bench.run(arguments.quick, repetitions, arguments.ros_domain))
-    if "cost" in sections:
+    if 'cost' in sections:
         import cost_bench
 
-        print("\n## Node against a minimal hand-written publisher\n")
+        print('\n## Node against a minimal hand-written publisher\n')
         print(cost_bench.run(arguments.quick, arguments.ros_domain))
-    if "memory" in sections:
+    if 'memory' in sections:
         import node_bench
 
         minutes = arguments.memory_minutes
         if minutes is None:
             minutes = 0.5 if arguments.quick else 10.0
-        print(f"\n## Node memory over {minutes:g} min at 1 kHz\n")
+        print(f'\n## Node memory over {minutes:g} min at 1 kHz\n')
         print(node_bench.memory_run(minutes, arguments.ros_domain))
-    load = ", ".join(f"{value:.2f}" for value in os.getloadavg())
-    print(f"\nbenchmark took {time.perf_counter() - started:.0f} s; load average at the end: "
-          f"{load}")
+    load = ', '.join(f'{value:.2f}' for value in os.getloadavg())
+    print(f'\nbenchmark took {time.perf_counter() - started:.0f} s; load average at the end: '
+          f'{load}')
     return 0
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -32,38 +32,38 @@ def interleaved_medians(
 
 def machine_description() -> str:
     """CPU model, cores, load, Python and numpy versions, for the report."""
-    model = "unknown CPU"
-    with open("/proc/cpuinfo", encoding="utf-8") as cpuinfo:
+    model = 'unknown CPU'
+    with open('/proc/cpuinfo', encoding='utf-8') as cpuinfo:
         for line in cpuinfo:
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
+            if line.startswith('model name'):
+                model = line.split(':', 1)[1].strip()
                 break
-    load = ", ".join(f"{value:.2f}" for value in os.getloadavg())
+    load = ', '.join(f'{value:.2f}' for value in os.getloadavg())
     return (
-        f"{model}, {os.cpu_count()} cores (load average {load}); Linux {platform.release()}; "
-        f"Python {platform.python_version()}, numpy {np.__version__}"
+        f'{model}, {os.cpu_count()} cores (load average {load}); Linux {platform.release()}; '
+        f'Python {platform.python_version()}, numpy {np.__version__}'
     )
 
 
 def format_seconds(seconds: float) -> str:
     """A duration with a unit that keeps 3 significant digits readable."""
     if not math.isfinite(seconds):
-        return "–"
-    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("µs", 1e-6), ("ns", 1e-9)):
-        if seconds >= scale or unit == "ns":
-            return f"{seconds / scale:.3g} {unit}"
-    raise AssertionError("unreachable")
+        return '–'
+    for unit, scale in (('s', 1.0), ('ms', 1e-3), ('µs', 1e-6), ('ns', 1e-9)):
+        if seconds >= scale or unit == 'ns':
+            return f'{seconds / scale:.3g} {unit}'
+    raise AssertionError('unreachable')
 
 
 def format_error(error: float) -> str:
     """An error for a table: NaN becomes 'no result'."""
     if math.isnan(error):
-        return "no result"
-    return f"{error:.1e}"
+        return 'no result'
+    return f'{error:.1e}'
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
     """A GitHub markdown table."""
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    lines += ["| " + " | ".join(row) + " |" for row in rows]
-    return "\n".join(lines)
+    lines = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
+    lines += ['| ' + ' | '.join(row) + ' |' for row in rows]
+    return '\n'.join(lines)

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from mpmath import mpf
 
-sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'test'))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from reference import (  # noqa: E402
@@ -38,9 +38,9 @@ from linkage_kinematics.kinematics import DeadPointError, solve  # noqa: E402
 
 DRIVES = (DriveLaw(2.0), DriveLaw(0.10, 2.3))
 GROUPS = {
-    "angles": ("angle",),
-    "rates": ("angular_rate", "velocity"),
-    "accelerations": ("angular_acceleration", "acceleration"),
+    'angles': ('angle',),
+    'rates': ('angular_rate', 'velocity'),
+    'accelerations': ('angular_acceleration', 'acceleration'),
 }
 
 
@@ -51,20 +51,20 @@ def dead_points(linkage: FourBar) -> list[tuple[mpf, int, str]]:
     found = []
     for end, side in ((low, 1), (high, -1)):
         point = min(points, key=lambda p: abs(math.remainder(float(p) - end, 2 * math.pi)))
-        found.append((point, side, f"{math.degrees(end):.3f}°"))
+        found.append((point, side, f'{math.degrees(end):.3f}°'))
     return found
 
 
 def dead_point_table(rng: random.Random) -> None:
-    paper = PRESETS["paper"].geometry
-    print("paper mechanism, approaching each dead point from its reachable side (worst of 4 δ "
-          "per decade × 2 branches × 2 drive laws)")
+    paper = PRESETS['paper'].geometry
+    print('paper mechanism, approaching each dead point from its reachable side (worst of 4 δ '
+          'per decade × 2 branches × 2 drive laws)')
     for point, side, label in dead_points(paper):
         print()
-        print(f"dead point at {label}")
-        print("| δ (rad) | angles (rad) | rates | accelerations | worst error ÷ input floor "
-              "(angles, rates, accelerations) | solve() refuses |")
-        print("|---|---|---|---|---|---|")
+        print(f'dead point at {label}')
+        print('| δ (rad) | angles (rad) | rates | accelerations | worst error ÷ input floor '
+              '(angles, rates, accelerations) | solve() refuses |')
+        print('|---|---|---|---|---|---|')
         for decade in range(1, 17):
             worst = {group: 0.0 for group in GROUPS}
             ratio = {group: 0.0 for group in GROUPS}
@@ -89,23 +89,23 @@ def dead_point_table(rng: random.Random) -> None:
                                 worst[group] = max(worst[group], errors[kind])
                                 ratio[group] = max(ratio[group], errors[kind] / floor[kind])
             answered = total - refused
-            cells = (" | ".join(f"{worst[group]:.1e}" for group in GROUPS) if answered
-                     else "— | — | —")
-            ratios = (", ".join(f"{ratio[group]:.2g}" for group in GROUPS) if answered else "—")
-            print(f"| 1e-{decade + 1}…1e-{decade} | {cells} | {ratios} | {refused}/{total} |")
+            cells = (' | '.join(f'{worst[group]:.1e}' for group in GROUPS) if answered
+                     else '— | — | —')
+            ratios = (', '.join(f'{ratio[group]:.2g}' for group in GROUPS) if answered else '—')
+            print(f'| 1e-{decade + 1}…1e-{decade} | {cells} | {ratios} | {refused}/{total} |')
 
 
 def change_point_table() -> None:
     linkages = {
-        "parallelogram 0.3/1.0/0.3, C = (1, 0)": FourBar(0.3, 1.0, 0.3, 1.0, 0.0),
-        "kite 0.4/0.4/1, C = (1, 0)": FourBar(0.4, 0.4, 1.0, 1.0, 0.0),
-        "general 0.25/0.75/0.5, C = (0.5, 0)": FourBar(0.25, 0.75, 0.5, 0.5, 0.0),
+        'parallelogram 0.3/1.0/0.3, C = (1, 0)': FourBar(0.3, 1.0, 0.3, 1.0, 0.0),
+        'kite 0.4/0.4/1, C = (1, 0)': FourBar(0.4, 0.4, 1.0, 1.0, 0.0),
+        'general 0.25/0.75/0.5, C = (0.5, 0)': FourBar(0.25, 0.75, 0.5, 0.5, 0.0),
     }
     print()
-    print("change points: worst error over both sides, both assemblies and both drive laws, at "
-          "offsets 1e-1 … 1e-16 rad and on the float nearest each change point")
-    print("| linkage | angles (rad) | rates | accelerations |")
-    print("|---|---|---|---|")
+    print('change points: worst error over both sides, both assemblies and both drive laws, at '
+          'offsets 1e-1 … 1e-16 rad and on the float nearest each change point')
+    print('| linkage | angles (rad) | rates | accelerations |')
+    print('|---|---|---|---|')
     for name, linkage in linkages.items():
         worst = {group: 0.0 for group in GROUPS}
         for point in linkage.reachability.change_points:
@@ -120,9 +120,9 @@ def change_point_table() -> None:
                         for group, kinds in GROUPS.items():
                             for kind in kinds:
                                 worst[group] = max(worst[group], errors[kind])
-        print(f"| {name} | " + " | ".join(f"{worst[group]:.1e}" for group in GROUPS) + " |")
+        print(f'| {name} | ' + ' | '.join(f'{worst[group]:.1e}' for group in GROUPS) + ' |')
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     dead_point_table(random.Random(20261122))
     change_point_table()

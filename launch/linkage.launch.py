@@ -15,17 +15,17 @@ from launch_ros.actions import Node
 
 
 def _start_scenario(context):
-    scenario = LaunchConfiguration("scenario").perform(context)
+    scenario = LaunchConfiguration('scenario').perform(context)
     parameters = os.path.join(
-        get_package_share_directory("linkage_kinematics"), "config", f"seed_{scenario}.yaml"
+        get_package_share_directory('linkage_kinematics'), 'config', f'seed_{scenario}.yaml'
     )
     return [
         Node(
-            package="linkage_kinematics",
-            executable="linkage_node",
-            name="linkage_node",
+            package='linkage_kinematics',
+            executable='linkage_node',
+            name='linkage_node',
             parameters=[parameters],
-            output="screen",
+            output='screen',
         )
     ]
 
@@ -33,11 +33,11 @@ def _start_scenario(context):
 def generate_launch_description() -> LaunchDescription:
     return LaunchDescription([
         DeclareLaunchArgument(
-            "scenario",
-            default_value="constant",
-            choices=["constant", "variable"],
+            'scenario',
+            default_value='constant',
+            choices=['constant', 'variable'],
             description="drive law of the seed's 90° turn: constant (ω = 2 rad/s) or "
-            "variable (ω = 0.10 + 2.3·α)",
+            'variable (ω = 0.10 + 2.3·α)',
         ),
         OpaqueFunction(function=_start_scenario),
     ])

@@ -18,15 +18,15 @@ from linkage_kinematics.parameters import NODE_NAME, mechanism_namespaces
 
 
 def _start_mechanisms(context):
-    parameters_file = LaunchConfiguration("mechanisms").perform(context)
+    parameters_file = LaunchConfiguration('mechanisms').perform(context)
     return [
         Node(
-            package="linkage_kinematics",
-            executable="linkage_node",
+            package='linkage_kinematics',
+            executable='linkage_node',
             name=NODE_NAME,
             namespace=namespace,
             parameters=[parameters_file],
-            output="screen",
+            output='screen',
         )
         for namespace in mechanism_namespaces(parameters_file)
     ]
@@ -34,13 +34,13 @@ def _start_mechanisms(context):
 
 def generate_launch_description() -> LaunchDescription:
     default_file = os.path.join(
-        get_package_share_directory("linkage_kinematics"), "config", "two_mechanisms.yaml"
+        get_package_share_directory('linkage_kinematics'), 'config', 'two_mechanisms.yaml'
     )
     return LaunchDescription([
         DeclareLaunchArgument(
-            "mechanisms",
+            'mechanisms',
             default_value=default_file,
-            description="parameters file with one /<namespace>/linkage_node entry per mechanism",
+            description='parameters file with one /<namespace>/linkage_node entry per mechanism',
         ),
         OpaqueFunction(function=_start_mechanisms),
     ])

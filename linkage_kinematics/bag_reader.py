@@ -31,19 +31,19 @@ from mcap_ros2.decoder import DecoderFactory
 
 from linkage_kinematics.kinematics import LinkageState
 
-STATE_TOPIC = "/linkage/state"
-STATE_TYPE = "trajectory_msgs/msg/JointTrajectory"
+STATE_TOPIC = '/linkage/state'
+STATE_TYPE = 'trajectory_msgs/msg/JointTrajectory'
 STATE_JOINT_NAMES = (
-    "alpha", "beta", "gamma", "pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y",
-    "rocker_angle", "pin_a_arc", "pin_b_arc",
+    'alpha', 'beta', 'gamma', 'pin_a_x', 'pin_a_y', 'pin_b_x', 'pin_b_y',
+    'rocker_angle', 'pin_a_arc', 'pin_b_arc',
 )
 # Bags logged before the rocker angle and the pin arcs were added hold only the first seven
 # coordinates; those map onto LinkageState in the same way, so both read alike.
 SEVEN_STATE_JOINT_NAMES = STATE_JOINT_NAMES[:7]
 _READ_COORDINATES = len(SEVEN_STATE_JOINT_NAMES)
 
-_MAGIC = b"\x89MCAP0\r\n"
-_RECORD_PREFIX = struct.Struct("<BQ")  # opcode, length of the record's content
+_MAGIC = b'\x89MCAP0\r\n'
+_RECORD_PREFIX = struct.Struct('<BQ')  # opcode, length of the record's content
 # Failures of the mcap readers on records that are complete but damaged. lz4 reports a corrupt
 # frame as RuntimeError.
 _CORRUPT_DATA_ERRORS = (McapError, ValueError, struct.error, zstandard.ZstdError, RuntimeError)
@@ -88,7 +88,7 @@ def bag_files(path: str | os.PathLike[str]) -> list[McapFile]:
     """
     bag = Path(path)
     if not bag.exists():
-        raise BagError(f"no bag at {bag}: no such file or folder")
+        raise BagError(f'no bag at {bag}: no such file or folder')
     if bag.is_dir():
         paths = _folder_files(bag)
     else:
@@ -108,7 +108,7 @@ def iter_messages(
         if wanted is None or channel.topic in wanted:
             yield BagMessage(
                 topic=channel.topic,
-                schema_name=schema.name if schema is not None else "",
+                schema_name=schema.name if schema is not None else '',
                 data=message.data,
                 log_time_ns=message.log_time,
                 publish_time_ns=message.publish_time,
@@ -133,18 +133,18 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
         if not channel.topic.endswith(STATE_TOPIC):  # under any namespace
             other_topics.add(channel.topic)
             continue
-        where = f"{STATE_TOPIC} message {len(stamps)} (log time {message.log_time} ns) in {path}"
+        where = f'{STATE_TOPIC} message {len(stamps)} (log time {message.log_time} ns) in {path}'
         if schema is None or schema.name != STATE_TYPE:
-            found = "no schema" if schema is None else f"type {schema.name}"
-            raise BagError(f"{where} has {found}; expected {STATE_TYPE}")
+            found = 'no schema' if schema is None else f'type {schema.name}'
+            raise BagError(f'{where} has {found}; expected {STATE_TYPE}')
         try:
             decode = decoders.decoder_for(channel.message_encoding, schema)
             trajectory = None if decode is None else decode(message.data)
         except _UNDECODABLE_ERRORS as error:
-            raise BagError(f"{where} cannot be decoded: {_one_line(error)}") from None
+            raise BagError(f'{where} cannot be decoded: {_one_line(error)}') from None
         if trajectory is None:
             raise BagError(
-                f"{where} cannot be decoded: message encoding {channel.message_encoding!r} with "
+                f'{where} cannot be decoded: message encoding {channel.message_encoding!r} with '
                 f"schema encoding {schema.encoding!r} (expected 'cdr' and 'ros2msg')"
             )
         point = _state_point(trajectory, where)
@@ -153,8 +153,8 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
         velocities.append(point.velocities[:_READ_COORDINATES])
         accelerations.append(point.accelerations[:_READ_COORDINATES])
     if not stamps:
-        present = ", ".join(sorted(other_topics)) if other_topics else "none"
-        raise BagError(f"{path} holds no {STATE_TOPIC} messages (topics present: {present})")
+        present = ', '.join(sorted(other_topics)) if other_topics else 'none'
+        raise BagError(f'{path} holds no {STATE_TOPIC} messages (topics present: {present})')
     return np.array(stamps, dtype=np.int64), _state_from_columns(
         np.array(positions, dtype=float),
         np.array(velocities, dtype=float),
@@ -164,10 +164,10 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
 
 def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
     """The ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml."""
-    metadata_path = Path(folder) / "metadata.yaml"
+    metadata_path = Path(folder) / 'metadata.yaml'
     try:
-        return yaml.safe_load(metadata_path.read_text(encoding="utf-8"))[
-            "rosbag2_bagfile_information"
+        return yaml.safe_load(metadata_path.read_text(encoding='utf-8'))[
+            'rosbag2_bagfile_information'
         ]
     except (OSError, ValueError, yaml.YAMLError, KeyError, TypeError) as error:
         raise _not_metadata(metadata_path, error) from None
@@ -175,28 +175,28 @@ def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
 
 def _not_metadata(metadata_path: Path, error: BaseException) -> BagError:
     return BagError(
-        f"{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: "
-        f"{_one_line(error)})"
+        f'{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: '
+        f'{_one_line(error)})'
     )
 
 
 def _folder_files(folder: Path) -> list[Path]:
-    metadata_path = folder / "metadata.yaml"
+    metadata_path = folder / 'metadata.yaml'
     if not metadata_path.exists():
-        paths = sorted(folder.glob("*.mcap"))
+        paths = sorted(folder.glob('*.mcap'))
         if not paths:
-            raise BagError(f"{folder} is not a bag: no metadata.yaml and no .mcap file")
+            raise BagError(f'{folder} is not a bag: no metadata.yaml and no .mcap file')
         return paths
     information = bag_information(folder)
     try:
-        storage = information.get("storage_identifier", "mcap")
-        relative_paths = information["relative_file_paths"]
+        storage = information.get('storage_identifier', 'mcap')
+        relative_paths = information['relative_file_paths']
     except (KeyError, TypeError, AttributeError) as error:
         raise _not_metadata(metadata_path, error) from None
-    if storage != "mcap":
-        raise BagError(f"{folder} stores its messages in {storage!r}; only MCAP bags can be read")
+    if storage != 'mcap':
+        raise BagError(f'{folder} stores its messages in {storage!r}; only MCAP bags can be read')
     if not isinstance(relative_paths, list) or not relative_paths:
-        raise BagError(f"{metadata_path} lists no bag files")
+        raise BagError(f'{metadata_path} lists no bag files')
     paths = [folder / str(relative) for relative in relative_paths]
     missing = [str(file_path) for file_path in paths if not file_path.is_file()]
     if missing:
@@ -207,12 +207,12 @@ def _folder_files(folder: Path) -> list[Path]:
 def _scan(file_path: Path) -> McapFile:
     """Walk the record headers to find where the complete records end."""
     try:
-        with open(file_path, "rb") as stream:
+        with open(file_path, 'rb') as stream:
             size = os.fstat(stream.fileno()).st_size
             magic = stream.read(len(_MAGIC))
             if magic != _MAGIC:
-                found = "it is empty" if not magic else f"it starts with {magic[:8]!r}"
-                raise BagError(f"{file_path} is not an MCAP file: {found}")
+                found = 'it is empty' if not magic else f'it starts with {magic[:8]!r}'
+                raise BagError(f'{file_path} is not an MCAP file: {found}')
             offset = len(_MAGIC)
             while offset + _RECORD_PREFIX.size <= size:
                 stream.seek(offset)
@@ -227,7 +227,7 @@ def _scan(file_path: Path) -> McapFile:
                     break
                 offset = end
     except OSError as error:
-        raise BagError(f"cannot read {file_path}: {error.strerror or error}") from None
+        raise BagError(f'cannot read {file_path}: {error.strerror or error}') from None
     return McapFile(file_path, size, offset, complete=False)
 
 
@@ -254,7 +254,7 @@ class _BoundedFile(io.RawIOBase):
 def _iter_records(files: list[McapFile]) -> Iterator[tuple[Optional[Schema], Channel, Message]]:
     for mcap_file in files:
         try:
-            with open(mcap_file.path, "rb") as stream:
+            with open(mcap_file.path, 'rb') as stream:
                 reader = NonSeekingReader(
                     _BoundedFile(stream, mcap_file.readable_size), validate_crcs=True
                 )
@@ -262,16 +262,16 @@ def _iter_records(files: list[McapFile]) -> Iterator[tuple[Optional[Schema], Cha
         except EndOfFile:
             # The readable part of a truncated file ends on a record boundary: nothing is lost.
             if mcap_file.complete:
-                raise BagError(f"{mcap_file.path} is damaged: it ends inside a record") from None
+                raise BagError(f'{mcap_file.path} is damaged: it ends inside a record') from None
         except OSError as error:
-            raise BagError(f"cannot read {mcap_file.path}: {error.strerror or error}") from None
+            raise BagError(f'cannot read {mcap_file.path}: {error.strerror or error}') from None
         except _CORRUPT_DATA_ERRORS as error:
-            raise BagError(f"{mcap_file.path} is damaged: {_one_line(error)}") from None
+            raise BagError(f'{mcap_file.path} is damaged: {_one_line(error)}') from None
 
 
 def _one_line(error: BaseException) -> str:
     """An error's text on one line (YAML and decoder errors span several)."""
-    return " ".join(str(error).split())
+    return ' '.join(str(error).split())
 
 
 def _state_point(trajectory: Any, where: str) -> Any:
@@ -280,18 +280,18 @@ def _state_point(trajectory: Any, where: str) -> Any:
     names = tuple(trajectory.joint_names)
     if names not in (STATE_JOINT_NAMES, SEVEN_STATE_JOINT_NAMES):
         raise BagError(
-            f"{where} has joint_names {list(names)}; expected {list(STATE_JOINT_NAMES)} "
-            f"(or its first seven, as logged before the last three were added)"
+            f'{where} has joint_names {list(names)}; expected {list(STATE_JOINT_NAMES)} '
+            f'(or its first seven, as logged before the last three were added)'
         )
     points = trajectory.points
     if len(points) != 1:
-        raise BagError(f"{where} has {len(points)} points; expected exactly 1")
+        raise BagError(f'{where} has {len(points)} points; expected exactly 1')
     point = points[0]
-    for field in ("positions", "velocities", "accelerations"):
+    for field in ('positions', 'velocities', 'accelerations'):
         count = len(getattr(point, field))
         if count != len(names):
             raise BagError(
-                f"{where} has {count} {field}; expected {len(names)} (one per joint)"
+                f'{where} has {count} {field}; expected {len(names)} (one per joint)'
             )
     return point
 

@@ -34,25 +34,25 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from linkage_kinematics import bag_reader
 
-PACKAGE_NAME = "linkage_kinematics"
+PACKAGE_NAME = 'linkage_kinematics'
 METADATA_RECORD_NAME = PACKAGE_NAME
-ROSBAG2_METADATA_RECORD_NAME = "rosbag2"
+ROSBAG2_METADATA_RECORD_NAME = 'rosbag2'
 ROSBAG2_METADATA_VERSION = 9
-ROS_DISTRO = "jazzy"
-PROFILE = "ros2"
-SCHEMA_ENCODING = "ros2msg"
-MESSAGE_ENCODING = "cdr"
+ROS_DISTRO = 'jazzy'
+PROFILE = 'ros2'
+SCHEMA_ENCODING = 'ros2msg'
+MESSAGE_ENCODING = 'cdr'
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 # Messages queued before they go into the MCAP chunk together (see BagWriter._add_queued): at
 # 5 kHz, 16 messages are 8 ticks, and adding them takes well under one tick's period.
 WRITE_BATCH = 16
-DEFINITION_SEPARATOR = "=" * 80
+DEFINITION_SEPARATOR = '=' * 80
 _COMPRESSION = {
-    "zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "none": CompressionType.NONE
+    'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4, 'none': CompressionType.NONE
 }
 _PRIMITIVE_TYPES = frozenset(
-    "bool byte char float32 float64 int8 uint8 int16 uint16 int32 uint32 int64 uint64 "
-    "string wstring".split()
+    'bool byte char float32 float64 int8 uint8 int16 uint16 int32 uint32 int64 uint64 '
+    'string wstring'.split()
 )
 
 
@@ -60,7 +60,7 @@ def package_version() -> str:
     try:
         return distribution_metadata.version(PACKAGE_NAME)
     except distribution_metadata.PackageNotFoundError:
-        return "unknown"
+        return 'unknown'
 
 
 class BagWriteError(OSError):
@@ -80,27 +80,27 @@ def _interface_file(package: str, name: str, suffix: str) -> Path | None:
         share = Path(get_package_share_directory(package))
     except PackageNotFoundError:
         return None
-    candidate = share / "msg" / f"{name}{suffix}"
+    candidate = share / 'msg' / f'{name}{suffix}'
     return candidate if candidate.is_file() else None
 
 
 def _split_type_name(type_name: str) -> tuple[str, str]:
-    parts = type_name.split("/")
-    if len(parts) == 3 and parts[1] == "msg":
+    parts = type_name.split('/')
+    if len(parts) == 3 and parts[1] == 'msg':
         return parts[0], parts[2]
     if len(parts) == 2:
         return parts[0], parts[1]
     raise MessageDefinitionError(
-        f"message type {type_name!r} is not of the form package/msg/Name or package/Name"
+        f'message type {type_name!r} is not of the form package/msg/Name or package/Name'
     )
 
 
 def _field_base_type(line: str) -> str | None:
     """The type a field (or constant) line refers to: ``pkg/Name``, ``Name`` or a primitive."""
-    code = line.split("#", 1)[0].strip()
+    code = line.split('#', 1)[0].strip()
     if not code:
         return None
-    return code.split()[0].split("[", 1)[0].split("<=", 1)[0]
+    return code.split()[0].split('[', 1)[0].split('<=', 1)[0]
 
 
 @functools.cache
@@ -114,7 +114,7 @@ def message_definition(type_name: str) -> str:
     """
     package, name = _split_type_name(type_name)
     root = _read_msg(package, name)
-    sections = [root.rstrip("\n")]
+    sections = [root.rstrip('\n')]
     seen: set[str] = set()
     pending = _dependencies(package, root)
     while pending:
@@ -122,21 +122,21 @@ def message_definition(type_name: str) -> str:
         if dependency in seen:
             continue
         seen.add(dependency)
-        dep_package, dep_name = dependency.split("/")
+        dep_package, dep_name = dependency.split('/')
         text = _read_msg(dep_package, dep_name)
-        sections.append(f"{DEFINITION_SEPARATOR}\nMSG: {dependency}\n{text.rstrip(chr(10))}")
+        sections.append(f'{DEFINITION_SEPARATOR}\nMSG: {dependency}\n{text.rstrip(chr(10))}')
         pending += _dependencies(dep_package, text)
-    return "\n".join(sections) + "\n"
+    return '\n'.join(sections) + '\n'
 
 
 def _read_msg(package: str, name: str) -> str:
-    path = _interface_file(package, name, ".msg")
+    path = _interface_file(package, name, '.msg')
     if path is None:
         raise MessageDefinitionError(
-            f"no {package}/msg/{name}.msg in the ament index (AMENT_PREFIX_PATH): "
-            "is the message package installed and the environment sourced?"
+            f'no {package}/msg/{name}.msg in the ament index (AMENT_PREFIX_PATH): '
+            'is the message package installed and the environment sourced?'
         )
-    return path.read_text(encoding="utf-8")
+    return path.read_text(encoding='utf-8')
 
 
 def _dependencies(package: str, text: str) -> list[str]:
@@ -145,7 +145,7 @@ def _dependencies(package: str, text: str) -> list[str]:
         base = _field_base_type(line)
         if base is None or base in _PRIMITIVE_TYPES:
             continue
-        found.append(base if "/" in base else f"{package}/{base}")
+        found.append(base if '/' in base else f'{package}/{base}')
     return found
 
 
@@ -153,14 +153,14 @@ def _dependencies(package: str, text: str) -> list[str]:
 def type_description_hash(type_name: str) -> str:
     """The RIHS01 type hash rosidl generated for ``type_name``, or '' if it is not installed."""
     package, name = _split_type_name(type_name)
-    path = _interface_file(package, name, ".json")
+    path = _interface_file(package, name, '.json')
     if path is None:
-        return ""
-    full_name = f"{package}/msg/{name}"
-    for entry in json.loads(path.read_text(encoding="utf-8")).get("type_hashes", []):
-        if entry.get("type_name") == full_name:
-            return str(entry.get("hash_string", ""))
-    return ""
+        return ''
+    full_name = f'{package}/msg/{name}'
+    for entry in json.loads(path.read_text(encoding='utf-8')).get('type_hashes', []):
+        if entry.get('type_name') == full_name:
+            return str(entry.get('hash_string', ''))
+    return ''
 
 
 @dataclass
@@ -185,23 +185,23 @@ class BagWriter:
         bag_path: Path | str,
         *,
         metadata: Mapping[str, str],
-        compression: str = "zstd",
+        compression: str = 'zstd',
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         flush_interval: float = 1.0,
     ) -> None:
         if compression not in _COMPRESSION:
             raise ValueError(
-                f"compression must be one of {sorted(_COMPRESSION)}, not {compression!r}"
+                f'compression must be one of {sorted(_COMPRESSION)}, not {compression!r}'
             )
         not_text = [key for key, value in metadata.items() if not isinstance(value, str)]
         if not_text:
-            raise TypeError(f"bag metadata values must be strings; not so for {not_text}")
+            raise TypeError(f'bag metadata values must be strings; not so for {not_text}')
         if chunk_size <= 0 or flush_interval <= 0:
-            raise ValueError("chunk_size and flush_interval must be positive")
+            raise ValueError('chunk_size and flush_interval must be positive')
         self.bag_path = Path(bag_path)
-        self.mcap_path = self.bag_path / f"{self.bag_path.name}_0.mcap"
-        self.metadata_path = self.bag_path / "metadata.yaml"
-        self.custom_data = {"package_version": package_version(), **dict(metadata)}
+        self.mcap_path = self.bag_path / f'{self.bag_path.name}_0.mcap'
+        self.metadata_path = self.bag_path / 'metadata.yaml'
+        self.custom_data = {'package_version': package_version(), **dict(metadata)}
         self._flush_interval = flush_interval
         self._topics: dict[int, _Topic] = {}
         self._schema_ids: dict[str, int] = {}
@@ -219,26 +219,26 @@ class BagWriter:
             self.bag_path.mkdir()
         except FileExistsError:
             raise BagExistsError(
-                f"bag folder {self.bag_path} already exists; refusing to overwrite it"
+                f'bag folder {self.bag_path} already exists; refusing to overwrite it'
             ) from None
         except OSError as error:
             raise BagWriteError(
-                f"cannot create bag folder {self.bag_path}: {error.strerror}"
+                f'cannot create bag folder {self.bag_path}: {error.strerror}'
             ) from None
         try:
-            self._file = open(self.mcap_path, "wb")
+            self._file = open(self.mcap_path, 'wb')
             self._writer = Writer(
                 self._file, chunk_size=chunk_size, compression=_COMPRESSION[compression]
             )
             self._writer.start(
-                profile=PROFILE, library=f"{PACKAGE_NAME}/{package_version()} {LIBRARY_IDENTIFIER}"
+                profile=PROFILE, library=f'{PACKAGE_NAME}/{package_version()} {LIBRARY_IDENTIFIER}'
             )
             self._writer.add_metadata(METADATA_RECORD_NAME, self.custom_data)
             self._file.flush()
             self._durable_size = self._file.tell()
             self._write_metadata_yaml()
         except OSError as error:
-            raise BagWriteError(f"cannot write bag {self.mcap_path}: {error.strerror}") from None
+            raise BagWriteError(f'cannot write bag {self.mcap_path}: {error.strerror}') from None
 
     @property
     def size_bytes(self) -> int:
@@ -256,20 +256,20 @@ class BagWriter:
         """
         self._check_writable()
         if any(existing.name == topic for existing in self._topics.values()):
-            raise ValueError(f"topic {topic} is already in bag {self.bag_path}")
+            raise ValueError(f'topic {topic} is already in bag {self.bag_path}')
         type_hash = type_description_hash(type_name)
         try:
             schema_id = self._schema_ids.get(type_name)
             if schema_id is None:
                 schema_id = self._writer.register_schema(
-                    type_name, SCHEMA_ENCODING, message_definition.encode("utf-8")
+                    type_name, SCHEMA_ENCODING, message_definition.encode('utf-8')
                 )
                 self._schema_ids[type_name] = schema_id
             channel_id = self._writer.register_channel(
                 topic,
                 MESSAGE_ENCODING,
                 schema_id,
-                {"offered_qos_profiles": offered_qos_profiles, "topic_type_hash": type_hash},
+                {'offered_qos_profiles': offered_qos_profiles, 'topic_type_hash': type_hash},
             )
         except OSError as error:
             raise self._fail(error) from None
@@ -284,7 +284,7 @@ class BagWriter:
         """Appends one serialized (CDR) message; raises BagWriteError if the disk refuses it."""
         self._check_writable()
         if channel_id not in self._topics:
-            raise ValueError(f"unknown channel id {channel_id} in bag {self.bag_path}")
+            raise ValueError(f'unknown channel id {channel_id} in bag {self.bag_path}')
         self._queued.append((channel_id, log_time_ns, data, publish_time_ns))
         if len(self._queued) >= WRITE_BATCH:
             self._add_queued()
@@ -339,7 +339,7 @@ class BagWriter:
                 self.flush()
                 serialized = yaml.safe_dump(self._bag_information(), sort_keys=False)
                 self._writer.add_metadata(
-                    ROSBAG2_METADATA_RECORD_NAME, {"serialized_metadata": serialized}
+                    ROSBAG2_METADATA_RECORD_NAME, {'serialized_metadata': serialized}
                 )
                 self._writer.finish()
                 self._file.close()
@@ -352,24 +352,24 @@ class BagWriter:
         except OSError as error:
             if failure_in_close is None and self._failure is None:
                 failure_in_close = BagWriteError(
-                    f"cannot write {self.metadata_path}: {error.strerror or error}"
+                    f'cannot write {self.metadata_path}: {error.strerror or error}'
                 )
         if failure_in_close is not None:
             raise failure_in_close
 
     def _check_writable(self) -> None:
         if self._closed:
-            raise BagWriteError(f"bag {self.bag_path} is closed")
+            raise BagWriteError(f'bag {self.bag_path} is closed')
         if self._failure is not None:
             raise BagWriteError(
-                f"bag {self.mcap_path} stopped at an earlier error: {self._failure}"
+                f'bag {self.mcap_path} stopped at an earlier error: {self._failure}'
             )
 
     def _fail(self, error: OSError) -> BagWriteError:
         """Cuts the file back to its last complete flush so what was written stays readable."""
         self._failure = BagWriteError(
-            f"writing bag {self.mcap_path} failed ({error.strerror or error}); "
-            f"the file keeps the {self._durable_size} bytes flushed before"
+            f'writing bag {self.mcap_path} failed ({error.strerror or error}); '
+            f'the file keeps the {self._durable_size} bytes flushed before'
         )
         try:
             self._file.close()
@@ -398,46 +398,46 @@ class BagWriter:
         duration = max(0, self._end_time_ns - start) if self._start_time_ns is not None else 0
         count = sum(topic.message_count for topic in self._topics.values())
         return {
-            "version": ROSBAG2_METADATA_VERSION,
-            "storage_identifier": "mcap",
-            "duration": {"nanoseconds": duration},
-            "starting_time": {"nanoseconds_since_epoch": start},
-            "message_count": count,
-            "topics_with_message_count": [
+            'version': ROSBAG2_METADATA_VERSION,
+            'storage_identifier': 'mcap',
+            'duration': {'nanoseconds': duration},
+            'starting_time': {'nanoseconds_since_epoch': start},
+            'message_count': count,
+            'topics_with_message_count': [
                 {
-                    "topic_metadata": {
-                        "name": topic.name,
-                        "type": topic.type_name,
-                        "serialization_format": MESSAGE_ENCODING,
+                    'topic_metadata': {
+                        'name': topic.name,
+                        'type': topic.type_name,
+                        'serialization_format': MESSAGE_ENCODING,
                         # metadata version 9 stores the profiles as a YAML list, not as text
-                        "offered_qos_profiles": yaml.safe_load(topic.offered_qos_profiles) or [],
-                        "type_description_hash": topic.type_hash,
+                        'offered_qos_profiles': yaml.safe_load(topic.offered_qos_profiles) or [],
+                        'type_description_hash': topic.type_hash,
                     },
-                    "message_count": topic.message_count,
+                    'message_count': topic.message_count,
                 }
                 for topic in self._topics.values()
             ],
-            "compression_format": "",
-            "compression_mode": "",
-            "relative_file_paths": [self.mcap_path.name],
-            "files": [
+            'compression_format': '',
+            'compression_mode': '',
+            'relative_file_paths': [self.mcap_path.name],
+            'files': [
                 {
-                    "path": self.mcap_path.name,
-                    "starting_time": {"nanoseconds_since_epoch": start},
-                    "duration": {"nanoseconds": duration},
-                    "message_count": count,
+                    'path': self.mcap_path.name,
+                    'starting_time': {'nanoseconds_since_epoch': start},
+                    'duration': {'nanoseconds': duration},
+                    'message_count': count,
                 }
             ],
-            "custom_data": dict(self.custom_data),
-            "ros_distro": ROS_DISTRO,
+            'custom_data': dict(self.custom_data),
+            'ros_distro': ROS_DISTRO,
         }
 
     def _write_metadata_yaml(self) -> None:
         text = yaml.safe_dump(
-            {"rosbag2_bagfile_information": self._bag_information()}, sort_keys=False
+            {'rosbag2_bagfile_information': self._bag_information()}, sort_keys=False
         )
-        temporary = self.metadata_path.with_name(self.metadata_path.name + ".tmp")
-        temporary.write_text(text, encoding="utf-8")
+        temporary = self.metadata_path.with_name(self.metadata_path.name + '.tmp')
+        temporary.write_text(text, encoding='utf-8')
         os.replace(temporary, self.metadata_path)
 
 
@@ -457,25 +457,25 @@ def recover_bag(bag_path: Path | str) -> RecoveryResult:
     On a complete bag it rewrites the same content.
     """
     bag = Path(bag_path)
-    if not (bag / "metadata.yaml").is_file():
-        raise BagWriteError(f"{bag} is not a bag folder (no metadata.yaml)")
+    if not (bag / 'metadata.yaml').is_file():
+        raise BagWriteError(f'{bag} is not a bag folder (no metadata.yaml)')
     files = bag_reader.bag_files(bag)
     if len(files) != 1:
-        raise BagWriteError(f"bag {bag} has {len(files)} files; only one-file bags are recovered")
+        raise BagWriteError(f'bag {bag} has {len(files)} files; only one-file bags are recovered')
     source = files[0].path
-    information = yaml.safe_load((bag / "metadata.yaml").read_text(encoding="utf-8"))[
-        "rosbag2_bagfile_information"
+    information = yaml.safe_load((bag / 'metadata.yaml').read_text(encoding='utf-8'))[
+        'rosbag2_bagfile_information'
     ]
     topics = {
-        entry["topic_metadata"]["name"]: entry["topic_metadata"]
-        for entry in information["topics_with_message_count"]
+        entry['topic_metadata']['name']: entry['topic_metadata']
+        for entry in information['topics_with_message_count']
     }
-    work = bag.parent / f".{bag.name}.recovering"
+    work = bag.parent / f'.{bag.name}.recovering'
     shutil.rmtree(work, ignore_errors=True)  # left over from an interrupted recovery
     work.mkdir()
     try:
         writer = BagWriter(
-            work / source.stem.removesuffix("_0"), metadata=information.get("custom_data") or {}
+            work / source.stem.removesuffix('_0'), metadata=information.get('custom_data') or {}
         )
         channel_ids: dict[str, int] = {}
         count = 0
@@ -484,14 +484,14 @@ def recover_bag(bag_path: Path | str) -> RecoveryResult:
                 topic = topics.get(message.topic)
                 if topic is None:
                     raise BagWriteError(
-                        f"{source} has messages on {message.topic}, which {bag}/metadata.yaml "
-                        "does not list"
+                        f'{source} has messages on {message.topic}, which {bag}/metadata.yaml '
+                        'does not list'
                     )
                 channel_ids[message.topic] = writer.add_topic(
                     message.topic,
-                    topic["type"],
-                    message_definition(topic["type"]),
-                    yaml.safe_dump(topic["offered_qos_profiles"], sort_keys=False),
+                    topic['type'],
+                    message_definition(topic['type']),
+                    yaml.safe_dump(topic['offered_qos_profiles'], sort_keys=False),
                 )
             writer.write(
                 channel_ids[message.topic],
@@ -502,7 +502,7 @@ def recover_bag(bag_path: Path | str) -> RecoveryResult:
             count += 1
         writer.close()
         os.replace(writer.mcap_path, source)
-        os.replace(writer.metadata_path, bag / "metadata.yaml")
+        os.replace(writer.metadata_path, bag / 'metadata.yaml')
         writer.bag_path.rmdir()
     finally:
         shutil.rmtree(work, ignore_errors=True)

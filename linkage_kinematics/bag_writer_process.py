@@ -41,9 +41,9 @@ from linkage_kinematics.bag_writer import (
     BagWriter,
 )
 
-_FRAME = struct.Struct("<cI")
-_MESSAGE = struct.Struct("<HqqI")
-START, TOPIC, MESSAGES = b"S", b"T", b"M"
+_FRAME = struct.Struct('<cI')
+_MESSAGE = struct.Struct('<HqqI')
+START, TOPIC, MESSAGES = b'S', b'T', b'M'
 # The pipe holds a batch for at most this long (s), so that a node killed outright loses at
 # most its last batch of this age, even at low rates.
 BATCH_AGE = 0.05
@@ -56,7 +56,7 @@ def set_process_affinity(pid: int, cpus: Set[int]) -> None:
     inherit their starter's CPUs). A process that has ended meanwhile is left alone: whoever
     waits for it learns how it ended."""
     try:
-        threads = os.listdir(f"/proc/{pid}/task")
+        threads = os.listdir(f'/proc/{pid}/task')
     except FileNotFoundError:
         return
     for thread in threads:
@@ -79,13 +79,13 @@ class BagWriterProcess:
         self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None
     ) -> None:
         self._process = subprocess.Popen(
-            [sys.executable, "-m", __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            [sys.executable, '-m', __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
             bufsize=0, start_new_session=True,
         )
         if cpus is not None:
             self.run_on(cpus)
         self._input = self._process.stdin.fileno()
-        self._replies = b""
+        self._replies = b''
         self._queued = bytearray()
         self._queued_count = 0
         self._batch_started = time.monotonic()
@@ -93,23 +93,23 @@ class BagWriterProcess:
         self._closed = False
         self.size_bytes = 0
         try:
-            reply = self._request(START, {"folder": str(folder), "metadata": dict(metadata)})
+            reply = self._request(START, {'folder': str(folder), 'metadata': dict(metadata)})
         except BagWriteError:
             self._process.stdin.close()
             self._process.wait(timeout=CLOSE_TIMEOUT)
             raise
-        self.bag_path = Path(reply["bag"])
-        self.size_bytes = reply["size"]
+        self.bag_path = Path(reply['bag'])
+        self.size_bytes = reply['size']
 
     def add_topic(
         self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str
     ) -> int:
         """``BagWriter.add_topic`` in the child; its channel id."""
         reply = self._request(TOPIC, {
-            "topic": topic, "type_name": type_name, "message_definition": message_definition,
-            "offered_qos_profiles": offered_qos_profiles,
+            'topic': topic, 'type_name': type_name, 'message_definition': message_definition,
+            'offered_qos_profiles': offered_qos_profiles,
         })
-        return int(reply["channel"])
+        return int(reply['channel'])
 
     def run_on(self, cpus: Set[int]) -> None:
         """Let the child run only on ``cpus``."""
@@ -118,7 +118,7 @@ class BagWriterProcess:
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
         """Queues one serialized message; a full or old batch goes to the child."""
         if self._failure is not None or self._closed:
-            raise BagWriteError(self._failure or f"bag {self.bag_path} is closed")
+            raise BagWriteError(self._failure or f'bag {self.bag_path} is closed')
         self._queued += _MESSAGE.pack(channel_id, log_time_ns, publish_time_ns, len(data))
         self._queued += data
         self._queued_count += 1
@@ -145,21 +145,21 @@ class BagWriterProcess:
             self._process.kill()
             self._process.wait()
             raise BagWriteError(
-                f"the bag writer of {self.bag_path} did not finish within {CLOSE_TIMEOUT:g} s"
+                f'the bag writer of {self.bag_path} did not finish within {CLOSE_TIMEOUT:g} s'
             ) from None
         self._replies += rest
         closing_error = None
         closed = False
         for reply in self._take_replies():
-            if "error" in reply and reply.get("in_close"):
-                closing_error = reply["error"]
-            closed = closed or "closed" in reply
+            if 'error' in reply and reply.get('in_close'):
+                closing_error = reply['error']
+            closed = closed or 'closed' in reply
         if closing_error is not None:
             raise BagWriteError(closing_error)
         if not closed:
             raise BagWriteError(
-                f"the bag writer of {self.bag_path} ended with status "
-                f"{self._process.returncode} before finishing the bag"
+                f'the bag writer of {self.bag_path} ended with status '
+                f'{self._process.returncode} before finishing the bag'
             )
 
     def _send_queued(self) -> None:
@@ -178,22 +178,22 @@ class BagWriterProcess:
                 view = view[os.write(self._input, view):]
         except BrokenPipeError:
             self._failure = (f"the bag writer of {getattr(self, 'bag_path', 'the log')} "
-                             f"ended unexpectedly (status {self._process.wait()})")
+                             f'ended unexpectedly (status {self._process.wait()})')
             raise BagWriteError(self._failure) from None
 
     def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
         """Sends a frame and waits for the child's answer to it."""
-        self._send(kind, json.dumps(payload).encode("utf-8"))
+        self._send(kind, json.dumps(payload).encode('utf-8'))
         os.set_blocking(self._process.stdout.fileno(), True)
         line = self._process.stdout.readline()
         os.set_blocking(self._process.stdout.fileno(), False)
         if not line:
             raise BagWriteError(
-                f"the bag writer ended with status {self._process.wait()} before answering"
+                f'the bag writer ended with status {self._process.wait()} before answering'
             )
         reply = json.loads(line)
-        if "error" in reply:
-            raise BagWriteError(reply["error"])
+        if 'error' in reply:
+            raise BagWriteError(reply['error'])
         return reply
 
     def _read_replies(self) -> None:
@@ -203,13 +203,13 @@ class BagWriterProcess:
         except BlockingIOError:
             pass
         for reply in self._take_replies():
-            if "error" in reply and self._failure is None:
-                self._failure = reply["error"]
-            if "size" in reply:
-                self.size_bytes = reply["size"]
+            if 'error' in reply and self._failure is None:
+                self._failure = reply['error']
+            if 'size' in reply:
+                self.size_bytes = reply['size']
 
     def _take_replies(self) -> list[dict[str, Any]]:
-        *lines, self._replies = self._replies.split(b"\n")
+        *lines, self._replies = self._replies.split(b'\n')
         return [json.loads(line) for line in lines if line]
 
 
@@ -222,18 +222,18 @@ def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise BagWriteError(
-            f"cannot create log folder {folder}: {error.strerror or error}"
+            f'cannot create log folder {folder}: {error.strerror or error}'
         ) from None
-    base_name = time.strftime("rosbag2_%Y_%m_%d-%H_%M_%S")
+    base_name = time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
     suffix = 0
     while True:
-        name = base_name if suffix == 0 else f"{base_name}_{suffix}"
+        name = base_name if suffix == 0 else f'{base_name}_{suffix}'
         try:
             return BagWriter(folder / name, metadata=metadata)
         except BagExistsError:
             suffix += 1
         except BagWriteError as error:
-            raise BagWriteError(f"cannot log into folder {folder}: {error}") from None
+            raise BagWriteError(f'cannot log into folder {folder}: {error}') from None
 
 
 class _Child:
@@ -267,14 +267,14 @@ class _Child:
 
     def _reply(self, **fields: Any) -> None:
         try:
-            self._replies.write(json.dumps(fields).encode("utf-8") + b"\n")
+            self._replies.write(json.dumps(fields).encode('utf-8') + b'\n')
             self._replies.flush()
         except BrokenPipeError:
             pass  # the node is gone; the bag is still finished
 
     def _start(self, request: dict[str, Any]) -> None:
         try:
-            self._writer = _open_bag(Path(request["folder"]), request["metadata"])
+            self._writer = _open_bag(Path(request['folder']), request['metadata'])
         except BagWriteError as error:
             self._reply(error=str(error))
             return
@@ -283,8 +283,8 @@ class _Child:
     def _add_topic(self, request: dict[str, Any]) -> None:
         try:
             channel = self._writer.add_topic(
-                request["topic"], request["type_name"], request["message_definition"],
-                request["offered_qos_profiles"],
+                request['topic'], request['type_name'], request['message_definition'],
+                request['offered_qos_profiles'],
             )
         except (BagWriteError, ValueError) as error:
             self._reply(error=str(error))
@@ -330,10 +330,10 @@ def main() -> None:
     # Woken by the node's every batch, the child would otherwise preempt the node on its own
     # core for a whole chunk (Linux places a woken task beside its waker): a batch task keeps
     # its fair share of the CPU but never preempts on wake-up (docs/logging.md).
-    if hasattr(os, "SCHED_BATCH"):
+    if hasattr(os, 'SCHED_BATCH'):
         os.sched_setscheduler(0, os.SCHED_BATCH, os.sched_param(0))
     _Child(sys.stdin.buffer, sys.stdout.buffer).run()
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

@@ -16,23 +16,23 @@ def number(
     *,
     above: float | None = None,
     at_least: float | None = None,
-    rule: str = "",
+    rule: str = '',
 ) -> Callable[[str], float]:
     """A type converting text to a finite ``kind`` (float or int) greater than ``above`` or at
     least ``at_least`` when given; ``rule`` says the bound in the error message."""
-    noun = "a whole number" if kind is int else "a number"
+    noun = 'a whole number' if kind is int else 'a number'
 
     def convert(text: str) -> float:
         try:
             value = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"not {noun}: {text!r}") from None
+            raise argparse.ArgumentTypeError(f'not {noun}: {text!r}') from None
         if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+            raise argparse.ArgumentTypeError(f'must be a finite number, got {text!r}')
         if (above is not None and not value > above) or (
             at_least is not None and not value >= at_least
         ):
-            raise argparse.ArgumentTypeError(f"must be {rule}, got {text!r}")
+            raise argparse.ArgumentTypeError(f'must be {rule}, got {text!r}')
         return value
 
     return convert

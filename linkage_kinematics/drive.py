@@ -33,10 +33,10 @@ class DriveLaw:
     k: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("omega0", "k"):
+        for name in ('omega0', 'k'):
             value = getattr(self, name)
             if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise DriveError(f"{name} must be a finite number, got {value!r}")
+                raise DriveError(f'{name} must be a finite number, got {value!r}')
 
     def angular_velocity(self, alpha: float) -> float:
         """ω at crank angle α (rad/s)."""
@@ -55,14 +55,14 @@ class DriveLaw:
             growth = math.expm1(self.k * elapsed)
         except OverflowError:
             raise DriveError(
-                f"under ω = {self.omega0} + {self.k}·α the crank angle overflows {elapsed} s "
-                f"after α = {alpha_start} rad"
+                f'under ω = {self.omega0} + {self.k}·α the crank angle overflows {elapsed} s '
+                f'after α = {alpha_start} rad'
             ) from None
         alpha = alpha_start + omega_start * growth / self.k
         if not math.isfinite(alpha):
             raise DriveError(
-                f"under ω = {self.omega0} + {self.k}·α the crank angle overflows {elapsed} s "
-                f"after α = {alpha_start} rad"
+                f'under ω = {self.omega0} + {self.k}·α the crank angle overflows {elapsed} s '
+                f'after α = {alpha_start} rad'
             )
         return alpha
 
@@ -74,8 +74,8 @@ class DriveLaw:
             return 0.0
         if omega_start == 0.0:
             raise DriveError(
-                f"the crank is at rest at α = {math.degrees(alpha_start):.6g}° (ω0 + k·α = 0) "
-                "and never moves"
+                f'the crank is at rest at α = {math.degrees(alpha_start):.6g}° (ω0 + k·α = 0) '
+                'and never moves'
             )
         scaled = self.k * travel / omega_start
         if abs(scaled) < _LINEAR_LIMIT:
@@ -83,14 +83,14 @@ class DriveLaw:
         else:
             elapsed = math.log1p(scaled) / self.k if scaled > -1.0 else -1.0
         if elapsed < 0.0:
-            direction = "counterclockwise" if omega_start > 0.0 else "clockwise"
+            direction = 'counterclockwise' if omega_start > 0.0 else 'clockwise'
             limit = (
-                ""
+                ''
                 if self.k * omega_start >= 0.0
-                else f" and only approaches α* = {math.degrees(-self.omega0 / self.k):.6g}°"
+                else f' and only approaches α* = {math.degrees(-self.omega0 / self.k):.6g}°'
             )
             raise DriveError(
-                f"the crank turns {direction} from α = {math.degrees(alpha_start):.6g}°{limit}; "
-                f"it never reaches α = {math.degrees(alpha):.6g}°"
+                f'the crank turns {direction} from α = {math.degrees(alpha_start):.6g}°{limit}; '
+                f'it never reaches α = {math.degrees(alpha):.6g}°'
             )
         return elapsed

@@ -66,7 +66,7 @@ def wrap_angle(angle: float) -> float:
 
 def format_interval(interval: tuple[float, float]) -> str:
     """``[lo°, hi°]`` for an error message."""
-    return f"[{math.degrees(interval[0]):.3f}°, {math.degrees(interval[1]):.3f}°]"
+    return f'[{math.degrees(interval[0]):.3f}°, {math.degrees(interval[1]):.3f}°]'
 
 
 @dataclass(frozen=True)
@@ -99,16 +99,16 @@ class Reachability:
     def describe(self) -> str:
         """The reachable set in degrees, for messages."""
         if self.full_rotation:
-            return "all crank angles (full rotation)"
-        return " and ".join(format_interval(interval) for interval in self.intervals)
+            return 'all crank angles (full rotation)'
+        return ' and '.join(format_interval(interval) for interval in self.intervals)
 
     def require(self, alpha: float) -> tuple[float, float]:
         """Return the interval holding ``alpha`` or raise UnreachableError naming the reachable set."""
         interval = self.interval_containing(alpha)
         if interval is None:
             raise UnreachableError(
-                f"crank angle α = {math.degrees(alpha):.6f}° is not reachable: the loop closes "
-                f"only for α in {self.describe()} (mod 360°)"
+                f'crank angle α = {math.degrees(alpha):.6f}° is not reachable: the loop closes '
+                f'only for α in {self.describe()} (mod 360°)'
             )
         return interval
 
@@ -160,23 +160,23 @@ class FourBar:
     closure: LoopClosure = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ("crank_length", "coupler_length", "rocker_length"):
+        for name in ('crank_length', 'coupler_length', 'rocker_length'):
             value = getattr(self, name)
             if not _is_real(value) or not MIN_LENGTH <= value <= MAX_LENGTH:
                 raise GeometryError(
-                    f"{name} must be a length from {MIN_LENGTH:g} to {MAX_LENGTH:g} m, "
-                    f"got {value!r}"
+                    f'{name} must be a length from {MIN_LENGTH:g} to {MAX_LENGTH:g} m, '
+                    f'got {value!r}'
                 )
-        for name in ("ground_x", "ground_y"):
+        for name in ('ground_x', 'ground_y'):
             value = getattr(self, name)
             if not _is_real(value) or not abs(value) <= MAX_LENGTH:
                 raise GeometryError(
-                    f"{name} must be a coordinate from {-MAX_LENGTH:g} to {MAX_LENGTH:g} m, "
-                    f"got {value!r}"
+                    f'{name} must be a coordinate from {-MAX_LENGTH:g} to {MAX_LENGTH:g} m, '
+                    f'got {value!r}'
                 )
         closure, reachability = _loop_closure(self)
-        object.__setattr__(self, "closure", _closure_constants(self, closure))
-        object.__setattr__(self, "reachability", reachability)
+        object.__setattr__(self, 'closure', _closure_constants(self, closure))
+        object.__setattr__(self, 'reachability', reachability)
 
     @property
     def ground_length(self) -> float:
@@ -223,7 +223,7 @@ _ROOTS = 1
 _TOUCH = 2
 # Digits of the one-time computation of the singular crank angles (decimal arithmetic).
 _DIGITS = 60
-_PI = Decimal("3.14159265358979323846264338327950288419716939937510582097494459230781640629")
+_PI = Decimal('3.14159265358979323846264338327950288419716939937510582097494459230781640629')
 
 
 def _cos_sin(angle: Decimal) -> tuple[Decimal, Decimal]:
@@ -336,8 +336,8 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
                                       linkage.rocker_length)
             if not abs(coupler - rocker) < crank < coupler + rocker:
                 raise GeometryError(
-                    "with O and C coincident the loop needs |AB − BC| < OA < AB + BC, "
-                    f"got OA = {crank} m, AB = {coupler} m, BC = {rocker} m"
+                    'with O and C coincident the loop needs |AB − BC| < OA < AB + BC, '
+                    f'got OA = {crank} m, AB = {coupler} m, BC = {rocker} m'
                 )
             closure = LoopClosure(
                 LoopFactor(_PLAIN, coupler + rocker), LoopFactor(_PLAIN, abs(coupler - rocker)),
@@ -350,9 +350,9 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
         highest_cosine = (ground_squared + r * r - (b - c) ** 2) / product
         if lowest_cosine >= 1 - TOUCH_TOLERANCE or highest_cosine <= -1 + TOUCH_TOLERANCE:
             raise GeometryError(
-                f"the loop cannot close at any crank angle: |C − A| spans "
-                f"[{float(abs(ground - r)):.6g}, {float(ground + r):.6g}] m but AB and BC reach "
-                f"only [{float(abs(b - c)):.6g}, {float(b + c):.6g}] m"
+                f'the loop cannot close at any crank angle: |C − A| spans '
+                f'[{float(abs(ground - r)):.6g}, {float(ground + r):.6g}] m but AB and BC reach '
+                f'only [{float(abs(b - c)):.6g}, {float(b + c):.6g}] m'
             )
         direction = _PI / 2 + _atan2(y_c, x_c)
         opposite = direction + _PI
@@ -367,7 +367,7 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
             gap = product * (cosine - bound) * bound  # the factor's least value over a turn
             if gap > 0:
                 # Far from zero everywhere, d's own rounding is small beside the factor.
-                plain = gap >= Decimal("0.25") * (ground + r) ** 2
+                plain = gap >= Decimal('0.25') * (ground + r) ** 2
                 return LoopFactor(_PLAIN if plain else _TOUCH, float(length), _split(touch_at),
                                   gap=float(gap))
             half_width = _atan2((1 - cosine * cosine).sqrt(), cosine)
@@ -425,22 +425,22 @@ class Preset:
 _SEED_COUPLER = math.sqrt(1.09)
 
 PRESETS: dict[str, Preset] = {
-    "paper": Preset(
+    'paper': Preset(
         FourBar(0.3, _SEED_COUPLER, 0.3, 1.3, 0.0),
         1.0,
         "the seed's mechanism: OA = BC = 0.3 m, OC = 1.3 m, AB = √1.09 m, C level with O",
     ),
-    "paper_full_turn": Preset(
+    'paper_full_turn': Preset(
         FourBar(0.3, _SEED_COUPLER, 0.3, math.sqrt(1.09 - 0.6**2), 0.0),
         -1.0,
         "the seed's 'full revolution' redesign, driven clockwise; it cannot turn fully: the loop "
-        "closes only for α in about [−211.3°, 31.3°]",
+        'closes only for α in about [−211.3°, 31.3°]',
     ),
-    "grashof_crank_rocker": Preset(
+    'grashof_crank_rocker': Preset(
         FourBar(0.3, _SEED_COUPLER, 0.6, 1.0, 0.0),
         1.0,
         "a Grashof crank-rocker with the seed's coupler (OA = 0.3, BC = 0.6, OC = 1.0 m): the "
-        "crank is the shortest link and turns fully",
+        'crank is the shortest link and turns fully',
     ),
 }
 

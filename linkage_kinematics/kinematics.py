@@ -451,7 +451,7 @@ def _closed_form(
 
 def _check_branch(branch: int) -> None:
     if branch not in (1, -1):
-        raise ValueError(f"branch must be +1 or -1, got {branch!r}")
+        raise ValueError(f'branch must be +1 or -1, got {branch!r}')
 
 
 def _too_close(alpha: float, nearest_dead: float | None) -> bool:
@@ -463,9 +463,9 @@ def _too_close(alpha: float, nearest_dead: float | None) -> bool:
 
 def _dead_point_message(alpha: float) -> str:
     return (
-        f"crank angle α = {math.degrees(alpha):.9f}° is at a dead point: coupler and rocker are "
-        "collinear, so the rates are undefined (closer than a one-ulp change of α moving the "
-        f"accelerations by {RATE_ACCURACY:.1%})"
+        f'crank angle α = {math.degrees(alpha):.9f}° is at a dead point: coupler and rocker are '
+        'collinear, so the rates are undefined (closer than a one-ulp change of α moving the '
+        f'accelerations by {RATE_ACCURACY:.1%})'
     )
 
 
@@ -484,9 +484,9 @@ def _check_pivot_passage(linkage: FourBar, alpha: FloatOrArray) -> None:
     if np.any(close):
         angle = float(np.asarray(alpha).reshape(-1)[int(np.argmax(np.reshape(close, -1)))])
         raise DeadPointError(
-            f"crank angle α = {math.degrees(angle):.9f}° puts pin A on the pivot C (OA = OC, "
-            "AB = BC): coupler and rocker lie on each other and can turn together about it, so "
-            "the motion is undetermined there"
+            f'crank angle α = {math.degrees(angle):.9f}° puts pin A on the pivot C (OA = OC, '
+            'AB = BC): coupler and rocker lie on each other and can turn together about it, so '
+            'the motion is undetermined there'
         )
 
 
@@ -504,7 +504,7 @@ def _refuse(linkage: FourBar, alpha: float) -> ValueError:
     outside the reachable set (with its tolerance), DeadPointError at an interval end or with
     pin A on the pivot C."""
     if not math.isfinite(alpha):
-        return UnreachableError(f"crank angle α must be finite, got {alpha!r}")
+        return UnreachableError(f'crank angle α must be finite, got {alpha!r}')
     if linkage.closure.passes_through_pivot:
         try:
             _check_pivot_passage(linkage, alpha)
@@ -595,7 +595,7 @@ def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
     ``branch`` as in ``solve``. Raises UnreachableError outside the reachable set.
     """
     if not math.isfinite(alpha):
-        raise UnreachableError(f"crank angle α must be finite, got {alpha!r}")
+        raise UnreachableError(f'crank angle α must be finite, got {alpha!r}')
     _check_branch(branch)
     if linkage.closure.passes_through_pivot:
         _check_pivot_passage(linkage, alpha)
@@ -617,14 +617,14 @@ def solve_many(
     """
     alpha = np.asarray(alpha, dtype=float)
     if not np.all(np.isfinite(alpha)):
-        raise UnreachableError("crank angles must be finite")
+        raise UnreachableError('crank angles must be finite')
     if isinstance(branch, np.ndarray):
         if branch.shape != alpha.shape or not np.all(np.abs(branch) == 1):
-            raise ValueError("branch must be +1 or -1, or an array of them shaped like alpha")
+            raise ValueError('branch must be +1 or -1, or an array of them shaped like alpha')
         branch = branch.astype(float)
     else:
         _check_branch(branch)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide='ignore', invalid='ignore'):
         flat_alpha = alpha.reshape(-1)
         flat_branch = branch.reshape(-1) if isinstance(branch, np.ndarray) else branch
         columns = [np.empty(flat_alpha.size) for _ in range(len(fields(LinkageState)) - 1)]

@@ -25,8 +25,8 @@ from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
 from linkage_kinematics.recording import FixedShapeEncoder
 
-JOINT_NAMES = ("crank_joint", "coupler_joint", "rocker_joint")
-MARKER_NAMESPACE = "linkage"
+JOINT_NAMES = ('crank_joint', 'coupler_joint', 'rocker_joint')
+MARKER_NAMESPACE = 'linkage'
 # Marker ids are fixed so that every MarkerArray updates the same markers in place.
 DISK_ID, BARS_ID, PIN_A_ID, PIN_B_ID, PIVOT_O_ID, PIVOT_C_ID = range(6)
 
@@ -65,7 +65,7 @@ def duration_fields(seconds: float) -> tuple[int, int]:
 
 
 def _stamp_paths(prefix: str) -> list[str]:
-    return [f"{prefix}header.stamp.sec", f"{prefix}header.stamp.nanosec"]
+    return [f'{prefix}header.stamp.sec', f'{prefix}header.stamp.nanosec']
 
 
 def joint_positions(
@@ -106,7 +106,7 @@ class JointStateEncoder:
 
     def __init__(self) -> None:
         template = JointState(name=list(JOINT_NAMES), position=[0.0] * 3, velocity=[0.0] * 3)
-        self._encoder = FixedShapeEncoder(template, [*_stamp_paths(""), "position", "velocity"])
+        self._encoder = FixedShapeEncoder(template, [*_stamp_paths(''), 'position', 'velocity'])
 
     def encode(self, state: LinkageState, stamp_ns: int, positions: Sequence[float]) -> bytes:
         """``positions`` are ``joint_positions`` of ``state``, unwrapped as the caller keeps them."""
@@ -182,9 +182,9 @@ class LinkageStateEncoder:
         template = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[point])
         template.header.frame_id = frame_id
         self._encoder = FixedShapeEncoder(template, [
-            *_stamp_paths(""), "points[0].positions", "points[0].velocities",
-            "points[0].accelerations", "points[0].time_from_start.sec",
-            "points[0].time_from_start.nanosec",
+            *_stamp_paths(''), 'points[0].positions', 'points[0].velocities',
+            'points[0].accelerations', 'points[0].time_from_start.sec',
+            'points[0].time_from_start.nanosec',
         ])
 
     def encode(self, state: LinkageState, stamp_ns: int, motion_time: float) -> bytes:
@@ -237,20 +237,20 @@ class MarkerArrayEncoder:
     """The bytes of ``marker_array`` (encode_cdr) of one linkage and frame, straight from a
     state."""
 
-    _PIN_A_PATHS = (f"markers[{BARS_ID}].points[1]", f"markers[{BARS_ID}].points[2]",
-                    f"markers[{PIN_A_ID}].pose.position")
-    _PIN_B_PATHS = (f"markers[{BARS_ID}].points[3]", f"markers[{BARS_ID}].points[4]",
-                    f"markers[{PIN_B_ID}].pose.position")
+    _PIN_A_PATHS = (f'markers[{BARS_ID}].points[1]', f'markers[{BARS_ID}].points[2]',
+                    f'markers[{PIN_A_ID}].pose.position')
+    _PIN_B_PATHS = (f'markers[{BARS_ID}].points[3]', f'markers[{BARS_ID}].points[4]',
+                    f'markers[{PIN_B_ID}].pose.position')
 
     def __init__(self, linkage: FourBar, frame_id: str) -> None:
         template = _new_marker_array(linkage, frame_id)
         self._marker_count = len(template.markers)
         varying = [path for index in range(self._marker_count)
-                   for path in _stamp_paths(f"markers[{index}].")]
-        varying += [f"{point}.{axis}" for point in self._PIN_A_PATHS + self._PIN_B_PATHS
-                    for axis in "xy"]
-        varying += [f"markers[{DISK_ID}].pose.orientation.z",
-                    f"markers[{DISK_ID}].pose.orientation.w"]
+                   for path in _stamp_paths(f'markers[{index}].')]
+        varying += [f'{point}.{axis}' for point in self._PIN_A_PATHS + self._PIN_B_PATHS
+                    for axis in 'xy']
+        varying += [f'markers[{DISK_ID}].pose.orientation.z',
+                    f'markers[{DISK_ID}].pose.orientation.w']
         self._encoder = FixedShapeEncoder(template, varying)
 
     def encode(self, state: LinkageState, stamp_ns: int) -> bytes:

@@ -44,7 +44,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
     None when a 'stop' motion has reached a dead point before alpha_end: the crank cannot go on.
     """
     duration = config.segment_duration
-    if config.end_behavior == "stop":
+    if config.end_behavior == 'stop':
         if elapsed >= duration:
             if config.blocked_at is not None:
                 return None
@@ -53,7 +53,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
             _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, elapsed)),
             motion_time=elapsed,
         )
-    if config.end_behavior == "loop":
+    if config.end_behavior == 'loop':
         passes = math.floor(elapsed / duration)
         in_pass = elapsed - passes * duration
         return MotionSample(
@@ -93,13 +93,13 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
     def time_of(alpha: float) -> float:
         return config.drive.time_to(config.alpha_start, alpha)
 
-    if config.end_behavior == "stop":
+    if config.end_behavior == 'stop':
         if step >= points:
             return None
         alpha = _step_alpha(config, step)
         return MotionSample(alpha, motion_time=time_of(alpha), final=(
             config.blocked_at is None and step == points - 1))
-    if config.end_behavior == "loop":
+    if config.end_behavior == 'loop':
         # Over whole turns the end of one pass is the start of the next: visit it once.
         per_pass = config.step_count if config.whole_turns else points
         passes, index = divmod(step, per_pass)
@@ -144,13 +144,13 @@ def blocked_note(config: RunConfiguration) -> str | None:
     if config.blocked_at is None:
         return None
     outcome = {
-        "stop": "the run will end there with an error",
-        "loop": "the crank restarts from alpha_start there",
-        "bounce": "the crank reverses there",
+        'stop': 'the run will end there with an error',
+        'loop': 'the crank restarts from alpha_start there',
+        'bounce': 'the crank reverses there',
     }[config.end_behavior]
     return (
-        f"dead point at {math.degrees(config.blocked_at):.6f}° before alpha_end = "
-        f"{math.degrees(config.alpha_end):.6f}°: {outcome}"
+        f'dead point at {math.degrees(config.blocked_at):.6f}° before alpha_end = '
+        f'{math.degrees(config.alpha_end):.6f}°: {outcome}'
     )
 
 
@@ -160,7 +160,7 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
     end of every pass, 'bounce' at the end of every forward (even) pass."""
     if config.blocked_at is None or current_pass <= previous_pass:
         return False
-    if config.end_behavior == "bounce":
+    if config.end_behavior == 'bounce':
         return previous_pass % 2 == 0 or current_pass - previous_pass >= 2
     return True
 
@@ -168,11 +168,11 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
 def dead_point_problem(config: RunConfiguration) -> str:
     """The ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
     outcome = {
-        "stop": "stops; the run cannot go on",
-        "loop": "restarts from alpha_start",
-        "bounce": "reverses",
+        'stop': 'stops; the run cannot go on',
+        'loop': 'restarts from alpha_start',
+        'bounce': 'reverses',
     }[config.end_behavior]
     return (
-        f"the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° "
-        f"before alpha_end = {math.degrees(config.alpha_end):.6f}°: it {outcome}"
+        f'the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° '
+        f'before alpha_end = {math.degrees(config.alpha_end):.6f}°: it {outcome}'
     )

@@ -67,7 +67,7 @@ from linkage_kinematics.parameters import (
 from linkage_kinematics.recording import Recorder, encode_cdr
 from linkage_kinematics.urdf import urdf_text
 
-DIAGNOSTIC_TASK = "crank motion"
+DIAGNOSTIC_TASK = 'crank motion'
 DIAGNOSTICS_PERIOD = 1.0  # s
 
 EXIT_OK = 0
@@ -115,24 +115,24 @@ def assess(
     deviation = min(state.transmission_angle, math.pi - state.transmission_angle)
     if deviation < config.min_transmission_angle:
         warnings.append(
-            f"transmission angle {math.degrees(state.transmission_angle):.2f}° is within "
-            f"{math.degrees(config.min_transmission_angle):.2f}° of a straight line"
+            f'transmission angle {math.degrees(state.transmission_angle):.2f}° is within '
+            f'{math.degrees(config.min_transmission_angle):.2f}° of a straight line'
         )
     reachability = config.linkage.reachability
     distance = reachability.dead_point_distance(state.alpha)
     if distance is not None and distance < config.dead_point_warning:
-        warnings.append(f"{math.degrees(distance):.3f}° from a dead point")
+        warnings.append(f'{math.degrees(distance):.3f}° from a dead point')
     distance = reachability.change_point_distance(state.alpha)
     if distance is not None and distance < config.dead_point_warning:
         warnings.append(
-            f"{math.degrees(distance):.3f}° from a change point (the assemblies meet; the "
-            "motion continues smoothly on its branch)"
+            f'{math.degrees(distance):.3f}° from a change point (the assemblies meet; the '
+            'motion continues smoothly on its branch)'
         )
     note = blocked_note(config)
     if note is not None:
         warnings.append(note)
     if warnings:
-        return DiagnosticStatus.WARN, "; ".join(warnings)
+        return DiagnosticStatus.WARN, '; '.join(warnings)
     return DiagnosticStatus.OK, activity
 
 
@@ -161,7 +161,7 @@ class LinkageNode(Node):
             self.get_logger().warning(blocked_note(self.config))
         self._pending: tuple[RunConfiguration, list[str]] | None = None
         self._problem: str | None = None
-        self._activity = "starting"
+        self._activity = 'starting'
         self._recording_error: str | None = None
         self._described_linkage: FourBar | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
@@ -183,11 +183,11 @@ class LinkageNode(Node):
         # robot_state_publisher's do), so mechanisms in different namespaces never mix;
         # /diagnostics is absolute, diagnostic_updater's convention.
         publishers = (
-            self.create_publisher(JointState, "joint_states", DATA_QOS),
-            self.create_publisher(JointTrajectory, "linkage/state", DATA_QOS),
-            self.create_publisher(String, "robot_description", ROBOT_DESCRIPTION_QOS),
-            self.create_publisher(MarkerArray, "linkage/markers", DATA_QOS),
-            self.create_publisher(DiagnosticArray, "/diagnostics", DATA_QOS),
+            self.create_publisher(JointState, 'joint_states', DATA_QOS),
+            self.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
+            self.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS),
+            self.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
+            self.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
         )
         self._topic_publishers = {publisher.topic_name: publisher for publisher in publishers}
         (
@@ -198,13 +198,13 @@ class LinkageNode(Node):
             self._diagnostics_topic,
         ) = self._topic_publishers
         self._available_cpus = (
-            os.sched_getaffinity(0) if hasattr(os, "sched_getaffinity") else set()
+            os.sched_getaffinity(0) if hasattr(os, 'sched_getaffinity') else set()
         )
         self._bag_writer_cpus: set[int] | None = None
         self._bag_writer_cpus = self._place(self.config.cpu_affinity)
         self._recorder = self._open_recorder() if self.config.log_enabled else None
         if self._recorder is not None:
-            self.get_logger().info(f"recording to {self._recorder.bag_path}")
+            self.get_logger().info(f'recording to {self._recorder.bag_path}')
         self._state_timer = self.create_timer(self._timer_period(), self._tick)
         self._marker_timer = self.create_timer(
             1.0 / self.config.display_rate_hz, self._publish_markers
@@ -221,18 +221,18 @@ class LinkageNode(Node):
 
     def _declare_parameters(self) -> tuple[ParameterSpec, ...]:
         """Declare every parameter up front (without ranges); return their specs."""
-        preset_spec = parameter_specs("paper")[0]
+        preset_spec = parameter_specs('paper')[0]
         self.declare_parameter(preset_spec.name, preset_spec.default,
                                parameter_descriptor(preset_spec, with_range=False))
-        preset_name = self.get_parameter("preset").value
+        preset_name = self.get_parameter('preset').value
         if not isinstance(preset_name, str):
             raise ConfigurationError(
-                "preset", f"must be a string, got {describe_value(preset_name)}"
+                'preset', f'must be a string, got {describe_value(preset_name)}'
             )
         try:
             specs = parameter_specs(preset_name)
         except GeometryError as error:
-            raise ConfigurationError("preset", str(error)) from None
+            raise ConfigurationError('preset', str(error)) from None
         for spec in specs[1:]:
             self.declare_parameter(
                 spec.name, spec.default, parameter_descriptor(spec, with_range=False)
@@ -285,9 +285,9 @@ class LinkageNode(Node):
         old, self.config = self.config, new
         restarts = new.restarts_motion(old)
         self.get_logger().info(
-            "parameters changed: "
-            + ", ".join(f"{name}={self.get_parameter(name).value!r}" for name in differing)
-            + ("; motion restarts at alpha_start" if restarts else "")
+            'parameters changed: '
+            + ', '.join(f'{name}={self.get_parameter(name).value!r}' for name in differing)
+            + ('; motion restarts at alpha_start' if restarts else '')
         )
         note = blocked_note(new)
         if note is not None:
@@ -312,12 +312,12 @@ class LinkageNode(Node):
         """ConfigurationError naming cpu_affinity unless this process may be pinned to ``cpu``."""
         if cpu == NO_CPU_AFFINITY:
             return
-        if not hasattr(os, "sched_setaffinity"):
-            raise ConfigurationError("cpu_affinity", "CPU affinity is not supported here")
+        if not hasattr(os, 'sched_setaffinity'):
+            raise ConfigurationError('cpu_affinity', 'CPU affinity is not supported here')
         if cpu not in self._available_cpus:
             raise ConfigurationError(
-                "cpu_affinity",
-                f"CPU {cpu} is not one this process may run on (it may run on "
+                'cpu_affinity',
+                f'CPU {cpu} is not one this process may run on (it may run on '
                 f"{', '.join(map(str, sorted(self._available_cpus)))})",
             )
 
@@ -335,11 +335,11 @@ class LinkageNode(Node):
         node_cpus = self._available_cpus if cpu == NO_CPU_AFFINITY else {cpu}
         set_process_affinity(os.getpid(), node_cpus)
         if cpu == NO_CPU_AFFINITY:
-            self.get_logger().info("no longer pinned to a CPU")
+            self.get_logger().info('no longer pinned to a CPU')
             return None
         bag_writer_cpus = (self._available_cpus - node_cpus) or node_cpus
         self.get_logger().info(
-            f"running on CPU {cpu}; the bag writer on CPU "
+            f'running on CPU {cpu}; the bag writer on CPU '
             f"{', '.join(map(str, sorted(bag_writer_cpus)))}"
         )
         return bag_writer_cpus
@@ -350,21 +350,21 @@ class LinkageNode(Node):
         """A recorder for every topic, before anything is published; ConfigurationError naming
         log.folder if it cannot be written."""
         metadata = {
-            "parameters": json.dumps(self.parameter_values(), sort_keys=True),
-            "package_version": package_version(),
+            'parameters': json.dumps(self.parameter_values(), sort_keys=True),
+            'package_version': package_version(),
         }
         try:
             recorder = Recorder(
                 self.config.log_folder, metadata=metadata, cpus=self._bag_writer_cpus
             )
         except OSError as error:
-            raise ConfigurationError("log.folder", str(error)) from None
+            raise ConfigurationError('log.folder', str(error)) from None
         try:
             for topic, publisher in self._topic_publishers.items():
                 recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
         except OSError as error:
             recorder.close()
-            raise ConfigurationError("log.folder", str(error)) from None
+            raise ConfigurationError('log.folder', str(error)) from None
         return recorder
 
     def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
@@ -380,7 +380,7 @@ class LinkageNode(Node):
             self._recorder.record(topic, data, log_time_ns)
         except OSError as error:
             # The data keep flowing; diagnostics report the lost log.
-            self._recording_error = f"recording stopped: {error}"
+            self._recording_error = f'recording stopped: {error}'
             self.get_logger().error(self._recording_error)
 
     def flush_publishers(self, timeout: float = 1.0) -> None:
@@ -397,11 +397,11 @@ class LinkageNode(Node):
         try:
             self._recorder.close()
         except OSError as error:
-            self.get_logger().error(f"could not finalize the log: {error}")
+            self.get_logger().error(f'could not finalize the log: {error}')
             return False
         bag = self._recorder.bag_path
-        count = bag_reader.bag_information(bag)["message_count"]
-        self.get_logger().info(f"bag finalized: {bag}, {count} messages")
+        count = bag_reader.bag_information(bag)['message_count']
+        self.get_logger().info(f'bag finalized: {bag}, {count} messages')
         return True
 
     # motion
@@ -409,7 +409,7 @@ class LinkageNode(Node):
     def _timer_period(self) -> float:
         """The state timer's period: rate_hz in real_time mode; in fixed_step mode the timer is
         re-armed for each step's time, and this first period only starts it."""
-        if self.config.mode == "real_time":
+        if self.config.mode == 'real_time':
             return 1.0 / self.config.rate_hz
         return 1e-3
 
@@ -433,7 +433,7 @@ class LinkageNode(Node):
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
             self._motion_start = now
-        if self.config.mode == "real_time":
+        if self.config.mode == 'real_time':
             self._advance_in_real_time(now)
         else:
             self._advance_steps(now)
@@ -484,7 +484,7 @@ class LinkageNode(Node):
         try:
             state = solve_sample(config, sample)
         except (DeadPointError, UnreachableError) as error:
-            if config.end_behavior == "stop":
+            if config.end_behavior == 'stop':
                 self._cannot_go_on(str(error))
             # loop and bounce turn round at the dead point itself, which has no state to show.
             return
@@ -515,7 +515,7 @@ class LinkageNode(Node):
             self._publish_markers()
             if self._described_linkage != self.config.linkage:
                 self._publish_robot_description(at)
-            self._activity = "moving"
+            self._activity = 'moving'
             self._publish_diagnostics()
         nanoseconds = at.nanoseconds
         self._joint_positions = messages.joint_positions(state, self._joint_positions)
@@ -538,7 +538,7 @@ class LinkageNode(Node):
 
     def _finish_at_end(self) -> None:
         self._activity = (
-            f"reached alpha_end = {math.degrees(self.config.alpha_end):.6f}°; stopped"
+            f'reached alpha_end = {math.degrees(self.config.alpha_end):.6f}°; stopped'
         )
         self.get_logger().info(self._activity)
         self._publish_markers()
@@ -550,7 +550,7 @@ class LinkageNode(Node):
         if config.blocked_at is not None:
             problem = dead_point_problem(config)
         else:
-            problem = f"the crank cannot go on: {detail}"
+            problem = f'the crank cannot go on: {detail}'
         self._problem = problem
         self.get_logger().error(problem)
         self._publish_diagnostics()
@@ -590,7 +590,7 @@ class LinkageNode(Node):
         level, text = assess(self.config, self._state, problem, self._activity)
         message = messages.diagnostic_array(
             at.to_msg(),
-            f"{self.get_name()}: {DIAGNOSTIC_TASK}",
+            f'{self.get_name()}: {DIAGNOSTIC_TASK}',
             f"four-bar linkage ({self.config.preset or 'explicit geometry'})",
             level,
             text,
@@ -601,11 +601,11 @@ class LinkageNode(Node):
     def _diagnostic_values(self) -> dict[str, str]:
         config = self.config
         values = {
-            "end behavior": config.end_behavior,
-            "mode": config.mode,
-            "achieved rate (Hz)": f"{self._achieved_rate:.1f}",
-            "rate_hz": f"{config.rate_hz:g}",
-            "missed deadlines": str(self._missed_deadlines),
+            'end behavior': config.end_behavior,
+            'mode': config.mode,
+            'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
+            'rate_hz': f'{config.rate_hz:g}',
+            'missed deadlines': str(self._missed_deadlines),
         }
         state = self._state
         if state is not None:
@@ -614,23 +614,23 @@ class LinkageNode(Node):
             change_distance = reachability.change_point_distance(state.alpha)
             residual = float(loop_closure_residual(config.linkage, state))
             values.update({
-                "alpha (rad)": repr(state.alpha),
-                "alpha (deg)": f"{math.degrees(state.alpha):.6f}",
-                "dead point distance (deg)": (
-                    "none (full rotation)" if distance is None
-                    else f"{math.degrees(distance):.6f}"
+                'alpha (rad)': repr(state.alpha),
+                'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
+                'dead point distance (deg)': (
+                    'none (full rotation)' if distance is None
+                    else f'{math.degrees(distance):.6f}'
                 ),
-                "change point distance (deg)": (
-                    "none" if change_distance is None else f"{math.degrees(change_distance):.6f}"
+                'change point distance (deg)': (
+                    'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
                 ),
-                "transmission angle (deg)": f"{math.degrees(state.transmission_angle):.6f}",
-                "loop closure residual": f"{residual:.3g}",
+                'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
+                'loop closure residual': f'{residual:.3g}',
             })
         if self._recorder is None:
-            values["log file"] = "disabled"
+            values['log file'] = 'disabled'
         else:
-            values["log file"] = str(self._recorder.bag_path)
-            values["log size (bytes)"] = str(self._recorder.size_bytes)
+            values['log file'] = str(self._recorder.bag_path)
+            values['log size (bytes)'] = str(self._recorder.size_bytes)
         return values
 
 
@@ -640,8 +640,8 @@ class LinkageNode(Node):
 def _report_configuration_error(error: ConfigurationError) -> None:
     """The one line saying which parameter is bad and why: to the node's logger (console,
     /rosout, log file) and plainly to stderr."""
-    get_logger(NODE_NAME).fatal(f"invalid parameter {error}")
-    print(f"{NODE_NAME}: invalid parameter {error}", file=sys.stderr, flush=True)
+    get_logger(NODE_NAME).fatal(f'invalid parameter {error}')
+    print(f'{NODE_NAME}: invalid parameter {error}', file=sys.stderr, flush=True)
 
 
 def main(args: list[str] | None = None) -> int:
@@ -670,7 +670,7 @@ def main(args: list[str] | None = None) -> int:
         # executor. The events executor's spin() busy-waits without running timers; spin_once
         # returns after each callback, and at the latest after the timeout, so the signal
         # handlers above run and the loop sees the end of the run.
-        if node.get_parameter("use_sim_time").value:
+        if node.get_parameter('use_sim_time').value:
             executor: Executor = SingleThreadedExecutor()
         else:
             executor = EventsExecutor()
@@ -689,5 +689,5 @@ def main(args: list[str] | None = None) -> int:
         rclpy.try_shutdown()
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

@@ -26,10 +26,10 @@ from linkage_kinematics.geometry import (
 from linkage_kinematics.kinematics import DeadPointError, continued_branch, solve
 from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 
-NODE_NAME = "linkage_node"
-END_BEHAVIORS = ("stop", "loop", "bounce")
-MODES = ("real_time", "fixed_step")
-GEOMETRY_PARAMETERS = ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")
+NODE_NAME = 'linkage_node'
+END_BEHAVIORS = ('stop', 'loop', 'bounce')
+MODES = ('real_time', 'fixed_step')
+GEOMETRY_PARAMETERS = ('crank_length', 'coupler_length', 'rocker_length', 'ground_x', 'ground_y')
 MAX_RATE_HZ = 10000.0
 MAX_DISPLAY_RATE_HZ = 1000.0
 MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
@@ -52,7 +52,7 @@ class ConfigurationError(ValueError):
     """A parameter value (or a combination of them) the node cannot run with."""
 
     def __init__(self, parameter: str, reason: str) -> None:
-        super().__init__(f"{parameter}: {reason}")
+        super().__init__(f'{parameter}: {reason}')
         self.parameter = parameter
         self.reason = reason
 
@@ -133,79 +133,79 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
             floating_range=limits,
         )
         for name, text, limits in (
-            ("crank_length", "disk radius OA, greater than 0", (0.0, MAX_LENGTH)),
-            ("coupler_length", "coupler length AB, greater than 0", (0.0, MAX_LENGTH)),
-            ("rocker_length", "rocker length BC, greater than 0", (0.0, MAX_LENGTH)),
-            ("ground_x", "x of the fixed pivot C relative to O", (-MAX_LENGTH, MAX_LENGTH)),
-            ("ground_y", "y of the fixed pivot C relative to O", (-MAX_LENGTH, MAX_LENGTH)),
+            ('crank_length', 'disk radius OA, greater than 0', (0.0, MAX_LENGTH)),
+            ('coupler_length', 'coupler length AB, greater than 0', (0.0, MAX_LENGTH)),
+            ('rocker_length', 'rocker length BC, greater than 0', (0.0, MAX_LENGTH)),
+            ('ground_x', 'x of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
+            ('ground_y', 'y of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
         )
     )
     return (
         ParameterSpec(
-            "preset", "paper",
+            'preset', 'paper',
             "mechanism whose dimensions are the geometry parameters' defaults: "
             "paper, paper_full_turn, grashof_crank_rocker, or '' for none",
             read_only=True,
         ),
         *geometry_specs,
-        ParameterSpec("branch", 1,
-                      "assembly at alpha_start: +1 (B left of A→C) or −1; through change points "
-                      "the motion continues on its smooth branch",
+        ParameterSpec('branch', 1,
+                      'assembly at alpha_start: +1 (B left of A→C) or −1; through change points '
+                      'the motion continues on its smooth branch',
                       integer_range=(-1, 1, 2)),
-        ParameterSpec("omega0", 2.0, "drive law ω = omega0 + k·α: omega0 (rad/s)",
+        ParameterSpec('omega0', 2.0, 'drive law ω = omega0 + k·α: omega0 (rad/s)',
                       floating_range=(-MAX_OMEGA0, MAX_OMEGA0)),
-        ParameterSpec("k", 0.0, "drive law ω = omega0 + k·α: k (1/s)",
+        ParameterSpec('k', 0.0, 'drive law ω = omega0 + k·α: k (1/s)',
                       floating_range=(-MAX_DRIVE_GAIN, MAX_DRIVE_GAIN)),
-        ParameterSpec("alpha_start", 0.0, "crank angle where the motion starts (rad)",
+        ParameterSpec('alpha_start', 0.0, 'crank angle where the motion starts (rad)',
                       floating_range=(-MAX_ANGLE, MAX_ANGLE)),
-        ParameterSpec("alpha_end", math.pi / 2.0,
-                      "crank angle where one pass ends (rad), not alpha_start",
+        ParameterSpec('alpha_end', math.pi / 2.0,
+                      'crank angle where one pass ends (rad), not alpha_start',
                       floating_range=(-MAX_ANGLE, MAX_ANGLE)),
-        ParameterSpec("end_behavior", "stop",
-                      "at the end of a pass: stop (and exit), loop or bounce"),
-        ParameterSpec("mode", "real_time",
-                      "real_time: α from node-clock time at rate_hz; fixed_step: steps of "
-                      "alpha_step, each published when the drive law reaches it"),
-        ParameterSpec("alpha_step", math.radians(0.5),
-                      "crank step in fixed_step mode (rad), greater than 0",
+        ParameterSpec('end_behavior', 'stop',
+                      'at the end of a pass: stop (and exit), loop or bounce'),
+        ParameterSpec('mode', 'real_time',
+                      'real_time: α from node-clock time at rate_hz; fixed_step: steps of '
+                      'alpha_step, each published when the drive law reaches it'),
+        ParameterSpec('alpha_step', math.radians(0.5),
+                      'crank step in fixed_step mode (rad), greater than 0',
                       floating_range=(0.0, TWO_PI)),
-        ParameterSpec("rate_hz", 100.0,
-                      "state compute and publish rate in real_time mode (Hz), greater than 0; "
-                      "unused in fixed_step mode",
+        ParameterSpec('rate_hz', 100.0,
+                      'state compute and publish rate in real_time mode (Hz), greater than 0; '
+                      'unused in fixed_step mode',
                       floating_range=(0.0, MAX_RATE_HZ)),
-        ParameterSpec("display_rate_hz", 30.0,
-                      "publish rate of linkage/markers (Hz), greater than 0",
+        ParameterSpec('display_rate_hz', 30.0,
+                      'publish rate of linkage/markers (Hz), greater than 0',
                       floating_range=(0.0, MAX_DISPLAY_RATE_HZ)),
-        ParameterSpec("frame_id", DEFAULT_FRAME_ID,
-                      "frame of the markers and linkage/state, root link of the URDF",
+        ParameterSpec('frame_id', DEFAULT_FRAME_ID,
+                      'frame of the markers and linkage/state, root link of the URDF',
                       read_only=True),
-        ParameterSpec("frame_prefix", "",
+        ParameterSpec('frame_prefix', '',
                       "prefix of every frame id the node publishes (robot_state_publisher's "
                       "frame_prefix, e.g. 'left/'); the URDF stays unprefixed",
                       read_only=True),
-        ParameterSpec("diagnostics.min_transmission_angle", math.radians(10.0),
-                      "WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)",
+        ParameterSpec('diagnostics.min_transmission_angle', math.radians(10.0),
+                      'WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)',
                       floating_range=(0.0, math.pi / 2.0)),
-        ParameterSpec("diagnostics.dead_point_warning", math.radians(1.0),
-                      "WARN when the crank is closer than this to a dead point or a change "
-                      "point (rad)",
+        ParameterSpec('diagnostics.dead_point_warning', math.radians(1.0),
+                      'WARN when the crank is closer than this to a dead point or a change '
+                      'point (rad)',
                       floating_range=(0.0, math.pi)),
-        ParameterSpec("log.enabled", True, "record every published message to a bag",
+        ParameterSpec('log.enabled', True, 'record every published message to a bag',
                       read_only=True),
-        ParameterSpec("log.folder", "bags",
-                      "folder that receives a new bag per run (relative to the working "
-                      "directory)", read_only=True),
-        ParameterSpec("cpu_affinity", NO_CPU_AFFINITY,
+        ParameterSpec('log.folder', 'bags',
+                      'folder that receives a new bag per run (relative to the working '
+                      'directory)', read_only=True),
+        ParameterSpec('cpu_affinity', NO_CPU_AFFINITY,
                       "CPU that every thread of the node's process runs on, its bag writer "
                       "process on the others (as ros2_control's cpu_affinity); -1 leaves "
-                      "both to the operating system",
+                      'both to the operating system',
                       integer_range=(NO_CPU_AFFINITY, MAX_CPU, 1)),
     )
 
 
-PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(""))
+PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(''))
 REAL_PARAMETERS = frozenset(
-    spec.name for spec in parameter_specs("") if spec.floating_range is not None
+    spec.name for spec in parameter_specs('') if spec.floating_range is not None
 )
 
 
@@ -215,35 +215,35 @@ REAL_PARAMETERS = frozenset(
 def describe_value(value: object) -> str:
     """A parameter value and its type, for error messages."""
     if value is None:
-        return "no value"
-    return f"{type(value).__name__} {value!r}"
+        return 'no value'
+    return f'{type(value).__name__} {value!r}'
 
 
 def _real(values: Mapping[str, Any], name: str) -> float:
     value = values.get(name)
     # bool is an int in Python but a different parameter type in ROS.
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigurationError(name, f"must be a number, got {describe_value(value)}")
+        raise ConfigurationError(name, f'must be a number, got {describe_value(value)}')
     value = float(value)
     if not math.isfinite(value):
-        raise ConfigurationError(name, f"must be finite, got {value!r}")
+        raise ConfigurationError(name, f'must be finite, got {value!r}')
     return value
 
 
 def _positive(values: Mapping[str, Any], name: str, unit: str, upper: float = math.inf) -> float:
     value = _real(values, name)
     if not 0.0 < value <= upper:
-        bound = f" and at most {upper:g} {unit}" if math.isfinite(upper) else ""
-        raise ConfigurationError(name, f"must be greater than 0 {unit}{bound}, got {value!r}")
+        bound = f' and at most {upper:g} {unit}' if math.isfinite(upper) else ''
+        raise ConfigurationError(name, f'must be greater than 0 {unit}{bound}, got {value!r}')
     return value
 
 
 def _within(
-    values: Mapping[str, Any], name: str, low: float, high: float, unit: str = "rad"
+    values: Mapping[str, Any], name: str, low: float, high: float, unit: str = 'rad'
 ) -> float:
     value = _real(values, name)
     if not low <= value <= high:
-        raise ConfigurationError(name, f"must lie in [{low:g}, {high:g}] {unit}, got {value!r}")
+        raise ConfigurationError(name, f'must lie in [{low:g}, {high:g}] {unit}, got {value!r}')
     return value
 
 
@@ -255,61 +255,61 @@ def _text(
 ) -> str:
     value = values.get(name)
     if not isinstance(value, str):
-        raise ConfigurationError(name, f"must be a string, got {describe_value(value)}")
+        raise ConfigurationError(name, f'must be a string, got {describe_value(value)}')
     if choices is not None and value not in choices:
         raise ConfigurationError(name, f"must be one of {', '.join(choices)}; got {value!r}")
     if choices is None and not value and not allow_empty:
-        raise ConfigurationError(name, "must not be empty")
+        raise ConfigurationError(name, 'must not be empty')
     return value
 
 
 def _flag(values: Mapping[str, Any], name: str) -> bool:
     value = values.get(name)
     if not isinstance(value, bool):
-        raise ConfigurationError(name, f"must be true or false, got {describe_value(value)}")
+        raise ConfigurationError(name, f'must be true or false, got {describe_value(value)}')
     return value
 
 
 def _cpu(values: Mapping[str, Any]) -> int:
-    value = values.get("cpu_affinity")
+    value = values.get('cpu_affinity')
     if (isinstance(value, bool) or not isinstance(value, int)
             or not NO_CPU_AFFINITY <= value <= MAX_CPU):
         raise ConfigurationError(
-            "cpu_affinity",
-            f"must be {NO_CPU_AFFINITY} (no pinning) or a CPU number in [0, {MAX_CPU}], got "
-            f"{describe_value(value)}",
+            'cpu_affinity',
+            f'must be {NO_CPU_AFFINITY} (no pinning) or a CPU number in [0, {MAX_CPU}], got '
+            f'{describe_value(value)}',
         )
     return value
 
 
 def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
-    preset_name = values.get("preset")
+    preset_name = values.get('preset')
     if not isinstance(preset_name, str):
-        raise ConfigurationError("preset", f"must be a string, got {describe_value(preset_name)}")
+        raise ConfigurationError('preset', f'must be a string, got {describe_value(preset_name)}')
     if preset_name:
         try:
             preset(preset_name)
         except GeometryError as error:
-            raise ConfigurationError("preset", str(error)) from None
+            raise ConfigurationError('preset', str(error)) from None
     for name in GEOMETRY_PARAMETERS:
         if values.get(name) is None:
             raise ConfigurationError(name, "has no value: with preset '' all five of "
                                      f"{', '.join(GEOMETRY_PARAMETERS)} must be given")
-    for name in ("crank_length", "coupler_length", "rocker_length"):
-        _positive(values, name, "m", MAX_LENGTH)
-    for name in ("ground_x", "ground_y"):
-        _within(values, name, -MAX_LENGTH, MAX_LENGTH, "m")
+    for name in ('crank_length', 'coupler_length', 'rocker_length'):
+        _positive(values, name, 'm', MAX_LENGTH)
+    for name in ('ground_x', 'ground_y'):
+        _within(values, name, -MAX_LENGTH, MAX_LENGTH, 'm')
     try:
         linkage = FourBar(*(_real(values, name) for name in GEOMETRY_PARAMETERS))
     except GeometryError as error:
-        raise ConfigurationError(", ".join(GEOMETRY_PARAMETERS), str(error)) from None
+        raise ConfigurationError(', '.join(GEOMETRY_PARAMETERS), str(error)) from None
     return preset_name, linkage
 
 
 def _branch(values: Mapping[str, Any]) -> int:
-    branch = values.get("branch")
+    branch = values.get('branch')
     if isinstance(branch, bool) or not isinstance(branch, int) or branch not in (1, -1):
-        raise ConfigurationError("branch", f"must be the integer 1 or -1, got {describe_value(branch)}")
+        raise ConfigurationError('branch', f'must be the integer 1 or -1, got {describe_value(branch)}')
     return int(branch)
 
 
@@ -321,17 +321,17 @@ def _motion(
         linkage.reachability.require(alpha_start)
         solve(linkage, alpha_start, drive, branch)
     except (UnreachableError, DeadPointError) as error:
-        raise ConfigurationError("alpha_start", str(error)) from None
+        raise ConfigurationError('alpha_start', str(error)) from None
     if drive.angular_velocity(alpha_start) == 0.0:
         raise ConfigurationError(
-            "omega0", "the crank is at rest at alpha_start (omega0 + k·alpha_start = 0 rad/s)"
+            'omega0', 'the crank is at rest at alpha_start (omega0 + k·alpha_start = 0 rad/s)'
         )
     if alpha_end == alpha_start:
-        raise ConfigurationError("alpha_end", "equals alpha_start, so a pass would be empty")
+        raise ConfigurationError('alpha_end', 'equals alpha_start, so a pass would be empty')
     try:
         drive.time_to(alpha_start, alpha_end)
     except DriveError as error:
-        raise ConfigurationError("alpha_end", str(error)) from None
+        raise ConfigurationError('alpha_end', str(error)) from None
     # Change points do not stop the crank: it goes through them on its smooth branch.
     blocked_at = linkage.reachability.first_dead_point(alpha_start, alpha_end)
     if blocked_at is None:
@@ -344,10 +344,10 @@ def _motion(
     duration = drive.time_to(alpha_start, segment_end)
     if duration < MIN_PASS_DURATION:
         raise ConfigurationError(
-            "alpha_end",
-            f"a pass from alpha_start to {math.degrees(segment_end):.6g}° would last only "
-            f"{duration:.3g} s under this drive law; it must last at least "
-            f"{MIN_PASS_DURATION:g} s",
+            'alpha_end',
+            f'a pass from alpha_start to {math.degrees(segment_end):.6g}° would last only '
+            f'{duration:.3g} s under this drive law; it must last at least '
+            f'{MIN_PASS_DURATION:g} s',
         )
     return blocked_at, duration
 
@@ -360,31 +360,31 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     """
     preset_name, linkage = _geometry(values)
     branch = _branch(values)
-    omega0 = _within(values, "omega0", -MAX_OMEGA0, MAX_OMEGA0, "rad/s")
-    k = _within(values, "k", -MAX_DRIVE_GAIN, MAX_DRIVE_GAIN, "1/s")
+    omega0 = _within(values, 'omega0', -MAX_OMEGA0, MAX_OMEGA0, 'rad/s')
+    k = _within(values, 'k', -MAX_DRIVE_GAIN, MAX_DRIVE_GAIN, '1/s')
     drive = DriveLaw(omega0, k)
-    alpha_start = _within(values, "alpha_start", -MAX_ANGLE, MAX_ANGLE)
-    alpha_end = _within(values, "alpha_end", -MAX_ANGLE, MAX_ANGLE)
-    end_behavior = _text(values, "end_behavior", END_BEHAVIORS)
-    mode = _text(values, "mode", MODES)
-    alpha_step = _positive(values, "alpha_step", "rad", TWO_PI)
-    rate_hz = _positive(values, "rate_hz", "Hz", MAX_RATE_HZ)
-    display_rate_hz = _positive(values, "display_rate_hz", "Hz", MAX_DISPLAY_RATE_HZ)
-    frame_id = _text(values, "frame_id")
-    frame_prefix = _text(values, "frame_prefix", allow_empty=True)
+    alpha_start = _within(values, 'alpha_start', -MAX_ANGLE, MAX_ANGLE)
+    alpha_end = _within(values, 'alpha_end', -MAX_ANGLE, MAX_ANGLE)
+    end_behavior = _text(values, 'end_behavior', END_BEHAVIORS)
+    mode = _text(values, 'mode', MODES)
+    alpha_step = _positive(values, 'alpha_step', 'rad', TWO_PI)
+    rate_hz = _positive(values, 'rate_hz', 'Hz', MAX_RATE_HZ)
+    display_rate_hz = _positive(values, 'display_rate_hz', 'Hz', MAX_DISPLAY_RATE_HZ)
+    frame_id = _text(values, 'frame_id')
+    frame_prefix = _text(values, 'frame_prefix', allow_empty=True)
     min_transmission_angle = _within(
-        values, "diagnostics.min_transmission_angle", 0.0, math.pi / 2.0
+        values, 'diagnostics.min_transmission_angle', 0.0, math.pi / 2.0
     )
-    dead_point_warning = _within(values, "diagnostics.dead_point_warning", 0.0, math.pi)
-    log_enabled = _flag(values, "log.enabled")
-    log_folder = Path(_text(values, "log.folder"))
+    dead_point_warning = _within(values, 'diagnostics.dead_point_warning', 0.0, math.pi)
+    log_enabled = _flag(values, 'log.enabled')
+    log_folder = Path(_text(values, 'log.folder'))
     cpu_affinity = _cpu(values)
     blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
     segment_end = alpha_end if blocked_at is None else blocked_at
     travel = abs(segment_end - alpha_start)
     steps = travel / alpha_step
     if not math.isfinite(steps):
-        raise ConfigurationError("alpha_step", f"is too small for a pass of {travel!r} rad")
+        raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
     step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     return RunConfiguration(
         preset=preset_name,
@@ -422,15 +422,15 @@ def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
     order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry."""
     path = Path(parameters_file)
     try:
-        entries = yaml.safe_load(path.read_text(encoding="utf-8"))
+        entries = yaml.safe_load(path.read_text(encoding='utf-8'))
     except (OSError, yaml.YAMLError) as error:
-        raise ValueError(f"cannot read parameters file {path}: {error}") from None
+        raise ValueError(f'cannot read parameters file {path}: {error}') from None
     if not isinstance(entries, dict) or not entries:
-        raise ValueError(f"{path} has no /<namespace>/{NODE_NAME} entries")
+        raise ValueError(f'{path} has no /<namespace>/{NODE_NAME} entries')
     namespaces = []
     for key in entries:
-        namespace, _, name = str(key).rpartition("/")
-        if name != NODE_NAME or not namespace.startswith("/") or "*" in namespace:
-            raise ValueError(f"{path}: entry {key!r} is not /<namespace>/{NODE_NAME}")
+        namespace, _, name = str(key).rpartition('/')
+        if name != NODE_NAME or not namespace.startswith('/') or '*' in namespace:
+            raise ValueError(f'{path}: entry {key!r} is not /<namespace>/{NODE_NAME}')
         namespaces.append(namespace)
     return namespaces

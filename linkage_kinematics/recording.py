@@ -41,14 +41,14 @@ from linkage_kinematics.bag_writer import BagWriteError, message_definition
 from linkage_kinematics.bag_writer_process import BagWriterProcess
 
 # XCDR1, little endian: the representation identifier and two option bytes.
-ENCAPSULATION_HEADER = b"\x00\x01\x00\x00"
+ENCAPSULATION_HEADER = b'\x00\x01\x00\x00'
 # struct code and size of each primitive (rclpy holds an octet as a 1-byte bytes, a char as an
 # int).
 _PRIMITIVES = {
-    "boolean": ("?", 1), "octet": ("c", 1), "char": ("B", 1), "int8": ("b", 1),
-    "uint8": ("B", 1), "int16": ("h", 2), "uint16": ("H", 2), "int32": ("i", 4),
-    "uint32": ("I", 4), "float": ("f", 4), "int64": ("q", 8), "uint64": ("Q", 8),
-    "double": ("d", 8),
+    'boolean': ('?', 1), 'octet': ('c', 1), 'char': ('B', 1), 'int8': ('b', 1),
+    'uint8': ('B', 1), 'int16': ('h', 2), 'uint16': ('H', 2), 'int32': ('i', 4),
+    'uint32': ('I', 4), 'float': ('f', 4), 'int64': ('q', 8), 'uint64': ('Q', 8),
+    'double': ('d', 8),
 }
 # How a plan entry is written: a run of fixed-size fields (primitives and messages made only of
 # them) in one struct code, a string, a message, and sequences (or arrays) of each.
@@ -61,19 +61,19 @@ class RecordingError(OSError):
 
 def ros_type_name(msg_type: type) -> str:
     """``sensor_msgs/msg/JointState`` for the rclpy class ``sensor_msgs.msg.JointState``."""
-    package, interface_kind = msg_type.__module__.split(".")[:2]
-    return f"{package}/{interface_kind}/{msg_type.__name__}"
+    package, interface_kind = msg_type.__module__.split('.')[:2]
+    return f'{package}/{interface_kind}/{msg_type.__name__}'
 
 
 def _message_class(slot_type: NamespacedType) -> type:
-    return getattr(importlib.import_module(".".join(slot_type.namespaces)), slot_type.name)
+    return getattr(importlib.import_module('.'.join(slot_type.namespaces)), slot_type.name)
 
 
 # One entry of a plan: its getter, how it is written, a detail (the struct codes and lengths
 # of a fixed run, by offset mod 8; the code and size of a primitive sequence's elements), the
 # element getter or message class of a sequence or message, and whether a length comes first.
 _Entry = tuple[Callable[[Any], Any], int, Any, Any, bool]
-_PADDING = ("",) + tuple(f"{n}x" for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
+_PADDING = ('',) + tuple(f'{n}x' for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
 
 
 def _fields(msg_type: type) -> list[tuple[str, Any]]:
@@ -92,7 +92,7 @@ def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
             nested = _fixed_leaves(_message_class(slot_type))
             if nested is None:
                 return None
-            leaves += [(f"{name}.{path}", code, size) for path, code, size in nested]
+            leaves += [(f'{name}.{path}', code, size) for path, code, size in nested]
         else:
             return None
     return tuple(leaves)
@@ -108,7 +108,7 @@ def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tu
             padding = -offset % size
             codes.append(_PADDING[padding] + code)
             offset += padding + size
-        layouts.append(("".join(codes), offset - phase))
+        layouts.append((''.join(codes), offset - phase))
     paths = [path for path, _, _ in leaves]
     if len(paths) == 1:
         single = operator.attrgetter(paths[0])
@@ -130,9 +130,9 @@ def _plan(msg_type: type) -> tuple[_Entry, ...]:
     for name, slot_type in _fields(msg_type):
         element = slot_type.value_type if isinstance(slot_type, AbstractNestedType) else slot_type
         if isinstance(element, AbstractWString):
-            raise TypeError(f"{ros_type_name(msg_type)}.{name}: wstring fields are not supported")
+            raise TypeError(f'{ros_type_name(msg_type)}.{name}: wstring fields are not supported')
         if not isinstance(element, (BasicType, AbstractString, NamespacedType)):
-            raise TypeError(f"{ros_type_name(msg_type)}.{name}: unsupported type {element!r}")
+            raise TypeError(f'{ros_type_name(msg_type)}.{name}: unsupported type {element!r}')
         message_class = _message_class(element) if isinstance(element, NamespacedType) else None
         fixed = _fixed_leaves(message_class) if message_class is not None else None
         if not isinstance(slot_type, AbstractNestedType):
@@ -140,7 +140,7 @@ def _plan(msg_type: type) -> tuple[_Entry, ...]:
                 run.append((name, *_PRIMITIVES[element.typename]))
                 continue
             if fixed is not None:
-                run += [(f"{name}.{path}", code, size) for path, code, size in fixed]
+                run += [(f'{name}.{path}', code, size) for path, code, size in fixed]
                 continue
         if run:
             plan.append(_run_entry(run))
@@ -181,14 +181,14 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
         else:
             if counted:
                 padding = -offset % 4
-                codes.append(_PADDING[padding] + "I")
+                codes.append(_PADDING[padding] + 'I')
                 values.append(len(value))
                 offset += padding + 4
             if kind == _PRIMITIVE_LIST:
                 if len(value):  # a fixed-size array is a numpy array
                     code, size = detail
                     padding = -offset % size
-                    codes.append(f"{_PADDING[padding]}{len(value)}{code}")
+                    codes.append(f'{_PADDING[padding]}{len(value)}{code}')
                     values.extend(value)
                     offset += padding + len(value) * size
             elif kind == _FIXED_LIST:
@@ -208,26 +208,26 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
 
 
 def _add_string(text: str, codes: list[str], values: list[Any], offset: int) -> int:
-    encoded = text.encode("utf-8")
+    encoded = text.encode('utf-8')
     padding = -offset % 4
     length = len(encoded) + 1  # with the terminating NUL, which struct adds
-    codes.append(f"{_PADDING[padding]}I{length}s")
+    codes.append(f'{_PADDING[padding]}I{length}s')
     values.extend((length, encoded))
     return offset + padding + 4 + length
 
 
 def encode_cdr(message: Any) -> bytes:
     """``message`` (an rclpy message) as little-endian XCDR1 with its encapsulation header."""
-    codes: list[str] = ["<"]
+    codes: list[str] = ['<']
     values: list[Any] = []
     _walk(message, _plan(type(message)), codes, values, 0)
-    return ENCAPSULATION_HEADER + struct.pack("".join(codes), *values)
+    return ENCAPSULATION_HEADER + struct.pack(''.join(codes), *values)
 
 
 class _Slot:
     """Stands for a value of a varying field while a template is walked."""
 
-    __slots__ = ("path",)
+    __slots__ = ('path',)
 
     def __init__(self, path: str) -> None:
         self.path = path
@@ -237,7 +237,7 @@ class _Template:
     """A message seen through ``_walk``: the fields named in ``varying`` read as slots (one per
     element of a sequence), every other field as the message's own value."""
 
-    __slots__ = ("_message", "_path", "_varying")
+    __slots__ = ('_message', '_path', '_varying')
 
     def __init__(self, message: Any, path: str, varying: frozenset[str]) -> None:
         self._message = message
@@ -245,20 +245,20 @@ class _Template:
         self._varying = varying
 
     def __getattr__(self, name: str) -> Any:
-        path = f"{self._path}.{name}" if self._path else name
+        path = f'{self._path}.{name}' if self._path else name
         value = getattr(self._message, name)
         if path in self._varying:
             return [_Slot(path)] * len(value) if _is_sequence(value) else _Slot(path)
-        if hasattr(value, "SLOT_TYPES"):
+        if hasattr(value, 'SLOT_TYPES'):
             return _Template(value, path, self._varying)
-        if isinstance(value, list) and value and hasattr(value[0], "SLOT_TYPES"):
-            return [_Template(element, f"{path}[{index}]", self._varying)
+        if isinstance(value, list) and value and hasattr(value[0], 'SLOT_TYPES'):
+            return [_Template(element, f'{path}[{index}]', self._varying)
                     for index, element in enumerate(value)]
         return value
 
 
 def _is_sequence(value: Any) -> bool:
-    return hasattr(value, "__len__") and not isinstance(value, (str, bytes))
+    return hasattr(value, '__len__') and not isinstance(value, (str, bytes))
 
 
 class FixedShapeEncoder:
@@ -273,9 +273,9 @@ class FixedShapeEncoder:
     """
 
     def __init__(self, template: Any, varying: list[str]) -> None:
-        codes: list[str] = ["<"]
+        codes: list[str] = ['<']
         values: list[Any] = []
-        _walk(_Template(template, "", frozenset(varying)), _plan(type(template)), codes, values,
+        _walk(_Template(template, '', frozenset(varying)), _plan(type(template)), codes, values,
               0)
         constants = [value for value in values if not isinstance(value, _Slot)]
         argument = {path: [] for path in varying}
@@ -284,7 +284,7 @@ class FixedShapeEncoder:
                 argument[value.path].append(index)
         unused = [path for path, indices in argument.items() if not indices]
         if unused:
-            raise ValueError(f"{ros_type_name(type(template))} has no fixed-size field {unused}")
+            raise ValueError(f'{ros_type_name(type(template))} has no fixed-size field {unused}')
         # struct argument i is element order[i] of constants + given values
         given = [index for path in varying for index in argument[path]]
         order = [0] * len(values)
@@ -300,7 +300,7 @@ class FixedShapeEncoder:
         # itemgetter of one index returns the element itself, not a 1-tuple
         self._order = (operator.itemgetter(*order) if len(order) > 1
                        else lambda arguments: (arguments[order[0]],))
-        self._struct = struct.Struct("".join(codes))
+        self._struct = struct.Struct(''.join(codes))
 
     def encode(self, values: tuple) -> bytes:
         """The message with ``values`` (``value_count`` of them) in the varying fields."""
@@ -308,21 +308,21 @@ class FixedShapeEncoder:
 
 
 def _duration(nanoseconds: int) -> dict[str, int]:
-    return {"sec": nanoseconds // 1_000_000_000, "nsec": nanoseconds % 1_000_000_000}
+    return {'sec': nanoseconds // 1_000_000_000, 'nsec': nanoseconds % 1_000_000_000}
 
 
 def offered_qos_profiles_yaml(qos: QoSProfile) -> str:
     """rosbag2's (Jazzy, metadata version 9) YAML text for a publisher offering ``qos``."""
     profile = {
-        "history": qos.history.name.lower(),
-        "depth": qos.depth,
-        "reliability": qos.reliability.name.lower(),
-        "durability": qos.durability.name.lower(),
-        "deadline": _duration(qos.deadline.nanoseconds),
-        "lifespan": _duration(qos.lifespan.nanoseconds),
-        "liveliness": qos.liveliness.name.lower(),
-        "liveliness_lease_duration": _duration(qos.liveliness_lease_duration.nanoseconds),
-        "avoid_ros_namespace_conventions": qos.avoid_ros_namespace_conventions,
+        'history': qos.history.name.lower(),
+        'depth': qos.depth,
+        'reliability': qos.reliability.name.lower(),
+        'durability': qos.durability.name.lower(),
+        'deadline': _duration(qos.deadline.nanoseconds),
+        'lifespan': _duration(qos.lifespan.nanoseconds),
+        'liveliness': qos.liveliness.name.lower(),
+        'liveliness_lease_duration': _duration(qos.liveliness_lease_duration.nanoseconds),
+        'avoid_ros_namespace_conventions': qos.avoid_ros_namespace_conventions,
     }
     return yaml.safe_dump([profile], sort_keys=False)
 

@@ -32,7 +32,7 @@ from linkage_kinematics import bag_reader
 from linkage_kinematics.bag_writer import BagWriteError, recover_bag
 from linkage_kinematics.cli_types import number
 
-TRANSIENT_LOCAL_TOPICS = frozenset({"/robot_description"})
+TRANSIENT_LOCAL_TOPICS = frozenset({'/robot_description'})
 ACK_TIMEOUT_S = 2.0
 
 
@@ -48,42 +48,42 @@ class TopicPlan:
     offered_qos: dict[str, Any] | None
 
 
-_positive_rate = number(above=0.0, rule="a positive factor")
-_non_negative_seconds = number(at_least=0.0, rule="zero or more seconds")
+_positive_rate = number(above=0.0, rule='a positive factor')
+_non_negative_seconds = number(at_least=0.0, rule='zero or more seconds')
 
 
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="linkage-replay",
-        description="Republish a logged linkage run (a rosbag2 MCAP bag folder or .mcap file) "
-        "with its recorded timing, or recover a bag whose recorder was killed.",
+        prog='linkage-replay',
+        description='Republish a logged linkage run (a rosbag2 MCAP bag folder or .mcap file) '
+        'with its recorded timing, or recover a bag whose recorder was killed.',
     )
-    parser.add_argument("bag", help="bag folder (as logged by the node) or .mcap file")
+    parser.add_argument('bag', help='bag folder (as logged by the node) or .mcap file')
     parser.add_argument(
-        "--rate", type=_positive_rate, default=1.0, help="speed factor (2 = twice as fast)"
+        '--rate', type=_positive_rate, default=1.0, help='speed factor (2 = twice as fast)'
     )
-    parser.add_argument("--loop", action="store_true", help="start over at the end, until Ctrl-C")
-    parser.add_argument("--topics", nargs="+", metavar="TOPIC", help="replay only these topics")
+    parser.add_argument('--loop', action='store_true', help='start over at the end, until Ctrl-C')
+    parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='replay only these topics')
     parser.add_argument(
-        "--delay",
+        '--delay',
         type=_non_negative_seconds,
         default=1.0,
-        help="seconds to wait after creating the publishers, for subscribers to connect (1.0)",
+        help='seconds to wait after creating the publishers, for subscribers to connect (1.0)',
     )
     parser.add_argument(
-        "--recover",
-        action="store_true",
-        help="instead of replaying, rewrite BAG (after SIGKILL) so every reader accepts it",
+        '--recover',
+        action='store_true',
+        help='instead of replaying, rewrite BAG (after SIGKILL) so every reader accepts it',
     )
     return parser
 
 
 def _import_message_type(type_name: str) -> type | None:
-    parts = type_name.split("/")
+    parts = type_name.split('/')
     if len(parts) != 3:
         return None
     try:
-        module = importlib.import_module(f"{parts[0]}.{parts[1]}")
+        module = importlib.import_module(f'{parts[0]}.{parts[1]}')
     except ImportError:
         return None
     msg_type = getattr(module, parts[2], None)
@@ -92,22 +92,22 @@ def _import_message_type(type_name: str) -> type | None:
 
 def _logged_topics(bag: Path) -> dict[str, tuple[str, dict[str, Any] | None]]:
     """topic -> (type name, first offered QoS profile or None) of every logged topic."""
-    metadata_path = bag / "metadata.yaml"
+    metadata_path = bag / 'metadata.yaml'
     if bag.is_dir() and metadata_path.is_file():
         try:
-            information = yaml.safe_load(metadata_path.read_text(encoding="utf-8"))[
-                "rosbag2_bagfile_information"
+            information = yaml.safe_load(metadata_path.read_text(encoding='utf-8'))[
+                'rosbag2_bagfile_information'
             ]
             topics = {}
-            for entry in information["topics_with_message_count"]:
-                topic = entry["topic_metadata"]
-                profiles = topic.get("offered_qos_profiles") or []
+            for entry in information['topics_with_message_count']:
+                topic = entry['topic_metadata']
+                profiles = topic.get('offered_qos_profiles') or []
                 if isinstance(profiles, str):  # metadata versions before 9 keep YAML text
                     profiles = yaml.safe_load(profiles) or []
-                topics[topic["name"]] = (topic["type"], profiles[0] if profiles else None)
+                topics[topic['name']] = (topic['type'], profiles[0] if profiles else None)
             return topics
         except (yaml.YAMLError, KeyError, TypeError, IndexError, AttributeError) as error:
-            raise ReplayError(f"{metadata_path} is not rosbag2 bag metadata ({error!r})") from None
+            raise ReplayError(f'{metadata_path} is not rosbag2 bag metadata ({error!r})') from None
     found: dict[str, tuple[str, dict[str, Any] | None]] = {}
     for message in bag_reader.iter_messages(bag):
         found.setdefault(message.topic, (message.schema_name, None))
@@ -128,29 +128,29 @@ def _plan(bag: Path, wanted: Sequence[str] | None) -> list[TopicPlan]:
         msg_type = _import_message_type(type_name)
         if msg_type is None:
             print(
-                f"linkage-replay: skipping {topic}: "
-                f"message type {type_name!r} is not installed here",
+                f'linkage-replay: skipping {topic}: '
+                f'message type {type_name!r} is not installed here',
                 file=sys.stderr,
             )
             continue
         plans.append(TopicPlan(topic, type_name, msg_type, offered_qos))
     if not plans:
         raise ReplayError(
-            f"nothing to replay in {bag}: none of its message types is installed here"
+            f'nothing to replay in {bag}: none of its message types is installed here'
         )
     return plans
 
 
 def _qos(plan: TopicPlan) -> QoSProfile:
     offered = plan.offered_qos or {}
-    durability = offered.get("durability") or (
-        "transient_local" if plan.topic in TRANSIENT_LOCAL_TOPICS else "volatile"
+    durability = offered.get('durability') or (
+        'transient_local' if plan.topic in TRANSIENT_LOCAL_TOPICS else 'volatile'
     )
-    history = offered.get("history", "keep_last")
+    history = offered.get('history', 'keep_last')
     return QoSProfile(
         history=_policy(HistoryPolicy, history),
-        depth=int(offered.get("depth") or 10),
-        reliability=_policy(ReliabilityPolicy, offered.get("reliability", "reliable")),
+        depth=int(offered.get('depth') or 10),
+        reliability=_policy(ReliabilityPolicy, offered.get('reliability', 'reliable')),
         durability=_policy(DurabilityPolicy, durability),
     )
 
@@ -171,7 +171,7 @@ def _replay(bag: Path, plans: list[TopicPlan], rate: float, loop: bool, delay: f
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     for stop_signal in (signal.SIGINT, signal.SIGTERM):
         signal.signal(stop_signal, signal.default_int_handler)
-    node = rclpy.create_node("linkage_replay")
+    node = rclpy.create_node('linkage_replay')
     published = 0
     try:
         publishers = {
@@ -200,7 +200,7 @@ def _replay(bag: Path, plans: list[TopicPlan], rate: float, loop: bool, delay: f
     finally:
         node.destroy_node()
         rclpy.try_shutdown()
-    print(f"linkage-replay: published {published} messages from {bag}", file=sys.stderr)
+    print(f'linkage-replay: published {published} messages from {bag}', file=sys.stderr)
     return 0
 
 
@@ -211,11 +211,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if arguments.recover:
             result = recover_bag(bag)
             state = (
-                "was cut short; its complete part" if result.was_truncated else "was complete; it"
+                'was cut short; its complete part' if result.was_truncated else 'was complete; it'
             )
             print(
-                f"linkage-replay: {bag} {state} is now {result.mcap_path} "
-                f"with summary ({result.message_count} messages)"
+                f'linkage-replay: {bag} {state} is now {result.mcap_path} '
+                f'with summary ({result.message_count} messages)'
             )
             return 0
         files = bag_reader.bag_files(bag)
@@ -223,17 +223,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         if cut:
             raise ReplayError(
                 f"{', '.join(cut)} ends without its summary (the recorder was killed); "
-                f"run `linkage-replay --recover {bag}` first"
+                f'run `linkage-replay --recover {bag}` first'
             )
         plans = _plan(bag, arguments.topics)
         return _replay(bag, plans, arguments.rate, arguments.loop, arguments.delay)
     except (ReplayError, bag_reader.BagError, BagWriteError) as error:
-        print(f"linkage-replay: {error}", file=sys.stderr)
+        print(f'linkage-replay: {error}', file=sys.stderr)
         return 1
     except OSError as error:
-        print(f"linkage-replay: {bag}: {error.strerror or error}", file=sys.stderr)
+        print(f'linkage-replay: {bag}: {error.strerror or error}', file=sys.stderr)
         return 1
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     sys.exit(main())

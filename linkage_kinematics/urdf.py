@@ -18,7 +18,7 @@ import math
 
 from linkage_kinematics.geometry import FourBar, preset
 
-DEFAULT_FRAME_ID = "linkage_base"
+DEFAULT_FRAME_ID = 'linkage_base'
 _BAR_WIDTH = 0.02  # m
 _BAR_HEIGHT = 0.01  # m
 _DISK_THICKNESS = 0.01  # m
@@ -32,16 +32,16 @@ def _number(value: float) -> str:
 
 
 def _xyz(x: float, y: float, z: float) -> str:
-    return f"{_number(x)} {_number(y)} {_number(z)}"
+    return f'{_number(x)} {_number(y)} {_number(z)}'
 
 
-def _visual(geometry: str, xyz: str, material: str, rpy: str = "0 0 0") -> str:
+def _visual(geometry: str, xyz: str, material: str, rpy: str = '0 0 0') -> str:
     return (
-        "    <visual>\n"
+        '    <visual>\n'
         f'      <origin xyz="{xyz}" rpy="{rpy}"/>\n'
-        f"      <geometry>{geometry}</geometry>\n"
+        f'      <geometry>{geometry}</geometry>\n'
         f'      <material name="{material}"/>\n'
-        "    </visual>\n"
+        '    </visual>\n'
     )
 
 
@@ -64,17 +64,17 @@ def _joint(name: str, parent: str, child: str, xyz: str) -> str:
         f'    <child link="{child}"/>\n'
         f'    <origin xyz="{xyz}" rpy="0 0 0"/>\n'
         '    <axis xyz="0 0 1"/>\n'
-        "  </joint>\n"
+        '  </joint>\n'
     )
 
 
 _MATERIALS = (
-    ("pivot", "0.15 0.15 0.15 1"),
-    ("ground", "0.5 0.5 0.5 1"),
-    ("disk", "0.55 0.6 0.7 1"),
-    ("pin", "0.85 0.1 0.1 1"),
-    ("coupler", "0.95 0.55 0.1 1"),
-    ("rocker", "0.15 0.7 0.3 1"),
+    ('pivot', '0.15 0.15 0.15 1'),
+    ('ground', '0.5 0.5 0.5 1'),
+    ('disk', '0.55 0.6 0.7 1'),
+    ('pin', '0.85 0.1 0.1 1'),
+    ('coupler', '0.95 0.55 0.1 1'),
+    ('rocker', '0.15 0.7 0.3 1'),
 )
 
 
@@ -86,40 +86,40 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
     ground = linkage.ground_length
     ground_heading = math.atan2(linkage.ground_y, linkage.ground_x)
     pivot = _box(_PIVOT_SIZE, _PIVOT_SIZE, _PIVOT_SIZE)
-    materials = "".join(
+    materials = ''.join(
         f'  <material name="{name}"><color rgba="{rgba}"/></material>\n'
         for name, rgba in _MATERIALS
     )
     base = (
         f'  <link name="{frame_id}">\n'
-        + _visual(pivot, _xyz(0.0, 0.0, 0.0), "pivot")
-        + _visual(pivot, _xyz(linkage.ground_x, linkage.ground_y, 0.0), "pivot")
+        + _visual(pivot, _xyz(0.0, 0.0, 0.0), 'pivot')
+        + _visual(pivot, _xyz(linkage.ground_x, linkage.ground_y, 0.0), 'pivot')
         # The ground link OC, drawn below the moving parts.
         + _visual(
             _box(ground, _BAR_WIDTH, _BAR_HEIGHT),
             _xyz(0.5 * linkage.ground_x, 0.5 * linkage.ground_y, -2.0 * _PIVOT_SIZE),
-            "ground",
-            rpy=f"0 0 {_number(ground_heading)}",
+            'ground',
+            rpy=f'0 0 {_number(ground_heading)}',
         )
-        + "  </link>\n"
+        + '  </link>\n'
     )
     disk = (
         '  <link name="disk">\n'
-        + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(0.0, 0.0, -_DISK_THICKNESS), "disk")
-        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, -crank, 0.0), "pin")
-        + "  </link>\n"
+        + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(0.0, 0.0, -_DISK_THICKNESS), 'disk')
+        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, -crank, 0.0), 'pin')
+        + '  </link>\n'
     )
     coupler_link = (
         '  <link name="coupler">\n'
         + _visual(_box(coupler, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * coupler, 0.0, 0.0),
-                  "coupler")
-        + "  </link>\n"
+                  'coupler')
+        + '  </link>\n'
     )
     rocker_link = (
         '  <link name="rocker">\n'
-        + _visual(_box(rocker, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * rocker, 0.0, 0.0), "rocker")
-        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, 0.0, 0.0), "pin")
-        + "  </link>\n"
+        + _visual(_box(rocker, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * rocker, 0.0, 0.0), 'rocker')
+        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, 0.0, 0.0), 'pin')
+        + '  </link>\n'
     )
     return (
         '<?xml version="1.0"?>\n'
@@ -129,12 +129,12 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
         + disk
         + coupler_link
         + rocker_link
-        + _joint("crank_joint", frame_id, "disk", _xyz(0.0, 0.0, 0.0))
-        + _joint("coupler_joint", "disk", "coupler", _xyz(0.0, -crank, 0.0))
-        + _joint("rocker_joint", "coupler", "rocker", _xyz(coupler, 0.0, 0.0))
-        + "</robot>\n"
+        + _joint('crank_joint', frame_id, 'disk', _xyz(0.0, 0.0, 0.0))
+        + _joint('coupler_joint', 'disk', 'coupler', _xyz(0.0, -crank, 0.0))
+        + _joint('rocker_joint', 'coupler', 'rocker', _xyz(coupler, 0.0, 0.0))
+        + '</robot>\n'
     )
 
 
-if __name__ == "__main__":
-    print(urdf_text(preset("paper").geometry), end="")
+if __name__ == '__main__':
+    print(urdf_text(preset('paper').geometry), end='')

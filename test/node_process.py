@@ -37,24 +37,24 @@ PROCESS_TIMEOUT = 60.0  # s; a generous bound on any one wait in these tests, al
 def ros_environment(domain_id: int) -> dict[str, str]:
     """The environment a node process (and the test's own rclpy) runs in."""
     environment = dict(os.environ)
-    environment["ROS_DOMAIN_ID"] = str(domain_id)
-    environment["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
-    environment.setdefault("AMENT_PREFIX_PATH", sys.prefix)
-    environment["PYTHONUNBUFFERED"] = "1"
+    environment['ROS_DOMAIN_ID'] = str(domain_id)
+    environment['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    environment.setdefault('AMENT_PREFIX_PATH', sys.prefix)
+    environment['PYTHONUNBUFFERED'] = '1'
     return environment
 
 
 def parameter_argument(name: str, value: Any) -> str:
     """``name:=value`` for ``--ros-args -p`` (floats exactly, strings as YAML strings)."""
     if isinstance(value, bool):
-        text = "true" if value else "false"
+        text = 'true' if value else 'false'
     elif isinstance(value, float):
-        text = ".nan" if math.isnan(value) else repr(value).replace("inf", ".inf")
+        text = '.nan' if math.isnan(value) else repr(value).replace('inf', '.inf')
     elif isinstance(value, str):
         text = "'" + value.replace("'", "''") + "'"
     else:
         text = str(value)
-    return f"{name}:={text}"
+    return f'{name}:={text}'
 
 
 def node_command(
@@ -64,10 +64,10 @@ def node_command(
 ) -> list[str]:
     """The command line of a node with ``parameters`` and further ``ros_arguments`` (e.g.
     ``-r __ns:=/left``)."""
-    command = executable or [sys.executable, "-m", "linkage_kinematics.node"]
-    arguments = ["--ros-args"]
+    command = executable or [sys.executable, '-m', 'linkage_kinematics.node']
+    arguments = ['--ros-args']
     for name, value in parameters.items():
-        arguments += ["-p", parameter_argument(name, value)]
+        arguments += ['-p', parameter_argument(name, value)]
     return command + arguments + list(ros_arguments)
 
 
@@ -83,7 +83,7 @@ def start_node(
 ) -> subprocess.Popen:
     """Start a node process (by default the working tree's, from the repository root); its
     stdout and stderr go to the file ``output``; ``preexec_fn`` runs in the child first."""
-    with open(output, "w") as log:
+    with open(output, 'w') as log:
         return subprocess.Popen(
             node_command(parameters, executable, ros_arguments),
             cwd=cwd,
@@ -113,15 +113,15 @@ def run_node(parameters: Mapping[str, Any], domain_id: int, output: Path) -> tup
 
 def bag_writer_pid(node_pid: int) -> int:
     """The process id of the node's bag writer (bag_writer_process), its child."""
-    for stat in Path("/proc").glob("[0-9]*/stat"):
+    for stat in Path('/proc').glob('[0-9]*/stat'):
         try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-            cmdline = (stat.parent / "cmdline").read_bytes()
+            fields = stat.read_text().rsplit(')', 1)[1].split()
+            cmdline = (stat.parent / 'cmdline').read_bytes()
         except OSError:
             continue  # a process that ended meanwhile
-        if int(fields[1]) == node_pid and b"linkage_kinematics.bag_writer_process" in cmdline:
+        if int(fields[1]) == node_pid and b'linkage_kinematics.bag_writer_process' in cmdline:
             return int(stat.parent.name)
-    raise AssertionError(f"no bag writer process under the node (pid {node_pid})")
+    raise AssertionError(f'no bag writer process under the node (pid {node_pid})')
 
 
 class Listener:
@@ -181,7 +181,7 @@ class Listener:
 
     def result_of(self, future: Future, timeout: float = PROCESS_TIMEOUT) -> Any:
         """Spin until ``future`` (e.g. a parameter service call) is done; its result."""
-        assert self.spin_until(future.done, timeout), "no answer within the timeout"
+        assert self.spin_until(future.done, timeout), 'no answer within the timeout'
         return future.result()
 
     def destroy(self) -> None:
@@ -192,8 +192,8 @@ class Listener:
 @contextmanager
 def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
     """A private rclpy context in the test process on ``domain_id``, loopback only."""
-    previous = os.environ.get("ROS_AUTOMATIC_DISCOVERY_RANGE")
-    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    previous = os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE')
+    os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     context = rclpy.Context()
     rclpy.init(context=context, domain_id=domain_id)
     try:
@@ -201,9 +201,9 @@ def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
     finally:
         rclpy.shutdown(context=context)
         if previous is None:
-            os.environ.pop("ROS_AUTOMATIC_DISCOVERY_RANGE")
+            os.environ.pop('ROS_AUTOMATIC_DISCOVERY_RANGE')
         else:
-            os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = previous
+            os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = previous
 
 
 def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int) -> None:
@@ -218,7 +218,7 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
         clock.publish(message)
         if listener.spin_until(ticked, timeout=0.5):
             return
-    raise AssertionError(f"no state stamped {clock_ns} ns")
+    raise AssertionError(f'no state stamped {clock_ns} ns')
 
 
 def stamp_ns(message: Any) -> int:
@@ -247,7 +247,7 @@ def expected_state_point(
 def configuration_values(**overrides: Any) -> dict[str, Any]:
     """The node's default parameter values (preset 'paper') with ``overrides``, by name; dotted
     names are passed as ``**{"log.enabled": False}``."""
-    return {**{spec.name: spec.default for spec in parameter_specs("paper")}, **overrides}
+    return {**{spec.name: spec.default for spec in parameter_specs('paper')}, **overrides}
 
 
 def set_parameter(

@@ -48,7 +48,7 @@ DIGITS = 50
 
 def _wrap(angle: mpf) -> mpf:
     """``angle`` wrapped to (−π, π]."""
-    wrapped = angle - 2 * mp.pi * mp.floor(angle / (2 * mp.pi) + mpf("0.5"))
+    wrapped = angle - 2 * mp.pi * mp.floor(angle / (2 * mp.pi) + mpf('0.5'))
     return wrapped if wrapped > -mp.pi else wrapped + 2 * mp.pi
 
 
@@ -66,7 +66,7 @@ def _angles(linkage: FourBar, alpha: mpf, branch: int) -> tuple[mpf, mpf]:
     if abs(ratio) > 1:
         # At a change point |ratio| touches 1; rounding in the last digits may pass it.
         if abs(ratio) - 1 > mpf(10) ** (10 - mp.dps):
-            raise ValueError(f"reference: the loop does not close at α = {alpha}")
+            raise ValueError(f'reference: the loop does not close at α = {alpha}')
         ratio = mp.sign(ratio)
     beta = -mp.atan2(q, p) + branch * mp.acos(ratio)
     pin_b_x = mpf(linkage.ground_x) - c * mp.cos(beta)
@@ -112,28 +112,28 @@ def reference_state(
             mp.sqrt(coupler[0] ** 2 + coupler[1] ** 2) * mp.sqrt(rocker[0] ** 2 + rocker[1] ** 2)
         )
         return {
-            "alpha": a,
-            "beta": beta,
-            "gamma": gamma,
-            "omega": omega,
-            "omega_dot": omega_dot,
-            "omega_ab": gamma_1 * omega,
-            "omega_bc": -beta_rate,
-            "omega_dot_ab": gamma_2 * omega * omega + gamma_1 * omega_dot,
-            "omega_dot_bc": -beta_acceleration,
-            "pin_a_x": pin_a[0],
-            "pin_a_y": pin_a[1],
-            "pin_b_x": pin_b[0],
-            "pin_b_y": pin_b[1],
-            "velocity_a_x": r * cos_a * omega,
-            "velocity_a_y": r * sin_a * omega,
-            "velocity_b_x": velocity_b[0],
-            "velocity_b_y": velocity_b[1],
-            "acceleration_a_x": r * (cos_a * omega_dot - sin_a * omega * omega),
-            "acceleration_a_y": r * (sin_a * omega_dot + cos_a * omega * omega),
-            "acceleration_b_x": acceleration_b[0],
-            "acceleration_b_y": acceleration_b[1],
-            "transmission_angle": mp.acos(max(-1, min(1, cosine))),
+            'alpha': a,
+            'beta': beta,
+            'gamma': gamma,
+            'omega': omega,
+            'omega_dot': omega_dot,
+            'omega_ab': gamma_1 * omega,
+            'omega_bc': -beta_rate,
+            'omega_dot_ab': gamma_2 * omega * omega + gamma_1 * omega_dot,
+            'omega_dot_bc': -beta_acceleration,
+            'pin_a_x': pin_a[0],
+            'pin_a_y': pin_a[1],
+            'pin_b_x': pin_b[0],
+            'pin_b_y': pin_b[1],
+            'velocity_a_x': r * cos_a * omega,
+            'velocity_a_y': r * sin_a * omega,
+            'velocity_b_x': velocity_b[0],
+            'velocity_b_y': velocity_b[1],
+            'acceleration_a_x': r * (cos_a * omega_dot - sin_a * omega * omega),
+            'acceleration_a_y': r * (sin_a * omega_dot + cos_a * omega * omega),
+            'acceleration_b_x': acceleration_b[0],
+            'acceleration_b_y': acceleration_b[1],
+            'transmission_angle': mp.acos(max(-1, min(1, cosine))),
         }
 
 
@@ -203,7 +203,7 @@ def continued_sides(
                 misfit = {s: sum(abs(_wrap(c - p)) for c, p in zip(candidates[s], predicted))
                           for s in candidates}
                 best, other = sorted(candidates, key=misfit.get)
-                if misfit[best] < mpf("0.01") * misfit[other]:
+                if misfit[best] < mpf('0.01') * misfit[other]:
                     side = best
                     # the secant carries the slopes on (its error is O(step·curvature))
                     rates = [_wrap(c - a) / moved for c, a in zip(candidates[side], angles)]
@@ -231,18 +231,18 @@ def _group_errors(values: dict[str, mpf], reference: dict[str, mpf]) -> dict[str
             scale = max([abs(reference[name]) for name in names] + [floor])
             return float(max(gap(name) for name in names) / scale)
 
-        omega_squared = reference["omega"] ** 2
-        pin_names = ("pin_a_x", "pin_a_y", "pin_b_x", "pin_b_y")
+        omega_squared = reference['omega'] ** 2
+        pin_names = ('pin_a_x', 'pin_a_y', 'pin_b_x', 'pin_b_y')
         return {
-            "angle": float(max(angle_gap("beta"), angle_gap("gamma"))),
-            "pin": normwise(pin_names),
-            "angular_rate": normwise(("omega", "omega_ab", "omega_bc")),
-            "angular_acceleration": normwise(
-                ("omega_dot", "omega_dot_ab", "omega_dot_bc"), omega_squared
+            'angle': float(max(angle_gap('beta'), angle_gap('gamma'))),
+            'pin': normwise(pin_names),
+            'angular_rate': normwise(('omega', 'omega_ab', 'omega_bc')),
+            'angular_acceleration': normwise(
+                ('omega_dot', 'omega_dot_ab', 'omega_dot_bc'), omega_squared
             ),
-            "velocity": normwise(("velocity_a_x", "velocity_a_y", "velocity_b_x", "velocity_b_y")),
-            "acceleration": normwise(
-                ("acceleration_a_x", "acceleration_a_y", "acceleration_b_x", "acceleration_b_y")
+            'velocity': normwise(('velocity_a_x', 'velocity_a_y', 'velocity_b_x', 'velocity_b_y')),
+            'acceleration': normwise(
+                ('acceleration_a_x', 'acceleration_a_y', 'acceleration_b_x', 'acceleration_b_y')
             ),
         }
 

@@ -72,13 +72,13 @@ from node_process import (
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 NODE_TOPICS = {
-    "/joint_states": JointState,
-    "/linkage/state": JointTrajectory,
-    "/robot_description": String,
-    "/linkage/markers": MarkerArray,
-    "/diagnostics": DiagnosticArray,
+    '/joint_states': JointState,
+    '/linkage/state': JointTrajectory,
+    '/robot_description': String,
+    '/linkage/markers': MarkerArray,
+    '/diagnostics': DiagnosticArray,
 }
-DATA_TOPICS = ("/joint_states", "/linkage/state", "/linkage/markers", "/diagnostics")
+DATA_TOPICS = ('/joint_states', '/linkage/state', '/linkage/markers', '/diagnostics')
 RATE_HZ = 200.0
 # 90° at this constant ω takes 0.3 s: a short run.
 SHORT_RUN_OMEGA = (math.pi / 2) / 0.3
@@ -91,7 +91,7 @@ DOMAIN_ID = 30
 def listen_to_node_topics(context: rclpy.Context, name: str) -> Listener:
     listener = Listener(name, context)
     for topic, msg_type in NODE_TOPICS.items():
-        listener.subscribe(topic, msg_type, transient_local=topic == "/robot_description")
+        listener.subscribe(topic, msg_type, transient_local=topic == '/robot_description')
     return listener
 
 
@@ -101,7 +101,7 @@ def stopped(process: subprocess.Popen) -> Callable[[], bool]:
 
 def only_bag(folder: Path) -> Path:
     bags = [path for path in folder.iterdir() if path.is_dir()]
-    assert len(bags) == 1, f"expected one bag in {folder}, found {bags}"
+    assert len(bags) == 1, f'expected one bag in {folder}, found {bags}'
     return bags[0]
 
 
@@ -117,20 +117,20 @@ def read_with_rosbags(bag: Path) -> dict[str, list[tuple[int, Any, bytes]]]:
 
 
 def bag_information(bag: Path) -> dict[str, Any]:
-    return yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    return yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
 
 
 def topic_counts(information: dict[str, Any]) -> dict[str, int]:
     """topic -> message count, as metadata.yaml states them."""
     return {
-        entry["topic_metadata"]["name"]: entry["message_count"]
-        for entry in information["topics_with_message_count"]
+        entry['topic_metadata']['name']: entry['message_count']
+        for entry in information['topics_with_message_count']
     }
 
 
 def message_stamp_ns(message: Any) -> int:
     """Header stamp; a MarkerArray's is that of its (equally stamped) markers."""
-    return stamp_ns(message.markers[0] if hasattr(message, "markers") else message)
+    return stamp_ns(message.markers[0] if hasattr(message, 'markers') else message)
 
 
 # --- BagWriter and Recorder on their own ---------------------------------------------------------
@@ -138,19 +138,19 @@ def message_stamp_ns(message: Any) -> int:
 
 def sample_messages() -> list[Any]:
     """One message of every type the node logs, built by the node's own message builders."""
-    paper = preset("paper")
+    paper = preset('paper')
     state = solve(paper.geometry, 0.3, DriveLaw(2.0, 0.0))
     stamp = messages.time_msg(1_234_567_890_123)
     return [
         messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
-        messages.linkage_state(paper.geometry, state, stamp, 0.1, "linkage_base"),
-        messages.marker_array(paper.geometry, state, stamp, "linkage_base"),
+        messages.linkage_state(paper.geometry, state, stamp, 0.1, 'linkage_base'),
+        messages.marker_array(paper.geometry, state, stamp, 'linkage_base'),
         messages.diagnostic_array(
-            stamp, "linkage_node: crank motion", "four-bar", DiagnosticStatus.WARN,
-            "1.2° from a dead point", {"α (deg)": "12.5", "empty": ""},
+            stamp, 'linkage_node: crank motion', 'four-bar', DiagnosticStatus.WARN,
+            '1.2° from a dead point', {'α (deg)': '12.5', 'empty': ''},
         ),
         String(data="<robot name='ü'/>"),
-        String(data=""),
+        String(data=''),
     ]
 
 
@@ -169,7 +169,7 @@ def assert_exact_encoding(data: bytes, message: Any) -> None:
     assert data == encoded_by_rosbags(data, ros_type_name(type(message)))
 
 
-@pytest.mark.parametrize("message", sample_messages(), ids=lambda m: type(m).__name__)
+@pytest.mark.parametrize('message', sample_messages(), ids=lambda m: type(m).__name__)
 def test_encode_cdr_writes_every_logged_type_as_the_independent_serializers(message: Any) -> None:
     logged = encode_cdr(message)
     assert_exact_encoding(logged, message)
@@ -185,7 +185,7 @@ def test_encode_cdr_writes_every_logged_type_as_the_independent_serializers(mess
 
 def test_joint_state_values_survive_encoding() -> None:
     message = sample_messages()[0]
-    decoded = TYPESTORE.deserialize_cdr(encode_cdr(message), "sensor_msgs/msg/JointState")
+    decoded = TYPESTORE.deserialize_cdr(encode_cdr(message), 'sensor_msgs/msg/JointState')
     assert list(decoded.name) == list(message.name)
     assert list(decoded.position) == list(message.position)
     assert list(decoded.velocity) == list(message.velocity)
@@ -193,7 +193,7 @@ def test_joint_state_values_survive_encoding() -> None:
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
-ros_text = st.text(st.characters(codec="utf-8", exclude_characters="\x00"), max_size=7)  # no NUL
+ros_text = st.text(st.characters(codec='utf-8', exclude_characters='\x00'), max_size=7)  # no NUL
 
 
 @settings(max_examples=60, deadline=None)
@@ -250,20 +250,20 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
 
 
 def test_encode_cdr_follows_every_change_of_a_reused_message() -> None:
-    message = JointState(name=["abc", "c"], position=[1.0], velocity=[2.0])
-    message.header.frame_id = "aaa"
+    message = JointState(name=['abc', 'c'], position=[1.0], velocity=[2.0])
+    message.header.frame_id = 'aaa'
     # Each step changes one field of the reused message, as a node would, and with it the exact
     # length. Two steps keep every Python length and change only the UTF-8 bytes.
     steps: list[Callable[[JointState], None]] = [
         lambda m: None,
-        lambda m: setattr(m, "name", ["übc", "c"]),
-        lambda m: setattr(m, "name", ["ab"]),
-        lambda m: setattr(m.header, "frame_id", "üaa"),
-        lambda m: setattr(m, "name", ["ab", "c"]),
-        lambda m: setattr(m, "effort", [3.0]),
-        lambda m: setattr(m, "effort", []),  # where rclpy's serialize_message returned 4 too many
-        lambda m: setattr(m, "position", [1.0, 4.0]),
-        lambda m: setattr(m.header, "frame_id", "the_base_link"),
+        lambda m: setattr(m, 'name', ['übc', 'c']),
+        lambda m: setattr(m, 'name', ['ab']),
+        lambda m: setattr(m.header, 'frame_id', 'üaa'),
+        lambda m: setattr(m, 'name', ['ab', 'c']),
+        lambda m: setattr(m, 'effort', [3.0]),
+        lambda m: setattr(m, 'effort', []),  # where rclpy's serialize_message returned 4 too many
+        lambda m: setattr(m, 'position', [1.0, 4.0]),
+        lambda m: setattr(m.header, 'frame_id', 'the_base_link'),
     ]
     lengths = []
     for step in steps:
@@ -276,7 +276,7 @@ def test_encode_cdr_follows_every_change_of_a_reused_message() -> None:
 
 point_lengths = st.tuples(*[st.integers(0, 3)] * 4)  # positions, velocities, accelerations, effort
 # Few choices, so that consecutive messages often differ in one place only.
-few_texts = st.sampled_from(["", "base", "bäse", "the_base_link"])
+few_texts = st.sampled_from(['', 'base', 'bäse', 'the_base_link'])
 
 
 @settings(max_examples=40, deadline=None)
@@ -286,7 +286,7 @@ few_texts = st.sampled_from(["", "base", "bäse", "the_base_link"])
         min_size=2, max_size=6,
     )
 )
-@example(shapes=[("base", ["a"], [(1, 0, 0, 0)]), ("base", ["a"], [(2, 0, 0, 0)])])
+@example(shapes=[('base', ['a'], [(1, 0, 0, 0)]), ('base', ['a'], [(2, 0, 0, 0)])])
 def test_encode_cdr_follows_every_reshaping_of_a_trajectory(
     shapes: list[tuple[str, list[str], list[tuple[int, int, int, int]]]],
 ) -> None:
@@ -307,11 +307,11 @@ def test_encode_cdr_follows_every_reshaping_of_a_trajectory(
 
 @settings(max_examples=60, deadline=None)
 @given(
-    preset_name=st.sampled_from(["paper", "paper_full_turn", "grashof_crank_rocker"]),
+    preset_name=st.sampled_from(['paper', 'paper_full_turn', 'grashof_crank_rocker']),
     alpha=st.floats(-10.0, 10.0),
     stamp=st.integers(0, 2**31 * 10**9 - 1),  # builtin_interfaces/Time.sec is an int32
     motion_time=st.floats(0.0, 1e6),
-    frame_id=st.sampled_from(["", "linkage_base", "ü/base", "left/linkage_base"]),
+    frame_id=st.sampled_from(['', 'linkage_base', 'ü/base', 'left/linkage_base']),
     previous=st.tuples(*[st.floats(-100.0, 100.0)] * 3),
 )
 def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_messages(
@@ -338,43 +338,43 @@ def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_message
 
 
 def test_a_fixed_shape_encoder_of_one_field_and_one_naming_no_field() -> None:
-    encoder = FixedShapeEncoder(Float64(data=0.0), ["data"])
+    encoder = FixedShapeEncoder(Float64(data=0.0), ['data'])
     assert encoder.value_count == 1
     assert encoder.encode((2.5,)) == encode_cdr(Float64(data=2.5))
     with pytest.raises(ValueError, match=r"std_msgs/msg/Float64 has no fixed-size field \['dat'\]"):
-        FixedShapeEncoder(Float64(data=0.0), ["dat"])
+        FixedShapeEncoder(Float64(data=0.0), ['dat'])
 
 
 def test_schema_names_dependencies_as_the_referencing_field_spells_them() -> None:
-    text = message_definition("sensor_msgs/msg/JointState")
-    msg_file = Path(get_package_share_directory("sensor_msgs")) / "msg" / "JointState.msg"
-    assert text.startswith(msg_file.read_text().rstrip("\n"))
-    sections = text.split(DEFINITION_SEPARATOR + "\n")
+    text = message_definition('sensor_msgs/msg/JointState')
+    msg_file = Path(get_package_share_directory('sensor_msgs')) / 'msg' / 'JointState.msg'
+    assert text.startswith(msg_file.read_text().rstrip('\n'))
+    sections = text.split(DEFINITION_SEPARATOR + '\n')
     assert [section.splitlines()[0] for section in sections[1:]] == [
-        "MSG: std_msgs/Header",
-        "MSG: builtin_interfaces/Time",
+        'MSG: std_msgs/Header',
+        'MSG: builtin_interfaces/Time',
     ]
-    assert "std_msgs/msg/Header" not in text
-    markers = message_definition("visualization_msgs/msg/MarkerArray")
-    dependency_names = re.findall(r"^MSG: (\S+)$", markers, flags=re.MULTILINE)
+    assert 'std_msgs/msg/Header' not in text
+    markers = message_definition('visualization_msgs/msg/MarkerArray')
+    dependency_names = re.findall(r'^MSG: (\S+)$', markers, flags=re.MULTILINE)
     assert len(dependency_names) == len(set(dependency_names))
     # bare names in a .msg file (``Marker[] markers``) get the package of that file
-    assert {"visualization_msgs/Marker", "geometry_msgs/Point", "std_msgs/Header"} <= set(
+    assert {'visualization_msgs/Marker', 'geometry_msgs/Point', 'std_msgs/Header'} <= set(
         dependency_names
     )
 
 
 def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: Path) -> None:
-    bag = tmp_path / "unit_bag"
-    writer = BagWriter(bag, metadata={"rate_hz": "200"}, flush_interval=0.05)
-    assert (bag / "metadata.yaml").is_file(), "a killed run's folder must already be a bag"
+    bag = tmp_path / 'unit_bag'
+    writer = BagWriter(bag, metadata={'rate_hz': '200'}, flush_interval=0.05)
+    assert (bag / 'metadata.yaml').is_file(), "a killed run's folder must already be a bag"
     channel = writer.add_topic(
-        "/chatter",
-        "std_msgs/msg/String",
-        message_definition("std_msgs/msg/String"),
+        '/chatter',
+        'std_msgs/msg/String',
+        message_definition('std_msgs/msg/String'),
         offered_qos_profiles_yaml(QoSProfile(depth=7)),
     )
-    payload = encode_cdr(String(data="hello"))
+    payload = encode_cdr(String(data='hello'))
     writer.write(channel, payload, 1_000, 1_000)
     time.sleep(0.06)
     writer.write(channel, payload, 2_000, 2_000)  # the interval has passed: the chunk is flushed
@@ -385,119 +385,119 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
     writer.close()
     writer.close()
 
-    with open(writer.mcap_path, "rb") as stream:
+    with open(writer.mcap_path, 'rb') as stream:
         reader = make_reader(stream)
         header = reader.get_header()
         summary = reader.get_summary()
-        assert header.profile == "ros2"
-        assert header.library.startswith(f"linkage_kinematics/{package_version()} mcap-python/")
+        assert header.profile == 'ros2'
+        assert header.library.startswith(f'linkage_kinematics/{package_version()} mcap-python/')
         assert summary.statistics.message_count == 1_999
-        assert {index.compression for index in summary.chunk_indexes} == {"zstd"}
+        assert {index.compression for index in summary.chunk_indexes} == {'zstd'}
         assert len(summary.chunk_indexes) >= 2
         (schema,) = summary.schemas.values()
         (channel_record,) = summary.channels.values()
-        assert (schema.name, schema.encoding) == ("std_msgs/msg/String", "ros2msg")
-        assert channel_record.message_encoding == "cdr"
-        assert yaml.safe_load(channel_record.metadata["offered_qos_profiles"])[0]["depth"] == 7
-        assert channel_record.metadata["topic_type_hash"].startswith("RIHS01_")
+        assert (schema.name, schema.encoding) == ('std_msgs/msg/String', 'ros2msg')
+        assert channel_record.message_encoding == 'cdr'
+        assert yaml.safe_load(channel_record.metadata['offered_qos_profiles'])[0]['depth'] == 7
+        assert channel_record.metadata['topic_type_hash'].startswith('RIHS01_')
         records = {record.name: record.metadata for record in reader.iter_metadata()}
-    assert records["linkage_kinematics"] == {"package_version": package_version(), "rate_hz": "200"}
-    rosbag2_record = yaml.safe_load(records["rosbag2"]["serialized_metadata"])
-    assert rosbag2_record["version"] == 9 and rosbag2_record["message_count"] == 1_999
+    assert records['linkage_kinematics'] == {'package_version': package_version(), 'rate_hz': '200'}
+    rosbag2_record = yaml.safe_load(records['rosbag2']['serialized_metadata'])
+    assert rosbag2_record['version'] == 9 and rosbag2_record['message_count'] == 1_999
     information = bag_information(bag)
-    assert information["message_count"] == 1_999
-    assert information["custom_data"]["rate_hz"] == "200"
+    assert information['message_count'] == 1_999
+    assert information['custom_data']['rate_hz'] == '200'
 
 
-@pytest.mark.parametrize("count", [1, WRITE_BATCH - 1, WRITE_BATCH, 3 * WRITE_BATCH + 1])
+@pytest.mark.parametrize('count', [1, WRITE_BATCH - 1, WRITE_BATCH, 3 * WRITE_BATCH + 1])
 def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: int) -> None:
     """Messages wait in a queue before they enter the chunk; flush and close take them all, in
     the order written, on their channels."""
-    writer = BagWriter(tmp_path / "queued", metadata={}, flush_interval=3600.0)
+    writer = BagWriter(tmp_path / 'queued', metadata={}, flush_interval=3600.0)
     channels = [
-        writer.add_topic(topic, "std_msgs/msg/String", message_definition("std_msgs/msg/String"),
+        writer.add_topic(topic, 'std_msgs/msg/String', message_definition('std_msgs/msg/String'),
                          offered_qos_profiles_yaml(QoSProfile(depth=10)))
-        for topic in ("/a", "/b")
+        for topic in ('/a', '/b')
     ]
-    written = [(("/a", "/b")[index % 2], encode_cdr(String(data=f"m{index}")), 1_000 + index)
+    written = [(('/a', '/b')[index % 2], encode_cdr(String(data=f'm{index}')), 1_000 + index)
                for index in range(count)]
     for index, (_, data, log_time) in enumerate(written):
         writer.write(channels[index % 2], data, log_time, log_time)
     writer.flush()
     flushed = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
     assert flushed == written
-    writer.write(channels[0], encode_cdr(String(data="last")), 5_000, 5_000)
+    writer.write(channels[0], encode_cdr(String(data='last')), 5_000, 5_000)
     writer.close()
     logged = [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(writer.bag_path)]
-    assert logged == written + [("/a", encode_cdr(String(data="last")), 5_000)]
+    assert logged == written + [('/a', encode_cdr(String(data='last')), 5_000)]
     information = bag_information(writer.bag_path)
-    assert information["message_count"] == count + 1
-    assert information["starting_time"]["nanoseconds_since_epoch"] == 1_000
-    assert information["duration"]["nanoseconds"] == 4_000
+    assert information['message_count'] == count + 1
+    assert information['starting_time']['nanoseconds_since_epoch'] == 1_000
+    assert information['duration']['nanoseconds'] == 4_000
 
 
 def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
-    bag = tmp_path / "taken"
+    bag = tmp_path / 'taken'
     bag.mkdir()
-    (bag / "keep.txt").write_text("untouched")
+    (bag / 'keep.txt').write_text('untouched')
     with pytest.raises(BagExistsError, match=re.escape(str(bag))):
         BagWriter(bag, metadata={})
-    assert [p.name for p in bag.iterdir()] == ["keep.txt"]
-    assert (bag / "keep.txt").read_text() == "untouched"
+    assert [p.name for p in bag.iterdir()] == ['keep.txt']
+    assert (bag / 'keep.txt').read_text() == 'untouched'
 
 
 def test_recorder_refuses_a_log_folder_under_a_regular_file(tmp_path: Path) -> None:
-    blocker = tmp_path / "afile"
-    blocker.write_text("")
-    with pytest.raises(OSError, match=re.escape(str(blocker / "bags"))):
-        Recorder(blocker / "bags", metadata={})
+    blocker = tmp_path / 'afile'
+    blocker.write_text('')
+    with pytest.raises(OSError, match=re.escape(str(blocker / 'bags'))):
+        Recorder(blocker / 'bags', metadata={})
 
 
 # --- a real node run, read back by two independent readers ------------------------------------
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """A logging run that the listener has heard on every topic, ended by SIGINT.
 
     The node loops until the listener (whose discovery may take seconds on a busy machine) has
     received a few messages on every topic; the bag then holds everything the listener got.
     """
-    run_folder = tmp_path_factory.mktemp("node_run")
-    folder = run_folder / "bags"
+    run_folder = tmp_path_factory.mktemp('node_run')
+    folder = run_folder / 'bags'
     with ros_context(DOMAIN_ID) as context:
-        listener = listen_to_node_topics(context, "bag_test_listener")
+        listener = listen_to_node_topics(context, 'bag_test_listener')
         process = start_node(
-            {"log.folder": str(folder), "rate_hz": RATE_HZ, "omega0": SHORT_RUN_OMEGA,
-             "end_behavior": "loop"},
+            {'log.folder': str(folder), 'rate_hz': RATE_HZ, 'omega0': SHORT_RUN_OMEGA,
+             'end_behavior': 'loop'},
             DOMAIN_ID,
-            run_folder / "node.log",
+            run_folder / 'node.log',
         )
         try:
-            assert listener.wait_for_every_topic(count=2), (run_folder / "node.log").read_text()
+            assert listener.wait_for_every_topic(count=2), (run_folder / 'node.log').read_text()
             process.send_signal(signal.SIGINT)
-            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (run_folder / "node.log").read_text()
+            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (run_folder / 'node.log').read_text()
         finally:
             stop_process(process)
             listener.destroy()
-    return {"bag": only_bag(folder), "received": listener.received}
+    return {'bag': only_bag(folder), 'received': listener.received}
 
 
 def test_every_published_topic_is_logged_with_its_type(node_run: dict[str, Any]) -> None:
-    logged = read_with_rosbags(node_run["bag"])
+    logged = read_with_rosbags(node_run['bag'])
     assert set(logged) == set(NODE_TOPICS)
-    with Reader(node_run["bag"]) as reader:
+    with Reader(node_run['bag']) as reader:
         types = {connection.topic: connection.msgtype for connection in reader.connections}
     assert types == {topic: ros_type_name(msg_type) for topic, msg_type in NODE_TOPICS.items()}
-    assert len(logged["/linkage/state"]) == len(logged["/joint_states"]) >= 2
-    assert len(logged["/robot_description"]) == 1
+    assert len(logged['/linkage/state']) == len(logged['/joint_states']) >= 2
+    assert len(logged['/robot_description']) == 1
 
 
 def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any]) -> None:
-    logged = read_with_rosbags(node_run["bag"])
-    received = node_run["received"]
+    logged = read_with_rosbags(node_run['bag'])
+    received = node_run['received']
     for topic in DATA_TOPICS:
-        assert received.get(topic), f"the listener received nothing on {topic}"
+        assert received.get(topic), f'the listener received nothing on {topic}'
         type_name = ros_type_name(NODE_TOPICS[topic])
         by_stamp = {message_stamp_ns(message): message for _, message, _ in logged[topic]}
         for message in received[topic]:
@@ -506,16 +506,16 @@ def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any
             assert encode_cdr(message) == bytes(
                 TYPESTORE.serialize_cdr(logged_message, type_name)
             ), topic
-            if topic == "/linkage/state":
+            if topic == '/linkage/state':
                 (point,) = message.points
                 (logged_point,) = logged_message.points
                 assert list(logged_message.joint_names) == list(message.joint_names)
-                for field in ("positions", "velocities", "accelerations"):
+                for field in ('positions', 'velocities', 'accelerations'):
                     assert list(getattr(logged_point, field)) == list(getattr(point, field))
-            elif topic == "/joint_states":
+            elif topic == '/joint_states':
                 assert list(logged_message.position) == list(message.position)
                 assert list(logged_message.velocity) == list(message.velocity)
-            elif topic == "/linkage/markers":
+            elif topic == '/linkage/markers':
                 assert [m.id for m in logged_message.markers] == [m.id for m in message.markers]
                 assert [(p.x, p.y) for m in logged_message.markers for p in m.points] == [
                     (p.x, p.y) for m in message.markers for p in m.points
@@ -524,21 +524,21 @@ def test_logged_messages_equal_what_subscribers_received(node_run: dict[str, Any
                 (status,) = message.status
                 (logged_status,) = logged_message.status
                 assert (logged_status.level, logged_status.message) == (
-                    int.from_bytes(status.level, "little"), status.message
+                    int.from_bytes(status.level, 'little'), status.message
                 )
                 assert {kv.key: kv.value for kv in logged_status.values} == {
                     kv.key: kv.value for kv in status.values
                 }
-    (description,) = received["/robot_description"]
-    assert logged["/robot_description"][0][1].data == description.data
+    (description,) = received['/robot_description']
+    assert logged['/robot_description'][0][1].data == description.data
 
 
 def test_logged_states_are_the_library_solution_at_the_logged_alpha(
     node_run: dict[str, Any],
 ) -> None:
-    paper = preset("paper")
+    paper = preset('paper')
     drive = DriveLaw(SHORT_RUN_OMEGA, 0.0)
-    states = read_with_rosbags(node_run["bag"])["/linkage/state"]
+    states = read_with_rosbags(node_run['bag'])['/linkage/state']
     for _, message, _ in states:
         (point,) = message.points
         state = solve(paper.geometry, point.positions[0], drive)
@@ -551,7 +551,7 @@ def test_logged_states_are_the_library_solution_at_the_logged_alpha(
 def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(
     node_run: dict[str, Any],
 ) -> None:
-    bag = node_run["bag"]
+    bag = node_run['bag']
     log_times = [message.log_time_ns for message in bag_reader.iter_messages(bag)]
     assert log_times == sorted(log_times)
     for topic, entries in read_with_rosbags(bag).items():
@@ -561,86 +561,86 @@ def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(
 
 
 def test_mcap_ros2_decodes_every_message_with_the_logged_schemas(node_run: dict[str, Any]) -> None:
-    bag = node_run["bag"]
-    (mcap_path,) = bag.glob("*.mcap")
+    bag = node_run['bag']
+    (mcap_path,) = bag.glob('*.mcap')
     counts: dict[str, int] = defaultdict(int)
     for decoded in read_ros2_messages(str(mcap_path)):
         counts[decoded.channel.topic] += 1
-        assert decoded.schema.encoding == "ros2msg"
-        assert decoded.channel.message_encoding == "cdr"
+        assert decoded.schema.encoding == 'ros2msg'
+        assert decoded.channel.message_encoding == 'cdr'
         assert decoded.schema.name == ros_type_name(NODE_TOPICS[decoded.channel.topic])
-        assert "offered_qos_profiles" in decoded.channel.metadata
+        assert 'offered_qos_profiles' in decoded.channel.metadata
     assert dict(counts) == topic_counts(bag_information(bag))
 
 
 def test_run_metadata_holds_parameters_and_version(node_run: dict[str, Any]) -> None:
-    bag = node_run["bag"]
-    (mcap_path,) = bag.glob("*.mcap")
-    with open(mcap_path, "rb") as stream:
+    bag = node_run['bag']
+    (mcap_path,) = bag.glob('*.mcap')
+    with open(mcap_path, 'rb') as stream:
         reader = make_reader(stream)
-        assert reader.get_header().profile == "ros2"
+        assert reader.get_header().profile == 'ros2'
         records = {record.name: record.metadata for record in reader.iter_metadata()}
-    run = records["linkage_kinematics"]
-    parameters = json.loads(run["parameters"])
-    assert parameters["rate_hz"] == RATE_HZ
-    assert parameters["omega0"] == SHORT_RUN_OMEGA
-    assert run["package_version"] == package_version()
-    assert bag_information(bag)["custom_data"] == run
+    run = records['linkage_kinematics']
+    parameters = json.loads(run['parameters'])
+    assert parameters['rate_hz'] == RATE_HZ
+    assert parameters['omega0'] == SHORT_RUN_OMEGA
+    assert run['package_version'] == package_version()
+    assert bag_information(bag)['custom_data'] == run
 
 
 def test_metadata_yaml_is_rosbag2_jazzy_format(node_run: dict[str, Any]) -> None:
-    bag = node_run["bag"]
+    bag = node_run['bag']
     information = bag_information(bag)
-    (mcap_path,) = bag.glob("*.mcap")
-    assert information["version"] == 9
-    assert information["storage_identifier"] == "mcap"
-    assert information["relative_file_paths"] == [mcap_path.name]
-    assert information["compression_format"] == information["compression_mode"] == ""
-    assert information["ros_distro"] == "jazzy"
+    (mcap_path,) = bag.glob('*.mcap')
+    assert information['version'] == 9
+    assert information['storage_identifier'] == 'mcap'
+    assert information['relative_file_paths'] == [mcap_path.name]
+    assert information['compression_format'] == information['compression_mode'] == ''
+    assert information['ros_distro'] == 'jazzy'
     logged = read_with_rosbags(bag)
     total = sum(len(entries) for entries in logged.values())
-    assert information["message_count"] == total
-    (file_entry,) = information["files"]
-    assert file_entry["path"] == mcap_path.name and file_entry["message_count"] == total
+    assert information['message_count'] == total
+    (file_entry,) = information['files']
+    assert file_entry['path'] == mcap_path.name and file_entry['message_count'] == total
     log_times = sorted(t for entries in logged.values() for t, _, _ in entries)
-    assert information["starting_time"]["nanoseconds_since_epoch"] == log_times[0]
-    assert information["duration"]["nanoseconds"] == log_times[-1] - log_times[0]
-    for entry in information["topics_with_message_count"]:
-        topic = entry["topic_metadata"]
-        assert topic["serialization_format"] == "cdr"
-        assert topic["type_description_hash"].startswith("RIHS01_")
-        (profile,) = topic["offered_qos_profiles"]
+    assert information['starting_time']['nanoseconds_since_epoch'] == log_times[0]
+    assert information['duration']['nanoseconds'] == log_times[-1] - log_times[0]
+    for entry in information['topics_with_message_count']:
+        topic = entry['topic_metadata']
+        assert topic['serialization_format'] == 'cdr'
+        assert topic['type_description_hash'].startswith('RIHS01_')
+        (profile,) = topic['offered_qos_profiles']
         assert set(profile) == {
-            "history", "depth", "reliability", "durability", "deadline", "lifespan",
-            "liveliness", "liveliness_lease_duration", "avoid_ros_namespace_conventions",
+            'history', 'depth', 'reliability', 'durability', 'deadline', 'lifespan',
+            'liveliness', 'liveliness_lease_duration', 'avoid_ros_namespace_conventions',
         }
         expected_durability = (
-            "transient_local" if topic["name"] == "/robot_description" else "volatile"
+            'transient_local' if topic['name'] == '/robot_description' else 'volatile'
         )
-        assert (profile["reliability"], profile["durability"]) == ("reliable", expected_durability)
-        assert entry["message_count"] == len(logged[topic["name"]])
+        assert (profile['reliability'], profile['durability']) == ('reliable', expected_durability)
+        assert entry['message_count'] == len(logged[topic['name']])
 
 
 # --- linkage-replay ---------------------------------------------------------------------------
 
 
 def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: Path) -> None:
-    bag = node_run["bag"]
+    bag = node_run['bag']
     logged = read_with_rosbags(bag)
     logged_states = {
         stamp_ns(m): (list(m.points[0].positions), list(m.points[0].accelerations))
-        for _, m, _ in logged["/linkage/state"]
+        for _, m, _ in logged['/linkage/state']
     }
-    logged_joints = {stamp_ns(m): list(m.position) for _, m, _ in logged["/joint_states"]}
+    logged_joints = {stamp_ns(m): list(m.position) for _, m, _ in logged['/joint_states']}
     with ros_context(DOMAIN_ID + 1) as context:
-        listener = listen_to_node_topics(context, "replay_test_listener")
-        states = listener.received["/linkage/state"]
-        with open(tmp_path / "replay.log", "w") as output:
+        listener = listen_to_node_topics(context, 'replay_test_listener')
+        states = listener.received['/linkage/state']
+        with open(tmp_path / 'replay.log', 'w') as output:
             # At the logged pace, looped until every logged state was heard: a listener that
             # discovers the replay late, or falls behind while the machine is busy (the logged
             # QoS keeps the last 10), hears the rest in a later round.
             replay = subprocess.Popen(
-                [sys.executable, "-m", "linkage_kinematics.replay", str(bag), "--loop"],
+                [sys.executable, '-m', 'linkage_kinematics.replay', str(bag), '--loop'],
                 cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 1), stdout=output,
                 stderr=subprocess.STDOUT,
             )
@@ -648,9 +648,9 @@ def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: P
             assert listener.spin_until(
                 lambda: listener.heard_every_topic()
                 and len({stamp_ns(m) for m in states}) == len(logged_states)
-            ), (tmp_path / "replay.log").read_text()
+            ), (tmp_path / 'replay.log').read_text()
             replay.send_signal(signal.SIGINT)
-            assert replay.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / "replay.log").read_text()
+            assert replay.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / 'replay.log').read_text()
         finally:
             stop_process(replay)
             listener.destroy()
@@ -659,73 +659,73 @@ def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: P
         assert (list(message.points[0].positions), list(message.points[0].accelerations)) == (
             logged_states[stamp_ns(message)]
         )
-    for message in received["/joint_states"]:
+    for message in received['/joint_states']:
         assert list(message.position) == logged_joints[stamp_ns(message)]
     # Each round replays the run in its logged order.
     stamps = [stamp_ns(m) for m in states]
     rounds = [i for i in range(1, len(stamps)) if stamps[i] < stamps[i - 1]]
     for start, end in zip([0, *rounds], [*rounds, len(stamps)]):
         assert stamps[start:end] == sorted(stamps[start:end])
-    assert received["/robot_description"][0].data == logged["/robot_description"][0][1].data
+    assert received['/robot_description'][0].data == logged['/robot_description'][0][1].data
 
 
 def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path) -> None:
-    bag = node_run["bag"]
-    logged_states = len(read_with_rosbags(bag)["/linkage/state"])
+    bag = node_run['bag']
+    logged_states = len(read_with_rosbags(bag)['/linkage/state'])
     with ros_context(DOMAIN_ID + 2) as context:
-        listener = Listener("replay_loop_listener", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        with open(tmp_path / "replay.log", "w") as output:
+        listener = Listener('replay_loop_listener', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        with open(tmp_path / 'replay.log', 'w') as output:
             replay = subprocess.Popen(
-                [sys.executable, "-m", "linkage_kinematics.replay", str(bag), "--loop",
-                 "--rate", "4", "--topics", "/linkage/state"],
+                [sys.executable, '-m', 'linkage_kinematics.replay', str(bag), '--loop',
+                 '--rate', '4', '--topics', '/linkage/state'],
                 cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 2), stdout=output,
                 stderr=subprocess.STDOUT,
             )
         try:
             assert listener.spin_until(
-                lambda: len(listener.received["/linkage/state"]) > 2 * logged_states
+                lambda: len(listener.received['/linkage/state']) > 2 * logged_states
             )
             replay.send_signal(signal.SIGINT)
             assert replay.wait(timeout=PROCESS_TIMEOUT) == 0
         finally:
             stop_process(replay)
             listener.destroy()
-    output_text = (tmp_path / "replay.log").read_text()
-    assert "Traceback" not in output_text and "published" in output_text
-    alphas = [message.points[0].positions[0] for message in listener.received["/linkage/state"]]
+    output_text = (tmp_path / 'replay.log').read_text()
+    assert 'Traceback' not in output_text and 'published' in output_text
+    alphas = [message.points[0].positions[0] for message in listener.received['/linkage/state']]
     assert alphas.count(alphas[0]) >= 2  # the run started over
 
 
 def test_replay_rejects_bad_input_with_a_clear_message(
     tmp_path: Path, node_run: dict[str, Any], capsys: pytest.CaptureFixture[str]
 ) -> None:
-    not_mcap = tmp_path / "notes.mcap"
-    not_mcap.write_text("just text")
-    assert replay_main([str(tmp_path / "missing")]) == 1
-    assert "no bag at" in capsys.readouterr().err
+    not_mcap = tmp_path / 'notes.mcap'
+    not_mcap.write_text('just text')
+    assert replay_main([str(tmp_path / 'missing')]) == 1
+    assert 'no bag at' in capsys.readouterr().err
     assert replay_main([str(not_mcap)]) == 1
-    assert "not an MCAP file" in capsys.readouterr().err
+    assert 'not an MCAP file' in capsys.readouterr().err
 
-    cut = tmp_path / "cut"
+    cut = tmp_path / 'cut'
     cut.mkdir()
-    (source,) = node_run["bag"].glob("*.mcap")
+    (source,) = node_run['bag'].glob('*.mcap')
     (cut / source.name).write_bytes(source.read_bytes()[: source.stat().st_size // 2])
     assert replay_main([str(cut / source.name)]) == 1
-    assert "--recover" in capsys.readouterr().err
+    assert '--recover' in capsys.readouterr().err
 
-    foreign = tmp_path / "foreign"
+    foreign = tmp_path / 'foreign'
     writer = BagWriter(foreign, metadata={})
-    channel = writer.add_topic("/thing", "foreign_msgs/msg/Thing", "int32 x\n", "")
-    writer.write(channel, b"\x00\x01\x00\x00\x05\x00\x00\x00", 1, 1)
+    channel = writer.add_topic('/thing', 'foreign_msgs/msg/Thing', 'int32 x\n', '')
+    writer.write(channel, b'\x00\x01\x00\x00\x05\x00\x00\x00', 1, 1)
     writer.close()
     assert replay_main([str(foreign)]) == 1
     error = capsys.readouterr().err
-    assert "foreign_msgs/msg/Thing" in error and "nothing to replay" in error
+    assert 'foreign_msgs/msg/Thing' in error and 'nothing to replay' in error
 
-    assert replay_main([str(node_run["bag"]), "--topics", "/nope"]) == 1
-    assert "/nope" in capsys.readouterr().err
+    assert replay_main([str(node_run['bag']), '--topics', '/nope']) == 1
+    assert '/nope' in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_info:
-        replay_main([str(node_run["bag"]), "--rate", "-2"])
+        replay_main([str(node_run['bag']), '--rate', '-2'])
     assert exit_info.value.code == 2
-    assert "positive factor" in capsys.readouterr().err
+    assert 'positive factor' in capsys.readouterr().err

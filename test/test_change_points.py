@@ -31,7 +31,7 @@ PARALLELOGRAM = FourBar(0.3, 1.0, 0.3, 1.0, 0.0)
 KITE = FourBar(0.4, 0.4, 1.0, 1.0, 0.0)
 # One change point per turn (|AB − BC| = OC − OA): its smooth motion repeats every two turns.
 GENERAL = FourBar(0.25, 0.75, 0.5, 0.5, 0.0)
-LINKAGES = {"parallelogram": PARALLELOGRAM, "kite": KITE, "general": GENERAL}
+LINKAGES = {'parallelogram': PARALLELOGRAM, 'kite': KITE, 'general': GENERAL}
 # Every 0.5° from 0 to ±720°: the grid lands on the change points at ±90° and ±270°.
 STEP_DEG = 0.5
 TURN_STEPS = 1440
@@ -63,7 +63,7 @@ def side_of_b(linkage: FourBar, states: LinkageState) -> np.ndarray:
     return np.sign(cross)
 
 
-@pytest.mark.parametrize("name", sorted(LINKAGES))
+@pytest.mark.parametrize('name', sorted(LINKAGES))
 def test_change_points_are_the_reference_s_double_roots(name: str) -> None:
     linkage = LINKAGES[name]
     singular = [float(angle) for angle in reference_singular_angles(linkage)]
@@ -73,9 +73,9 @@ def test_change_points_are_the_reference_s_double_roots(name: str) -> None:
         assert min(abs(math.remainder(point - angle, 2 * math.pi)) for angle in singular) < 1e-15
 
 
-@pytest.mark.parametrize("name", sorted(LINKAGES))
-@pytest.mark.parametrize("branch", [1, -1])
-@pytest.mark.parametrize("direction", [1, -1], ids=["counterclockwise", "clockwise"])
+@pytest.mark.parametrize('name', sorted(LINKAGES))
+@pytest.mark.parametrize('branch', [1, -1])
+@pytest.mark.parametrize('direction', [1, -1], ids=['counterclockwise', 'clockwise'])
 def test_smooth_motion_through_two_turns(name: str, branch: int, direction: int) -> None:
     """Both assemblies, both directions, two full turns: the library's branch rule picks the
     root the reference's step-by-step continuation picks, at every 0.5°; and there (the change
@@ -106,8 +106,8 @@ def test_smooth_motion_through_two_turns(name: str, branch: int, direction: int)
                 assert error <= REFERENCE_TOLERANCE, (alpha, kind, errors)
 
 
-@pytest.mark.parametrize("drive", DRIVES, ids=["constant", "variable"])
-@pytest.mark.parametrize("direction", [1, -1], ids=["counterclockwise", "clockwise"])
+@pytest.mark.parametrize('drive', DRIVES, ids=['constant', 'variable'])
+@pytest.mark.parametrize('direction', [1, -1], ids=['counterclockwise', 'clockwise'])
 def test_parallelogram_stays_a_parallelogram(drive: DriveLaw, direction: int) -> None:
     """Started as a parallelogram (B = A + C, branch −1 at α = 0), it stays one through ±720°,
     change points included: γ = 0, ω_AB = 0, ω_BC = ω, ω̇_AB = 0, ω̇_BC = ω̇ to rounding."""
@@ -125,7 +125,7 @@ def test_parallelogram_stays_a_parallelogram(drive: DriveLaw, direction: int) ->
     assert np.max(np.abs(states.omega_dot_bc - states.omega_dot) / acceleration_scale) <= ROUNDING
 
 
-@pytest.mark.parametrize("drive", DRIVES, ids=["constant", "variable"])
+@pytest.mark.parametrize('drive', DRIVES, ids=['constant', 'variable'])
 def test_kite_keeps_its_folded_assembly(drive: DriveLaw) -> None:
     """The kite OA = AB = 0.4, BC = OC = 1 has an assembly with B on O (branch +1 at α = 0):
     the rocker stands still and the coupler turns with the crank, through both change points."""
@@ -181,9 +181,9 @@ def test_pin_passing_through_the_pivot_is_refused() -> None:
     and can turn together about it; solve refuses within PIVOT_PASSAGE of it, not beyond."""
     folding = FourBar(1.0, 0.4, 0.4, 1.0, 0.0)
     assert folding.reachability.change_points == pytest.approx((math.pi / 2,), abs=1e-15)
-    with pytest.raises(DeadPointError, match="on the pivot C"):
+    with pytest.raises(DeadPointError, match='on the pivot C'):
         solve(folding, math.pi / 2, CONSTANT)
-    with pytest.raises(DeadPointError, match="on the pivot C"):
+    with pytest.raises(DeadPointError, match='on the pivot C'):
         solve_many(folding, np.array([1.0, math.pi / 2 + 1e-8]), CONSTANT)
     for alpha in (math.pi / 2 + 0.2, math.pi / 2 - 0.3):
         state = solve(folding, alpha, CONSTANT)

@@ -24,15 +24,15 @@ from node_process import (
 
 DOMAIN_ID = 12
 PACKAGE_ENTRIES = (
-    "package.xml", "setup.py", "setup.cfg", "resource", "linkage_kinematics", "launch", "config",
-    "urdf", "foxglove",
+    'package.xml', 'setup.py', 'setup.cfg', 'resource', 'linkage_kinematics', 'launch', 'config',
+    'urdf', 'foxglove',
 )
 
 
 def _package_files() -> list[str]:
     """The package's files as git knows them (tracked, or new and not ignored)."""
     listed = subprocess.run(
-        ["git", "ls-files", "--cached", "--others", "--exclude-standard", "--", *PACKAGE_ENTRIES],
+        ['git', 'ls-files', '--cached', '--others', '--exclude-standard', '--', *PACKAGE_ENTRIES],
         cwd=REPOSITORY, check=True, capture_output=True, text=True,
     ).stdout.split()
     return [path for path in listed if (REPOSITORY / path).is_file()]
@@ -42,75 +42,75 @@ def _colcon_environment(install: Path, base: dict[str, str]) -> dict[str, str]:
     """What sourcing install/local_setup.sh would set: each package's hook .dsv files prepend
     their paths (relative to the package prefix) to the named variables."""
     environment = dict(base)
-    for package_dsv in sorted(install.glob("*/share/*/package.dsv")):
+    for package_dsv in sorted(install.glob('*/share/*/package.dsv')):
         prefix = package_dsv.parents[2]
         for line in package_dsv.read_text().splitlines():
-            kind, hook = line.split(";", 1)
-            if kind != "source" or not hook.endswith(".dsv"):
+            kind, hook = line.split(';', 1)
+            if kind != 'source' or not hook.endswith('.dsv'):
                 continue
             for entry in (prefix / hook).read_text().splitlines():
-                action, variable, relative = entry.split(";", 2)
-                assert action == "prepend-non-duplicate", entry
+                action, variable, relative = entry.split(';', 2)
+                assert action == 'prepend-non-duplicate', entry
                 value = str(prefix / relative) if relative else str(prefix)
-                current = environment.get(variable, "").split(os.pathsep)
+                current = environment.get(variable, '').split(os.pathsep)
                 environment[variable] = os.pathsep.join(
                     [value, *(part for part in current if part and part != value)])
     return environment
 
 
 def test_colcon_build_installs_a_node_that_publishes(tmp_path):
-    workspace = tmp_path / "ws"
-    source = workspace / "src" / "linkage_kinematics"
+    workspace = tmp_path / 'ws'
+    source = workspace / 'src' / 'linkage_kinematics'
     for path in _package_files():
         target = source / path
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(REPOSITORY / path, target)
-    colcon = Path(sys.executable).parent / "colcon"
-    build_environment = {**os.environ, "AMENT_PREFIX_PATH": sys.prefix}
+    colcon = Path(sys.executable).parent / 'colcon'
+    build_environment = {**os.environ, 'AMENT_PREFIX_PATH': sys.prefix}
     build = subprocess.run(
-        [str(colcon), "build", "--base-paths", "src"],
+        [str(colcon), 'build', '--base-paths', 'src'],
         cwd=workspace, env=build_environment, capture_output=True, text=True,
         timeout=PROCESS_TIMEOUT * 4,
     )
     assert build.returncode == 0, build.stdout + build.stderr
 
-    install = workspace / "install"
-    executable = install / "linkage_kinematics" / "lib" / "linkage_kinematics" / "linkage_node"
+    install = workspace / 'install'
+    executable = install / 'linkage_kinematics' / 'lib' / 'linkage_kinematics' / 'linkage_node'
     assert executable.is_file() and os.access(executable, os.X_OK)
-    share = install / "linkage_kinematics" / "share" / "linkage_kinematics"
-    for installed in ("launch/linkage.launch.py", "config/seed_constant.yaml",
-                      "config/seed_variable.yaml", "urdf/linkage.urdf"):
+    share = install / 'linkage_kinematics' / 'share' / 'linkage_kinematics'
+    for installed in ('launch/linkage.launch.py', 'config/seed_constant.yaml',
+                      'config/seed_variable.yaml', 'urdf/linkage.urdf'):
         assert (share / installed).is_file(), installed
 
     environment = _colcon_environment(install, ros_environment(DOMAIN_ID))
     imported = subprocess.run(
-        [sys.executable, "-c", "import linkage_kinematics.node as n; print(n.__file__)"],
+        [sys.executable, '-c', 'import linkage_kinematics.node as n; print(n.__file__)'],
         cwd=tmp_path, env=environment, capture_output=True, text=True, check=True,
     ).stdout.strip()
     assert Path(imported).is_relative_to(install), imported
 
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("colcon_listener", context)
-        listener.subscribe("/joint_states", JointState)
+        listener = Listener('colcon_listener', context)
+        listener.subscribe('/joint_states', JointState)
         process = start_node(
-            {"end_behavior": "loop", "log.folder": str(tmp_path / "bags")}, DOMAIN_ID,
-            tmp_path / "node.log",
+            {'end_behavior': 'loop', 'log.folder': str(tmp_path / 'bags')}, DOMAIN_ID,
+            tmp_path / 'node.log',
             executable=[str(executable)], environment=environment, cwd=tmp_path,
         )
         try:
-            assert listener.spin_until(lambda: len(listener.received["/joint_states"]) >= 5), (
-                tmp_path / "node.log").read_text()
+            assert listener.spin_until(lambda: len(listener.received['/joint_states']) >= 5), (
+                tmp_path / 'node.log').read_text()
             process.send_signal(signal.SIGINT)
             assert process.wait(timeout=PROCESS_TIMEOUT) == 0
         finally:
             stop_process(process)
             listener.destroy()
-    assert list(listener.received["/joint_states"][0].name) == [
-        "crank_joint", "coupler_joint", "rocker_joint"]
+    assert list(listener.received['/joint_states'][0].name) == [
+        'crank_joint', 'coupler_joint', 'rocker_joint']
     # The installed package's bag writer process finished the log.
-    (bag,) = (tmp_path / "bags").iterdir()
+    (bag,) = (tmp_path / 'bags').iterdir()
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
-    count = bag_reader.bag_information(bag)["message_count"]
+    count = bag_reader.bag_information(bag)['message_count']
     assert count >= 5
-    assert f"bag finalized: {bag}, {count} messages" in (tmp_path / "node.log").read_text()
+    assert f'bag finalized: {bag}, {count} messages' in (tmp_path / 'node.log').read_text()

@@ -18,72 +18,72 @@ REPO = Path(__file__).resolve().parents[1]
 
 
 def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
-    environment = dict(os.environ, ROS_DOMAIN_ID="91", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     completed = subprocess.run(
-        [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(tmp_path / "bags")],
+        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(tmp_path / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=300,
     )
     assert completed.returncode == 0, completed.stderr
-    bags = sorted(path for path in (tmp_path / "bags").iterdir() if path.is_dir())
+    bags = sorted(path for path in (tmp_path / 'bags').iterdir() if path.is_dir())
     assert len(bags) == 2
     for bag in bags:
-        assert (bag / "metadata.yaml").is_file()
-        assert len(list(bag.glob("*.mcap"))) == 1
-        height, width, _channels = matplotlib.image.imread(bag.parent / f"{bag.name}.png").shape
+        assert (bag / 'metadata.yaml').is_file()
+        assert len(list(bag.glob('*.mcap'))) == 1
+        height, width, _channels = matplotlib.image.imread(bag.parent / f'{bag.name}.png').shape
         assert width > 600 and height > 400
     # Each bag lasts the seed's turn in mechanism time, its 181 steps of 0.5° each logged when
     # the drive law reaches it.
     for bag, drive in zip(bags, (DriveLaw(2.0), DriveLaw(0.1, 2.3))):
         information = bag_information(bag)
-        assert information["duration"]["nanoseconds"] == round(
+        assert information['duration']['nanoseconds'] == round(
             drive.time_to(0.0, math.pi / 2) * 1e9)
         log_times, states = read_states(bag)
         assert len(log_times) == 181
         assert states.alpha == pytest.approx(np.radians(np.arange(181) * 0.5), abs=1e-15)
         elapsed_ns = log_times - log_times[0]
         assert list(elapsed_ns) == [round(drive.time_to(0.0, alpha) * 1e9) for alpha in states.alpha]
-    assert [round(bag_information(bag)["duration"]["nanoseconds"] * 1e-6) for bag in bags] == [
+    assert [round(bag_information(bag)['duration']['nanoseconds'] * 1e-6) for bag in bags] == [
         785, 1571]
-    constant, variable = completed.stdout.split("Variable law")
+    constant, variable = completed.stdout.split('Variable law')
     # Table 1 and 2, α = 0 and 90° rows (constant law)
-    for value in ("-6.667", "-57.78", "192.6", "0.1800", "5.200"):
+    for value in ('-6.667', '-57.78', '192.6', '0.1800', '5.200'):
         assert value in constant
     # exact variable law: ω = 0.1 at 0°, 3.713 at 90°, α̈ = 2.3·ω
-    for value in ("0.1000", "3.713", "-0.3333", "0.0856", "-0.2852"):
+    for value in ('0.1000', '3.713', '-0.3333', '0.0856', '-0.2852'):
         assert value in variable
 
 
 @pytest.mark.parametrize(
-    ("arguments", "message"),
+    ('arguments', 'message'),
     [
-        (["--rows", "0"], "--rows: must be at least 1"),
-        (["--rows", "two"], "--rows: not a whole number"),
-        (["--rows", "nan"], "--rows: not a whole number"),
+        (['--rows', '0'], '--rows: must be at least 1'),
+        (['--rows', 'two'], '--rows: not a whole number'),
+        (['--rows', 'nan'], '--rows: not a whole number'),
     ],
 )
 def test_bad_arguments_get_one_line_and_no_run(
     arguments: list[str], message: str, tmp_path: Path
 ) -> None:
     completed = subprocess.run(
-        [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(tmp_path / "bags"),
+        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(tmp_path / 'bags'),
          *arguments],
         cwd=REPO, capture_output=True, text=True, timeout=60,
     )
     assert completed.returncode == 2
     assert message in completed.stderr
-    assert "Traceback" not in completed.stderr
-    assert not (tmp_path / "bags").exists()
+    assert 'Traceback' not in completed.stderr
+    assert not (tmp_path / 'bags').exists()
 
 
 def test_unwritable_log_folder_is_reported_without_a_traceback(tmp_path: Path) -> None:
-    blocker = tmp_path / "a_file"
-    blocker.write_text("not a folder")
-    environment = dict(os.environ, ROS_DOMAIN_ID="91", ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+    blocker = tmp_path / 'a_file'
+    blocker.write_text('not a folder')
+    environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     completed = subprocess.run(
-        [sys.executable, "-m", "linkage_kinematics.demo", "--log-folder", str(blocker / "bags")],
+        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(blocker / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=60,
     )
     assert completed.returncode == 1
-    assert "invalid parameter log.folder" in completed.stderr
-    assert "linkage_node exited with status 2" in completed.stderr
-    assert "Traceback" not in completed.stderr
+    assert 'invalid parameter log.folder' in completed.stderr
+    assert 'linkage_node exited with status 2' in completed.stderr
+    assert 'Traceback' not in completed.stderr

@@ -101,22 +101,22 @@ def test_time_to_same_angle_is_zero() -> None:
 
 
 def test_errors() -> None:
-    with pytest.raises(DriveError, match="at rest"):
+    with pytest.raises(DriveError, match='at rest'):
         DriveLaw(0.0, 0.0).time_to(0.0, 1.0)
-    with pytest.raises(DriveError, match="at rest"):
+    with pytest.raises(DriveError, match='at rest'):
         DriveLaw(-2.3, 2.3).time_to(1.0, 2.0)  # ω(1) = 0
-    with pytest.raises(DriveError, match="never reaches"):
+    with pytest.raises(DriveError, match='never reaches'):
         DriveLaw(2.0).time_to(1.0, 0.5)  # turning counterclockwise, asked to go back
-    with pytest.raises(DriveError, match=r"only approaches α\*"):
+    with pytest.raises(DriveError, match=r'only approaches α\*'):
         DriveLaw(1.0, -1.0).time_to(0.0, 2.0)  # ω → 0 as α → 1 rad, never beyond
-    with pytest.raises(DriveError, match="overflows"):
+    with pytest.raises(DriveError, match='overflows'):
         DriveLaw(0.1, 2.3).alpha_at(0.0, 1e4)
-    with pytest.raises(DriveError, match="overflows"):
+    with pytest.raises(DriveError, match='overflows'):
         DriveLaw(1e300, 1.0).alpha_at(0.0, 700.0)
     for bad in (math.nan, math.inf, -math.inf):
-        with pytest.raises(DriveError, match="finite"):
+        with pytest.raises(DriveError, match='finite'):
             DriveLaw(bad, 0.0)
-        with pytest.raises(DriveError, match="finite"):
+        with pytest.raises(DriveError, match='finite'):
             DriveLaw(1.0, bad)
 
 

@@ -28,35 +28,35 @@ from node_process import REPOSITORY, start_node, stop_process
 
 DOMAIN_ID = 40
 NODE_EXIT_TIMEOUT = 60.0  # s; the stop run ends by itself after 1.57 s of motion
-LAYOUT_FILE = REPOSITORY / "foxglove" / "linkage_layout.json"
-TITLE_KEYS = ("foxglovePanelTitle", "lichtblickPanelTitle")
-PAPER = preset("paper").geometry
+LAYOUT_FILE = REPOSITORY / 'foxglove' / 'linkage_layout.json'
+TITLE_KEYS = ('foxglovePanelTitle', 'lichtblickPanelTitle')
+PAPER = preset('paper').geometry
 SEED_VARIABLE = DriveLaw(0.1, 2.3)
-ALPHA_PATH = "/linkage/state.points[0].positions[0]"
+ALPHA_PATH = '/linkage/state.points[0].positions[0]'
 # A message path without filters, slices or math modifiers: a topic, then fields with at most
 # one constant index each, e.g. /linkage/state.points[0].velocities[7].
-MESSAGE_PATH = re.compile(r"(?P<topic>/[A-Za-z0-9_/]+)(?P<fields>(?:\.[A-Za-z_]\w*(?:\[\d+\])?)+)")
-FIELD = re.compile(r"\.([A-Za-z_]\w*)(?:\[(\d+)\])?")
-NUMERIC_TYPES = {"float32", "float64", "int8", "uint8", "int16", "uint16", "int32", "uint32",
-                 "int64", "uint64"}
+MESSAGE_PATH = re.compile(r'(?P<topic>/[A-Za-z0-9_/]+)(?P<fields>(?:\.[A-Za-z_]\w*(?:\[\d+\])?)+)')
+FIELD = re.compile(r'\.([A-Za-z_]\w*)(?:\[(\d+)\])?')
+NUMERIC_TYPES = {'float32', 'float64', 'int8', 'uint8', 'int16', 'uint16', 'int32', 'uint32',
+                 'int64', 'uint64'}
 
 
 def load_layout() -> dict[str, Any]:
-    return json.loads(LAYOUT_FILE.read_text(encoding="utf-8"))
+    return json.loads(LAYOUT_FILE.read_text(encoding='utf-8'))
 
 
 def plots(layout: dict[str, Any]) -> dict[str, dict[str, Any]]:
-    return {key: config for key, config in layout["configById"].items()
-            if key.startswith("Plot!")}
+    return {key: config for key, config in layout['configById'].items()
+            if key.startswith('Plot!')}
 
 
 def plotted_paths(layout: dict[str, Any]) -> list[str]:
     """Every message path the plots read: their series and their custom x axes."""
     paths = []
     for config in plots(layout).values():
-        paths += [series["value"] for series in config["paths"]]
-        if config["xAxisVal"] == "custom":
-            paths.append(config["xAxisPath"]["value"])
+        paths += [series['value'] for series in config['paths']]
+        if config['xAxisVal'] == 'custom':
+            paths.append(config['xAxisPath']['value'])
     return paths
 
 
@@ -64,18 +64,18 @@ def series_by_label(layout: dict[str, Any]) -> dict[str, str]:
     """Legend label -> message path; a label means the same path in every plot."""
     by_label: dict[str, str] = {}
     for config in plots(layout).values():
-        for series in config["paths"]:
-            assert by_label.setdefault(series["label"], series["value"]) == series["value"]
+        for series in config['paths']:
+            assert by_label.setdefault(series['label'], series['value']) == series['value']
     return by_label
 
 
 def split_path(path: str) -> tuple[str, list[tuple[str, int | None]]]:
     """(topic, [(field, index or None)]) of a plain message path; fails on anything else."""
     match = MESSAGE_PATH.fullmatch(path)
-    assert match, f"{path!r} is not a plain message path (topic, fields, [index])"
-    fields = [(name, None if index == "" else int(index))
-              for name, index in FIELD.findall(match["fields"])]
-    return match["topic"], fields
+    assert match, f'{path!r} is not a plain message path (topic, fields, [index])'
+    fields = [(name, None if index == '' else int(index))
+              for name, index in FIELD.findall(match['fields'])]
+    return match['topic'], fields
 
 
 def evaluate(message: Any, fields: list[tuple[str, int | None]], path: str) -> Any:
@@ -83,7 +83,7 @@ def evaluate(message: Any, fields: list[tuple[str, int | None]], path: str) -> A
     for name, index in fields:
         value = getattr(value, name)
         if index is not None:
-            assert index < len(value), f"{path}: index {index} beyond the {len(value)} logged"
+            assert index < len(value), f'{path}: index {index} beyond the {len(value)} logged'
             value = value[index]
     return value
 
@@ -104,27 +104,27 @@ def strings(node: Any) -> Iterator[str]:
 def layout_tree_panels(node: Any) -> list[str]:
     if isinstance(node, str):
         return [node]
-    return layout_tree_panels(node["first"]) + layout_tree_panels(node["second"])
+    return layout_tree_panels(node['first']) + layout_tree_panels(node['second'])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """The seed's variable-law turn, logged by the real node: the bag's schemas, channels and
     decoded messages per topic."""
-    run_folder = tmp_path_factory.mktemp("layout_run")
-    folder = run_folder / "bags"
+    run_folder = tmp_path_factory.mktemp('layout_run')
+    folder = run_folder / 'bags'
     process = start_node(
-        {"omega0": SEED_VARIABLE.omega0, "k": SEED_VARIABLE.k, "alpha_start": 0.0,
-         "alpha_end": math.pi / 2, "end_behavior": "stop", "log.folder": str(folder)},
-        DOMAIN_ID, run_folder / "node.log",
+        {'omega0': SEED_VARIABLE.omega0, 'k': SEED_VARIABLE.k, 'alpha_start': 0.0,
+         'alpha_end': math.pi / 2, 'end_behavior': 'stop', 'log.folder': str(folder)},
+        DOMAIN_ID, run_folder / 'node.log',
     )
     try:
         status = process.wait(timeout=NODE_EXIT_TIMEOUT)
     finally:
         stop_process(process)
-    assert status == 0, (run_folder / "node.log").read_text()
-    [mcap_file] = folder.glob("*/*.mcap")
-    with open(mcap_file, "rb") as stream:
+    assert status == 0, (run_folder / 'node.log').read_text()
+    [mcap_file] = folder.glob('*/*.mcap')
+    with open(mcap_file, 'rb') as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
         summary = reader.get_summary()
         assert summary is not None
@@ -133,7 +133,7 @@ def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         decoded: dict[str, list[Any]] = {topic: [] for topic in schema_of_topic}
         for _, channel, _, message in reader.iter_decoded_messages():
             decoded[channel.topic].append(message)
-    return {"schemas": schema_of_topic, "messages": decoded}
+    return {'schemas': schema_of_topic, 'messages': decoded}
 
 
 # --- the layout on its own -----------------------------------------------------------------------
@@ -141,91 +141,91 @@ def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_panel_has_one_title_under_both_keys() -> None:
     layout = load_layout()
-    for key, config in layout["configById"].items():
+    for key, config in layout['configById'].items():
         titles = {config.get(title_key) for title_key in TITLE_KEYS}
-        assert len(titles) == 1 and None not in titles and "" not in titles, key
-        assert "title" not in config, f"{key}: neither viewer reads the key 'title'"
+        assert len(titles) == 1 and None not in titles and '' not in titles, key
+        assert 'title' not in config, f"{key}: neither viewer reads the key 'title'"
 
 
 def test_every_panel_is_placed_once_in_the_layout_or_a_tab() -> None:
     layout = load_layout()
-    placed = layout_tree_panels(layout["layout"])
-    for key, config in layout["configById"].items():
-        if key.startswith("Tab!"):
-            for tab in config["tabs"]:
-                placed += layout_tree_panels(tab["layout"])
-    assert sorted(placed) == sorted(layout["configById"])
+    placed = layout_tree_panels(layout['layout'])
+    for key, config in layout['configById'].items():
+        if key.startswith('Tab!'):
+            for tab in config['tabs']:
+                placed += layout_tree_panels(tab['layout'])
+    assert sorted(placed) == sorted(layout['configById'])
 
 
 def test_no_math_modifiers_anywhere() -> None:
     layout = load_layout()
-    assert not [text for text in strings(layout) if ".@" in text]
+    assert not [text for text in strings(layout) if '.@' in text]
     for path in plotted_paths(layout):
         split_path(path)
 
 
 def test_plots_carry_their_units_in_title_and_y_axis_label() -> None:
     for key, config in plots(load_layout()).items():
-        [unit] = re.findall(r"\(([^)]+)\)", config["yAxisLabel"])
-        assert f"({unit})" in config["foxglovePanelTitle"], key
-        assert config["xAxisLabel"] == ("α (rad)" if config["xAxisVal"] == "custom"
-                                        else "time (s)"), key
+        [unit] = re.findall(r'\(([^)]+)\)', config['yAxisLabel'])
+        assert f'({unit})' in config['foxglovePanelTitle'], key
+        assert config['xAxisLabel'] == ('α (rad)' if config['xAxisVal'] == 'custom'
+                                        else 'time (s)'), key
 
 
 def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_alpha() -> None:
     layout = load_layout()
-    [tab_panel] = [config for key, config in layout["configById"].items()
-                   if key.startswith("Tab!")]
-    assert tab_panel["activeTabIdx"] == 0
+    [tab_panel] = [config for key, config in layout['configById'].items()
+                   if key.startswith('Tab!')]
+    assert tab_panel['activeTabIdx'] == 0
     over_time, against_alpha = (
-        [layout["configById"][key] for key in layout_tree_panels(tab["layout"])]
-        for tab in tab_panel["tabs"]
+        [layout['configById'][key] for key in layout_tree_panels(tab['layout'])]
+        for tab in tab_panel['tabs']
     )
 
     def labels(configs: list[dict[str, Any]]) -> set[str]:
-        return {series["label"] for config in configs for series in config["paths"]}
+        return {series['label'] for config in configs for series in config['paths']}
 
-    assert all(config["xAxisVal"] == "timestamp" for config in over_time)
+    assert all(config['xAxisVal'] == 'timestamp' for config in over_time)
     # The node stamps each state with its time in the motion; plot against that.
-    assert {series["timestampMethod"] for config in over_time
-            for series in config["paths"]} == {"headerStamp"}
-    assert labels(over_time) == {"α", "β", "γ", "ω", "ω_AB", "ω_BC", "ω̇", "ω̇_AB", "ω̇_BC",
-                                 "V_A", "V_B"}
-    assert all(config["xAxisVal"] == "custom" and config["xAxisPath"]
-               == {"value": ALPHA_PATH, "enabled": True} for config in against_alpha)
-    assert labels(against_alpha) == {"β", "γ", "ω_AB", "ω_BC", "ω̇_AB", "ω̇_BC", "V_A", "V_B"}
+    assert {series['timestampMethod'] for config in over_time
+            for series in config['paths']} == {'headerStamp'}
+    assert labels(over_time) == {'α', 'β', 'γ', 'ω', 'ω_AB', 'ω_BC', 'ω̇', 'ω̇_AB', 'ω̇_BC',
+                                 'V_A', 'V_B'}
+    assert all(config['xAxisVal'] == 'custom' and config['xAxisPath']
+               == {'value': ALPHA_PATH, 'enabled': True} for config in against_alpha)
+    assert labels(against_alpha) == {'β', 'γ', 'ω_AB', 'ω_BC', 'ω̇_AB', 'ω̇_BC', 'V_A', 'V_B'}
 
 
 def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
     """The disk (radius OA about O) and every place pin B can reach (radius BC about C) lie
     inside the grid and inside the 2D camera's view of a square panel (wider panels see more)."""
-    [three_d] = [config for key, config in load_layout()["configById"].items()
-                 if key.startswith("3D!")]
+    [three_d] = [config for key, config in load_layout()['configById'].items()
+                 if key.startswith('3D!')]
     margin = 0.1  # m
     low_x = min(-PAPER.crank_length, PAPER.ground_x - PAPER.rocker_length)
     high_x = max(PAPER.crank_length, PAPER.ground_x + PAPER.rocker_length)
     high_y = max(PAPER.crank_length, abs(PAPER.ground_y) + PAPER.rocker_length)
     assert (low_x, high_x, high_y) == pytest.approx((-0.3, 1.6, 0.3))
 
-    camera = three_d["cameraState"]
+    camera = three_d['cameraState']
     # 2D mode: an orthographic camera looking down z, x to the right, centred on targetOffset,
     # whose view is ``distance`` high and distance × (width/height) wide.
-    assert (camera["perspective"], camera["phi"], camera["thetaOffset"]) == (False, 0, 0)
-    centre_x, centre_y, _ = camera["targetOffset"]
-    half_view = camera["distance"] / 2
+    assert (camera['perspective'], camera['phi'], camera['thetaOffset']) == (False, 0, 0)
+    centre_x, centre_y, _ = camera['targetOffset']
+    half_view = camera['distance'] / 2
     assert centre_x - half_view <= low_x - margin and high_x + margin <= centre_x + half_view
     assert centre_y - half_view <= -high_y - margin and high_y + margin <= centre_y + half_view
 
-    grid = three_d["layers"]["grid"]
-    grid_x, grid_y, grid_z = grid["position"]
-    half_grid = grid["size"] / 2
+    grid = three_d['layers']['grid']
+    grid_x, grid_y, grid_z = grid['position']
+    half_grid = grid['size'] / 2
     assert grid_x - half_grid <= low_x - margin and high_x + margin <= grid_x + half_grid
     assert grid_y - half_grid <= -high_y - margin and high_y + margin <= grid_y + half_grid
     assert grid_z < 0.0  # below the disk and the bars
-    assert three_d["scene"]["transforms"]["showLabel"] is False
+    assert three_d['scene']['transforms']['showLabel'] is False
     # The URDF needs /tf (robot_state_publisher on a live system), which a bag does not hold.
-    assert three_d["topics"] == {"/linkage/markers": {"visible": True},
-                                 "/robot_description": {"visible": False}}
+    assert three_d['topics'] == {'/linkage/markers': {'visible': True},
+                                 '/robot_description': {'visible': False}}
 
 
 # --- the layout against a real node bag ----------------------------------------------------------
@@ -236,27 +236,27 @@ def test_every_message_path_resolves_against_the_logged_definitions(
 ) -> None:
     for path in plotted_paths(load_layout()):
         topic, fields = split_path(path)
-        assert topic in node_bag["schemas"], f"{path}: the bag has no topic {topic}"
-        schema = node_bag["schemas"][topic]
-        assert schema.encoding == "ros2msg"
+        assert topic in node_bag['schemas'], f'{path}: the bag has no topic {topic}'
+        schema = node_bag['schemas'][topic]
+        assert schema.encoding == 'ros2msg'
         types = get_types_from_msg(schema.data.decode(), schema.name)
         type_name = schema.name
         leaf = None
         for name, index in fields:
-            assert leaf is None, f"{path}: {name} follows the plain field before it"
+            assert leaf is None, f'{path}: {name} follows the plain field before it'
             definition = dict(types[type_name][1])
-            assert name in definition, f"{path}: {type_name} has no field {name}"
+            assert name in definition, f'{path}: {type_name} has no field {name}'
             node_type, detail = definition[name]
             if index is not None:
-                assert node_type in (Nodetype.ARRAY, Nodetype.SEQUENCE), f"{path}: {name}"
+                assert node_type in (Nodetype.ARRAY, Nodetype.SEQUENCE), f'{path}: {name}'
                 (node_type, detail), _ = detail
             if node_type == Nodetype.NAME:
                 type_name = detail
             else:
-                assert node_type == Nodetype.BASE, f"{path}: {name} is an array"
+                assert node_type == Nodetype.BASE, f'{path}: {name} is an array'
                 leaf = detail[0]
-        assert leaf in NUMERIC_TYPES, f"{path} ends in {leaf or type_name}, not a number"
-        logged = node_bag["messages"][topic]
+        assert leaf in NUMERIC_TYPES, f'{path} ends in {leaf or type_name}, not a number'
+        logged = node_bag['messages'][topic]
         assert logged
         for message in logged:
             assert isinstance(evaluate(message, fields, path), float | int)
@@ -264,65 +264,65 @@ def test_every_message_path_resolves_against_the_logged_definitions(
 
 def test_layout_names_only_topics_and_frames_the_node_logs(node_bag: dict[str, Any]) -> None:
     layout = load_layout()
-    panels = layout["configById"]
+    panels = layout['configById']
     named = {split_path(path)[0] for path in plotted_paths(layout)}
-    [three_d] = [config for key, config in panels.items() if key.startswith("3D!")]
-    named |= set(three_d["topics"])
-    diagnostics = [config for key, config in panels.items() if key.startswith("Diagnostic")]
+    [three_d] = [config for key, config in panels.items() if key.startswith('3D!')]
+    named |= set(three_d['topics'])
+    diagnostics = [config for key, config in panels.items() if key.startswith('Diagnostic')]
     assert len(diagnostics) == 2
-    named |= {config["topicToRender"] for config in diagnostics}
-    assert named == {"/linkage/state", "/linkage/markers", "/robot_description", "/diagnostics"}
-    assert named <= set(node_bag["schemas"])
+    named |= {config['topicToRender'] for config in diagnostics}
+    assert named == {'/linkage/state', '/linkage/markers', '/robot_description', '/diagnostics'}
+    assert named <= set(node_bag['schemas'])
 
-    frames = {marker.header.frame_id for array in node_bag["messages"]["/linkage/markers"]
+    frames = {marker.header.frame_id for array in node_bag['messages']['/linkage/markers']
               for marker in array.markers}
-    assert frames == {three_d["followTf"]} == {three_d["layers"]["grid"]["frameId"]}
+    assert frames == {three_d['followTf']} == {three_d['layers']['grid']['frameId']}
 
 
 def test_diagnostics_detail_panel_shows_the_status_the_node_logs(node_bag: dict[str, Any]) -> None:
-    [detail] = [config for key, config in load_layout()["configById"].items()
-                if key.startswith("DiagnosticStatusPanel!")]
+    [detail] = [config for key, config in load_layout()['configById'].items()
+                if key.startswith('DiagnosticStatusPanel!')]
     logged = {(status.hardware_id, status.name)
-              for array in node_bag["messages"]["/diagnostics"] for status in array.status}
-    assert (detail["selectedHardwareId"], detail["selectedName"]) in logged
+              for array in node_bag['messages']['/diagnostics'] for status in array.status}
+    assert (detail['selectedHardwareId'], detail['selectedName']) in logged
 
 
 def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
     node_bag: dict[str, Any],
 ) -> None:
     by_label = series_by_label(load_layout())
-    states = node_bag["messages"]["/linkage/state"]
+    states = node_bag['messages']['/linkage/state']
     assert len(states) > 100
 
     def read(label_or_path: str) -> list[float]:
         path = by_label.get(label_or_path, label_or_path)
         topic, fields = split_path(path)
-        assert topic == "/linkage/state"
+        assert topic == '/linkage/state'
         return [evaluate(message, fields, path) for message in states]
 
     alphas = read(ALPHA_PATH)
     assert alphas[0] == 0.0 and alphas[-1] == math.pi / 2
     library = [solve(PAPER, alpha, SEED_VARIABLE) for alpha in alphas]
-    omega_bc = read("ω_BC")
+    omega_bc = read('ω_BC')
     assert max(omega_bc) < 0.0  # clockwise over the whole turn, as in the seed's Table 3
     assert omega_bc == pytest.approx([state.omega_bc for state in library], rel=1e-12)
-    assert read("ω̇_BC") == pytest.approx([state.omega_dot_bc for state in library], rel=1e-12)
-    assert round(read("ω̇_BC")[-1], 2) == 15.36  # rad/s² at α = 90°, the seed's Table 4
-    assert read("ω_AB") == pytest.approx([state.omega_ab for state in library], rel=1e-12)
-    assert read("ω̇_AB") == pytest.approx([state.omega_dot_ab for state in library], rel=1e-12)
+    assert read('ω̇_BC') == pytest.approx([state.omega_dot_bc for state in library], rel=1e-12)
+    assert round(read('ω̇_BC')[-1], 2) == 15.36  # rad/s² at α = 90°, the seed's Table 4
+    assert read('ω_AB') == pytest.approx([state.omega_ab for state in library], rel=1e-12)
+    assert read('ω̇_AB') == pytest.approx([state.omega_dot_ab for state in library], rel=1e-12)
     # Both pins move forwards along their circles over the turn, so the signed V_A and V_B
     # equal the library's speeds.
-    assert read("V_A") == pytest.approx([state.v_a for state in library], rel=1e-12)
-    assert read("V_B") == pytest.approx([state.v_b for state in library], rel=1e-12)
-    assert read("β") == pytest.approx([state.beta for state in library], rel=1e-12)
-    assert read("γ") == pytest.approx([state.gamma for state in library], rel=1e-12)
+    assert read('V_A') == pytest.approx([state.v_a for state in library], rel=1e-12)
+    assert read('V_B') == pytest.approx([state.v_b for state in library], rel=1e-12)
+    assert read('β') == pytest.approx([state.beta for state in library], rel=1e-12)
+    assert read('γ') == pytest.approx([state.gamma for state in library], rel=1e-12)
 
 
 # --- the paper's quantities as plain fields of /linkage/state ------------------------------------
 
 
-@pytest.mark.parametrize("drive", [DriveLaw(2.0), SEED_VARIABLE, DriveLaw(-1.5, 0.4)])
-@pytest.mark.parametrize("alpha_deg", [0.0, 17.0, 45.0, 90.0, 150.0])
+@pytest.mark.parametrize('drive', [DriveLaw(2.0), SEED_VARIABLE, DriveLaw(-1.5, 0.4)])
+@pytest.mark.parametrize('alpha_deg', [0.0, 17.0, 45.0, 90.0, 150.0])
 def test_rocker_angle_and_pin_arcs_are_the_papers_coordinates(
     drive: DriveLaw, alpha_deg: float
 ) -> None:
@@ -330,7 +330,7 @@ def test_rocker_angle_and_pin_arcs_are_the_papers_coordinates(
     (cos α, sin α) and (sin β, cos β) (the paper's Eqs. 8a and 8b–9), their rates the tangential
     accelerations."""
     state = solve(PAPER, math.radians(alpha_deg), drive)
-    point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, "o").points[0]
+    point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, 'o').points[0]
     rocker_angle, pin_a_arc, pin_b_arc = point.positions[7:]
     assert (PAPER.ground_x + PAPER.rocker_length * math.cos(rocker_angle),
             PAPER.ground_y + PAPER.rocker_length * math.sin(rocker_angle)) == pytest.approx(
@@ -362,7 +362,7 @@ def test_plain_fields_match_the_seeds_table_for_the_constant_law() -> None:
     """Table 1 and 2 rows the seed gets right (see shared/seed/README.md)."""
     def fields(alpha: float) -> tuple[Any, Any]:
         state = solve(PAPER, alpha, DriveLaw(2.0))
-        point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, "o").points[0]
+        point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, 'o').points[0]
         return point.velocities, point.accelerations
 
     velocities, accelerations = fields(0.0)

@@ -20,21 +20,21 @@ from linkage_kinematics.geometry import (
 from linkage_kinematics.kinematics import solve
 
 
-@pytest.mark.parametrize("name", ["crank_length", "coupler_length", "rocker_length"])
+@pytest.mark.parametrize('name', ['crank_length', 'coupler_length', 'rocker_length'])
 @pytest.mark.parametrize(
-    "bad", [0.0, -0.3, math.nan, math.inf, -math.inf, "0.3", None, True, 1e308, 1e-300]
+    'bad', [0.0, -0.3, math.nan, math.inf, -math.inf, '0.3', None, True, 1e308, 1e-300]
 )
 def test_bad_lengths_are_rejected_by_name(name: str, bad) -> None:
-    lengths = {"crank_length": 0.3, "coupler_length": 1.0, "rocker_length": 0.3}
+    lengths = {'crank_length': 0.3, 'coupler_length': 1.0, 'rocker_length': 0.3}
     lengths[name] = bad
     with pytest.raises(GeometryError, match=name):
         FourBar(**lengths, ground_x=1.3)
 
 
-@pytest.mark.parametrize("name", ["ground_x", "ground_y"])
-@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf, "1.3", True, 1e308, -1e308])
+@pytest.mark.parametrize('name', ['ground_x', 'ground_y'])
+@pytest.mark.parametrize('bad', [math.nan, math.inf, -math.inf, '1.3', True, 1e308, -1e308])
 def test_bad_ground_pivot_is_rejected_by_name(name: str, bad) -> None:
-    pivot = {"ground_x": 1.3, "ground_y": 0.0}
+    pivot = {'ground_x': 1.3, 'ground_y': 0.0}
     pivot[name] = bad
     with pytest.raises(GeometryError, match=name):
         FourBar(0.3, 1.0, 0.3, **pivot)
@@ -42,10 +42,10 @@ def test_bad_ground_pivot_is_rejected_by_name(name: str, bad) -> None:
 
 def test_a_loop_that_never_closes_is_rejected() -> None:
     # |C − A| ∈ [2.7, 3.3] m but AB + BC = 1.3 m
-    with pytest.raises(GeometryError, match="cannot close at any crank angle"):
+    with pytest.raises(GeometryError, match='cannot close at any crank angle'):
         FourBar(0.3, 1.0, 0.3, 3.0, 0.0)
     # |C − A| ∈ [0.7, 1.3] m but |AB − BC| = 2.0 m
-    with pytest.raises(GeometryError, match="cannot close at any crank angle"):
+    with pytest.raises(GeometryError, match='cannot close at any crank angle'):
         FourBar(0.3, 2.5, 0.5, 1.0, 0.0)
 
 
@@ -59,23 +59,23 @@ def test_coincident_pivots() -> None:
     assert state.omega_ab == pytest.approx(2.0, rel=1e-12)
     assert state.omega_bc == pytest.approx(2.0, rel=1e-12)
     for lengths in ((0.5, 1.0, 0.3), (0.5, 0.2, 0.3), (0.5, 0.3, 0.8)):
-        with pytest.raises(GeometryError, match="O and C coincident"):
+        with pytest.raises(GeometryError, match='O and C coincident'):
             FourBar(*lengths, 0.0, 0.0)
 
 
 def test_presets() -> None:
-    paper = preset("paper")
+    paper = preset('paper')
     assert paper.geometry == FourBar(0.3, math.sqrt(1.09), 0.3, 1.3, 0.0)
     assert paper.drive_sign == 1.0
     assert not paper.geometry.is_grashof
-    assert preset("paper_full_turn").drive_sign == -1.0
-    assert preset("paper_full_turn").geometry.ground_x == pytest.approx(math.sqrt(0.73))
-    assert preset("grashof_crank_rocker").geometry.is_grashof
-    with pytest.raises(GeometryError, match="known presets: grashof_crank_rocker, paper, "):
-        preset("nope")
+    assert preset('paper_full_turn').drive_sign == -1.0
+    assert preset('paper_full_turn').geometry.ground_x == pytest.approx(math.sqrt(0.73))
+    assert preset('grashof_crank_rocker').geometry.is_grashof
+    with pytest.raises(GeometryError, match='known presets: grashof_crank_rocker, paper, '):
+        preset('nope')
 
 
-@pytest.mark.parametrize("name", sorted(PRESETS))
+@pytest.mark.parametrize('name', sorted(PRESETS))
 def test_preset_singular_angles_match_reference(name: str) -> None:
     reachability = PRESETS[name].geometry.reachability
     found = sorted(wrap_angle(angle) for angle in reachability.dead_points)
@@ -84,14 +84,14 @@ def test_preset_singular_angles_match_reference(name: str) -> None:
 
 
 def test_reachability_messages() -> None:
-    paper = PRESETS["paper"].geometry.reachability
-    assert paper.describe() == "[-1.941°, 181.941°]"
-    assert PRESETS["grashof_crank_rocker"].geometry.reachability.describe() == (
-        "all crank angles (full rotation)"
+    paper = PRESETS['paper'].geometry.reachability
+    assert paper.describe() == '[-1.941°, 181.941°]'
+    assert PRESETS['grashof_crank_rocker'].geometry.reachability.describe() == (
+        'all crank angles (full rotation)'
     )
-    assert format_interval((-math.pi / 2, math.pi)) == "[-90.000°, 180.000°]"
-    with pytest.raises(UnreachableError, match=r"α = -10\.000000° is not reachable.*"
-                                               r"\[-1\.941°, 181\.941°\] \(mod 360°\)"):
+    assert format_interval((-math.pi / 2, math.pi)) == '[-90.000°, 180.000°]'
+    with pytest.raises(UnreachableError, match=r'α = -10\.000000° is not reachable.*'
+                                               r'\[-1\.941°, 181\.941°\] \(mod 360°\)'):
         paper.require(math.radians(-10.0))
     # the same angle a whole number of turns away is treated alike
     assert paper.require(math.radians(45.0 + 720.0)) == paper.intervals[0]
@@ -99,11 +99,11 @@ def test_reachability_messages() -> None:
 
 
 def test_dead_point_distance() -> None:
-    paper = PRESETS["paper"].geometry.reachability
+    paper = PRESETS['paper'].geometry.reachability
     assert paper.dead_point_distance(0.0) == pytest.approx(-paper.dead_points[0], rel=1e-15)
     assert paper.dead_point_distance(paper.dead_points[1]) == 0.0
     assert paper.change_point_distance(0.0) is None
-    assert PRESETS["grashof_crank_rocker"].geometry.reachability.dead_point_distance(1.0) is None
+    assert PRESETS['grashof_crank_rocker'].geometry.reachability.dead_point_distance(1.0) is None
 
 
 def test_change_points_are_not_dead_points() -> None:
@@ -118,7 +118,7 @@ def test_change_points_are_not_dead_points() -> None:
 
 
 def test_first_dead_point_on_the_way() -> None:
-    paper = PRESETS["paper"].geometry.reachability
+    paper = PRESETS['paper'].geometry.reachability
     low, high = paper.dead_points
     # counterclockwise from 0 the crank meets the 181.94° dead point, clockwise the −1.94° one
     assert paper.first_dead_point(0.0, math.radians(200.0)) == pytest.approx(high, abs=1e-15)
@@ -148,7 +148,7 @@ def test_change_points_of_equality_linkages() -> None:
 
 
 def test_scaled() -> None:
-    paper = PRESETS["paper"].geometry
+    paper = PRESETS['paper'].geometry
     small = paper.scaled(1e-6)
     assert small.coupler_length == paper.coupler_length * 1e-6
     assert small.reachability.intervals[0] == pytest.approx(

@@ -28,10 +28,10 @@ VARIABLE = DriveLaw(0.10, 2.3)
 
 GEOMETRIES = {
     **{name: preset.geometry for name, preset in PRESETS.items()},
-    "non_grashof_tilted": FourBar(0.5, 2.0, 1.8, 0.3, -0.2),
-    "drag_link": FourBar(1.0, 1.2, 0.9, 0.3, 0.0),
-    "crank_rocker_tilted": FourBar(0.25, 1.0, 0.7, 0.8, -0.35),
-    "rocker_rocker_raised": FourBar(0.5, 1.1, 0.8, 0.6, 0.4),
+    'non_grashof_tilted': FourBar(0.5, 2.0, 1.8, 0.3, -0.2),
+    'drag_link': FourBar(1.0, 1.2, 0.9, 0.3, 0.0),
+    'crank_rocker_tilted': FourBar(0.25, 1.0, 0.7, 0.8, -0.35),
+    'rocker_rocker_raised': FourBar(0.5, 1.1, 0.8, 0.6, 0.4),
 }
 
 
@@ -49,9 +49,9 @@ def sample_angles(linkage: FourBar, count: int) -> list[float]:
 def assert_matches_reference(state: LinkageState, linkage: FourBar, drive: DriveLaw,
                              branch: int) -> None:
     errors = state_errors(state, reference_state(linkage, state.alpha, drive, branch))
-    assert errors["angle"] <= ANGLE_TOLERANCE, errors
-    assert errors["pin"] <= ANGLE_TOLERANCE, errors
-    for kind in ("angular_rate", "angular_acceleration", "velocity", "acceleration"):
+    assert errors['angle'] <= ANGLE_TOLERANCE, errors
+    assert errors['pin'] <= ANGLE_TOLERANCE, errors
+    for kind in ('angular_rate', 'angular_acceleration', 'velocity', 'acceleration'):
         assert errors[kind] <= RATE_TOLERANCE, (kind, errors)
 
 
@@ -62,9 +62,9 @@ def branch_side(linkage: FourBar, state: LinkageState) -> float:
     return math.copysign(1.0, to_c[0] * to_b[1] - to_c[1] * to_b[0])
 
 
-@pytest.mark.parametrize("name", sorted(GEOMETRIES))
-@pytest.mark.parametrize("branch", [1, -1])
-@pytest.mark.parametrize("drive", [CONSTANT, VARIABLE], ids=["constant", "variable"])
+@pytest.mark.parametrize('name', sorted(GEOMETRIES))
+@pytest.mark.parametrize('branch', [1, -1])
+@pytest.mark.parametrize('drive', [CONSTANT, VARIABLE], ids=['constant', 'variable'])
 def test_solve_matches_reference(name: str, branch: int, drive: DriveLaw) -> None:
     linkage = GEOMETRIES[name]
     for alpha in sample_angles(linkage, 12):
@@ -73,8 +73,8 @@ def test_solve_matches_reference(name: str, branch: int, drive: DriveLaw) -> Non
         assert_matches_reference(state, linkage, drive, branch)
 
 
-@pytest.mark.parametrize("name", sorted(GEOMETRIES))
-@pytest.mark.parametrize("branch", [1, -1])
+@pytest.mark.parametrize('name', sorted(GEOMETRIES))
+@pytest.mark.parametrize('branch', [1, -1])
 def test_solve_many_equals_solve_and_closes_the_loop(name: str, branch: int) -> None:
     linkage = GEOMETRIES[name]
     angles = np.array(sample_angles(linkage, 200))
@@ -91,7 +91,7 @@ def test_solve_many_equals_solve_and_closes_the_loop(name: str, branch: int) -> 
         assert np.all(np.isfinite(getattr(states, field_name))), field_name
 
 
-@pytest.mark.parametrize("name", ["paper", "drag_link", "rocker_rocker_raised"])
+@pytest.mark.parametrize('name', ['paper', 'drag_link', 'rocker_rocker_raised'])
 def test_finite_differences_of_positions_give_the_rates(name: str) -> None:
     """Central differences in α of solve_many's positions, times ω (and α̈ = k·ω), reproduce
     the closed-form velocities and accelerations."""
@@ -118,13 +118,13 @@ def test_finite_differences_of_positions_give_the_rates(name: str) -> None:
     middle = solve_many(linkage, centres, VARIABLE)
     omega = middle.omega
     for position, rate, acceleration in (
-        ("beta", -middle.omega_bc, -middle.omega_dot_bc),
-        ("gamma", middle.omega_ab, middle.omega_dot_ab),
-        ("pin_b_x", middle.velocity_b_x, middle.acceleration_b_x),
-        ("pin_b_y", middle.velocity_b_y, middle.acceleration_b_y),
-        ("pin_a_y", middle.velocity_a_y, middle.acceleration_a_y),
+        ('beta', -middle.omega_bc, -middle.omega_dot_bc),
+        ('gamma', middle.omega_ab, middle.omega_dot_ab),
+        ('pin_b_x', middle.velocity_b_x, middle.acceleration_b_x),
+        ('pin_b_y', middle.velocity_b_y, middle.acceleration_b_y),
+        ('pin_a_y', middle.velocity_a_y, middle.acceleration_a_y),
     ):
-        forward, backward = around(getattr(stencil, position), position in ("beta", "gamma"))
+        forward, backward = around(getattr(stencil, position), position in ('beta', 'gamma'))
         first = (forward + backward) / (2.0 * step)
         second = (forward - backward) / step**2
         rate_scale = np.max(np.abs(rate))
@@ -160,11 +160,11 @@ def test_random_linkages_match_reference(crank, coupler, rocker, ground_x, groun
     assume(abs(drive.angular_velocity(alpha)) > 1e-3)
     reference = reference_state(linkage, alpha, drive, branch)
     # Well away from collinearity only: near it the error grows as measured in test_hard_cases.
-    assume(math.sin(float(reference["transmission_angle"])) > 1e-2)
+    assume(math.sin(float(reference['transmission_angle'])) > 1e-2)
     state = solve(linkage, alpha, drive, branch)
     errors = state_errors(state, reference)
-    assert errors["angle"] <= ANGLE_TOLERANCE, errors
-    for kind in ("angular_rate", "angular_acceleration", "velocity", "acceleration"):
+    assert errors['angle'] <= ANGLE_TOLERANCE, errors
+    for kind in ('angular_rate', 'angular_acceleration', 'velocity', 'acceleration'):
         assert errors[kind] <= RATE_TOLERANCE, (kind, errors)
     assert loop_closure_residual(linkage, state) <= 1e-12
 
@@ -185,46 +185,46 @@ def test_grashof_crank_rocker_turns_fully(crank, extra, tilt) -> None:
     for alpha in np.linspace(-math.pi, math.pi, 5):
         state = solve(linkage, float(alpha), CONSTANT)
         errors = state_errors(state, reference_state(linkage, float(alpha), CONSTANT))
-        assert errors["angle"] <= ANGLE_TOLERANCE and errors["angular_rate"] <= RATE_TOLERANCE
+        assert errors['angle'] <= ANGLE_TOLERANCE and errors['angular_rate'] <= RATE_TOLERANCE
 
 
 def _row(state: LinkageState) -> dict[str, float]:
     """The seed's table columns (degrees, m/s, rad/s, rad/s²)."""
     return {
-        "beta": math.degrees(state.beta),
-        "gamma": math.degrees(state.gamma),
-        "v_a": float(state.v_a),
-        "v_b": float(state.v_b),
-        "omega": state.omega,
-        "omega_ab": state.omega_ab,
-        "omega_bc": state.omega_bc,
-        "omega_dot_ab": state.omega_dot_ab,
-        "omega_dot_bc": state.omega_dot_bc,
+        'beta': math.degrees(state.beta),
+        'gamma': math.degrees(state.gamma),
+        'v_a': float(state.v_a),
+        'v_b': float(state.v_b),
+        'omega': state.omega,
+        'omega_ab': state.omega_ab,
+        'omega_bc': state.omega_bc,
+        'omega_dot_ab': state.omega_dot_ab,
+        'omega_dot_bc': state.omega_dot_bc,
     }
 
 
 # The seed's Tables 1 and 2 (constant ω = 2 rad/s), value and the decimals it prints. Its
 # "−6.7" for ω_BC at α = 0 is −6.667 (−20/3), and its Table 2 prints −57.8 and 192.6.
 SEED_TABLES_1_AND_2 = {
-    0.0: {"beta": (0, 0), "gamma": (16.7, 1), "v_a": (0.6, 1), "v_b": (2, 0), "omega": (2, 0),
-          "omega_ab": (2, 0), "omega_bc": (-6.7, 1), "omega_dot_ab": (-57.8, 1),
-          "omega_dot_bc": (192.6, 1)},
-    90.0: {"beta": (90, 0), "gamma": (16.7, 1), "v_a": (0.6, 1), "v_b": (0.18, 2),
-           "omega": (2, 0), "omega_ab": (-0.6, 1), "omega_bc": (-0.6, 1),
-           "omega_dot_ab": (0.0, 1), "omega_dot_bc": (5.2, 1)},
+    0.0: {'beta': (0, 0), 'gamma': (16.7, 1), 'v_a': (0.6, 1), 'v_b': (2, 0), 'omega': (2, 0),
+          'omega_ab': (2, 0), 'omega_bc': (-6.7, 1), 'omega_dot_ab': (-57.8, 1),
+          'omega_dot_bc': (192.6, 1)},
+    90.0: {'beta': (90, 0), 'gamma': (16.7, 1), 'v_a': (0.6, 1), 'v_b': (0.18, 2),
+           'omega': (2, 0), 'omega_ab': (-0.6, 1), 'omega_bc': (-0.6, 1),
+           'omega_dot_ab': (0.0, 1), 'omega_dot_bc': (5.2, 1)},
 }
 
 
-@pytest.mark.parametrize("alpha_degrees", sorted(SEED_TABLES_1_AND_2))
+@pytest.mark.parametrize('alpha_degrees', sorted(SEED_TABLES_1_AND_2))
 def test_seed_tables_1_and_2(alpha_degrees: float) -> None:
-    row = _row(solve(PRESETS["paper"].geometry, math.radians(alpha_degrees), CONSTANT))
+    row = _row(solve(PRESETS['paper'].geometry, math.radians(alpha_degrees), CONSTANT))
     for column, (printed, decimals) in SEED_TABLES_1_AND_2[alpha_degrees].items():
         assert round(row[column], decimals) == printed, (column, row[column])
 
 
 def test_seed_values_at_alpha_zero_to_more_digits() -> None:
     """The README's exact figures: ω_BC = −20/3, ω̇_AB = −57.78, ω̇_BC = 192.59 at α = 0."""
-    state = solve(PRESETS["paper"].geometry, 0.0, CONSTANT)
+    state = solve(PRESETS['paper'].geometry, 0.0, CONSTANT)
     assert state.omega_bc == pytest.approx(-20.0 / 3.0, rel=1e-12)
     assert round(state.omega_dot_ab, 2) == -57.78
     assert round(state.omega_dot_bc, 2) == 192.59
@@ -232,17 +232,17 @@ def test_seed_values_at_alpha_zero_to_more_digits() -> None:
 
 
 def test_reachability_of_the_presets() -> None:
-    paper = PRESETS["paper"].geometry.reachability
+    paper = PRESETS['paper'].geometry.reachability
     assert round(math.degrees(paper.dead_points[0]), 3) == -1.941
     assert not paper.full_rotation
-    full_turn = PRESETS["paper_full_turn"].geometry.reachability
+    full_turn = PRESETS['paper_full_turn'].geometry.reachability
     assert not full_turn.full_rotation
     ((low, high),) = full_turn.intervals
     assert (round(math.degrees(low), 1), round(math.degrees(high), 1)) == (-211.3, 31.3)
-    assert PRESETS["grashof_crank_rocker"].geometry.reachability.full_rotation
+    assert PRESETS['grashof_crank_rocker'].geometry.reachability.full_rotation
 
 
-@pytest.mark.parametrize("name", sorted(GEOMETRIES))
+@pytest.mark.parametrize('name', sorted(GEOMETRIES))
 def test_dead_points_match_reference(name: str) -> None:
     linkage = GEOMETRIES[name]
     reachability = linkage.reachability
@@ -253,23 +253,23 @@ def test_dead_points_match_reference(name: str) -> None:
 
 
 def test_unreachable_angle_names_the_interval() -> None:
-    linkage = PRESETS["paper_full_turn"].geometry
-    with pytest.raises(UnreachableError, match=r"\[-211\.\d+°, 31\.\d+°\]"):
+    linkage = PRESETS['paper_full_turn'].geometry
+    with pytest.raises(UnreachableError, match=r'\[-211\.\d+°, 31\.\d+°\]'):
         solve(linkage, math.radians(90.0), CONSTANT)
-    with pytest.raises(UnreachableError, match="-1.941"):
-        solve(PRESETS["paper"].geometry, math.radians(-10.0), CONSTANT)
-    with pytest.raises(UnreachableError, match=r"\[-211"):
+    with pytest.raises(UnreachableError, match='-1.941'):
+        solve(PRESETS['paper'].geometry, math.radians(-10.0), CONSTANT)
+    with pytest.raises(UnreachableError, match=r'\[-211'):
         solve_many(linkage, np.array([0.0, math.radians(90.0)]), CONSTANT)
     for bad in (math.nan, math.inf, -math.inf):
-        with pytest.raises(UnreachableError, match="finite"):
+        with pytest.raises(UnreachableError, match='finite'):
             solve(linkage, bad, CONSTANT)
-    with pytest.raises(UnreachableError, match="finite"):
+    with pytest.raises(UnreachableError, match='finite'):
         solve_many(linkage, np.array([0.0, math.nan]), CONSTANT)
-    with pytest.raises(ValueError, match="branch"):
+    with pytest.raises(ValueError, match='branch'):
         solve(linkage, 0.0, CONSTANT, branch=0)
 
 
-@pytest.mark.parametrize("name", sorted(GEOMETRIES))
+@pytest.mark.parametrize('name', sorted(GEOMETRIES))
 def test_dense_sweep_is_finite_and_reachable_mask_agrees(name: str) -> None:
     """solve never returns NaN or inf: it answers or raises, at every angle of a dense sweep."""
     linkage = GEOMETRIES[name]

@@ -44,18 +44,18 @@ from node_process import (
 )
 
 DOMAIN_ID = 10
-PAPER = preset("paper").geometry
+PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.94°, clockwise from 0
 DATA_TOPICS = {
-    "/joint_states": JointState,
-    "/linkage/state": JointTrajectory,
-    "/linkage/markers": MarkerArray,
-    "/diagnostics": DiagnosticArray,
+    '/joint_states': JointState,
+    '/linkage/state': JointTrajectory,
+    '/linkage/markers': MarkerArray,
+    '/diagnostics': DiagnosticArray,
 }
-QUIET = {"log.enabled": False}
+QUIET = {'log.enabled': False}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope='module')
 def context():
     with ros_context(DOMAIN_ID) as ros:
         yield ros
@@ -80,15 +80,15 @@ def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
     the switch waits until the listener has heard a time after the first, which the restart's
     zero is below even if the listener joined at the node's very first state.
     """
-    process = start_node({**parameters, "end_behavior": "loop"}, DOMAIN_ID, output)
-    trajectories = listener.received["/linkage/state"]
+    process = start_node({**parameters, 'end_behavior': 'loop'}, DOMAIN_ID, output)
+    trajectories = listener.received['/linkage/state']
     try:
         assert listener.spin_until(
             lambda: trajectories and _seconds(trajectories[-1].points[0].time_from_start) > 0.0
         ), output.read_text()
-        client = AsyncParameterClient(listener.node, "linkage_node")
+        client = AsyncParameterClient(listener.node, 'linkage_node')
         assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-        future = client.set_parameters([Parameter("end_behavior", value="stop")])
+        future = client.set_parameters([Parameter('end_behavior', value='stop')])
         assert listener.spin_until(future.done)
         assert future.result().results[0].successful
         listener.spin_until(lambda: process.poll() is not None)
@@ -123,12 +123,12 @@ def _values(status: DiagnosticStatus) -> dict[str, str]:
 
 
 def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
-    joint_states = listener.received["/joint_states"]
-    assert joint_states, "no /joint_states received"
+    joint_states = listener.received['/joint_states']
+    assert joint_states, 'no /joint_states received'
     previous = None
     for message in joint_states:
         assert list(message.name) == list(messages.JOINT_NAMES)
-        assert message.header.frame_id == ""
+        assert message.header.frame_id == ''
         alpha, coupler, rocker = message.position
         state = solve(PAPER, alpha, drive)
         assert math.remainder(coupler - (state.gamma - state.alpha), TWO_PI) == pytest.approx(
@@ -142,8 +142,8 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
                        for now, before in zip(message.position, previous))
         previous = message.position
 
-    trajectories = listener.received["/linkage/state"]
-    assert trajectories, "no /linkage/state received"
+    trajectories = listener.received['/linkage/state']
+    assert trajectories, 'no /linkage/state received'
     for message in trajectories:
         assert list(message.joint_names) == list(STATE_JOINT_NAMES)
         point = message.points[0]
@@ -153,7 +153,7 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
         assert _seconds(point.time_from_start) == pytest.approx(
             drive.time_to(0.0, state.alpha), abs=1e-9)
 
-    for topic in ("/joint_states", "/linkage/state"):
+    for topic in ('/joint_states', '/linkage/state'):
         stamps = [_stamp_ns(message) for message in listener.received[topic]]
         assert all(later > earlier for earlier, later in zip(stamps, stamps[1:])), topic
 
@@ -162,28 +162,28 @@ def test_stop_run_publishes_the_library_state_and_ends_exactly_at_alpha_end(list
     rate_hz = 400.0
     drive = DriveLaw(1.0)
     status = _listen_to_run(
-        listener, {**QUIET, "omega0": drive.omega0, "rate_hz": rate_hz}, tmp_path / "node.log")
+        listener, {**QUIET, 'omega0': drive.omega0, 'rate_hz': rate_hz}, tmp_path / 'node.log')
 
-    assert status == 0, (tmp_path / "node.log").read_text()
+    assert status == 0, (tmp_path / 'node.log').read_text()
     _assert_matches_library(listener, drive)
-    first = listener.received["/linkage/state"][0].points[0]
+    first = listener.received['/linkage/state'][0].points[0]
     assert (first.positions[0], _seconds(first.time_from_start)) == (0.0, 0.0)
-    assert listener.received["/joint_states"][0].position[0] == 0.0
-    final = listener.received["/joint_states"][-1]
+    assert listener.received['/joint_states'][0].position[0] == 0.0
+    final = listener.received['/joint_states'][-1]
     assert final.position[0] == math.pi / 2.0
-    assert listener.received["/linkage/state"][-1].points[0].positions[0] == math.pi / 2.0
+    assert listener.received['/linkage/state'][-1].points[0].positions[0] == math.pi / 2.0
     # A loose count over the run (a few ticks lost to discovery are fine).
-    stamps = [_stamp_ns(message) for message in listener.received["/joint_states"]]
+    stamps = [_stamp_ns(message) for message in listener.received['/joint_states']]
     window = (stamps[-1] - stamps[0]) * 1e-9
     assert window > 0.5
     assert 0.25 * rate_hz < (len(stamps) - 1) / window < 1.1 * rate_hz
 
-    markers = listener.received["/linkage/markers"][-1].markers
-    assert [(m.ns, m.id) for m in markers] == [("linkage", i) for i in range(6)]
+    markers = listener.received['/linkage/markers'][-1].markers
+    assert [(m.ns, m.id) for m in markers] == [('linkage', i) for i in range(6)]
     assert [m.type for m in markers] == [
         Marker.CYLINDER, Marker.LINE_LIST, Marker.SPHERE, Marker.SPHERE, Marker.CUBE,
         Marker.CUBE]
-    assert {m.header.frame_id for m in markers} == {"linkage_base"}
+    assert {m.header.frame_id for m in markers} == {'linkage_base'}
     end_state = solve(PAPER, math.pi / 2.0, drive)
     pin_a = markers[messages.PIN_A_ID].pose.position
     pin_b = markers[messages.PIN_B_ID].pose.position
@@ -192,18 +192,18 @@ def test_stop_run_publishes_the_library_state_and_ends_exactly_at_alpha_end(list
     pivot_c = markers[messages.PIVOT_C_ID].pose.position
     assert (pivot_c.x, pivot_c.y) == (PAPER.ground_x, PAPER.ground_y)
 
-    status_message = listener.received["/diagnostics"][-1].status[0]
-    assert status_message.name == "linkage_node: crank motion"
+    status_message = listener.received['/diagnostics'][-1].status[0]
+    assert status_message.name == 'linkage_node: crank motion'
     assert status_message.level == DiagnosticStatus.OK
-    assert "reached alpha_end" in status_message.message
+    assert 'reached alpha_end' in status_message.message
     values = _values(status_message)
-    assert float(values["alpha (rad)"]) == math.pi / 2.0
-    assert float(values["alpha (deg)"]) == pytest.approx(90.0)
-    assert float(values["loop closure residual"]) < 1e-12
-    assert float(values["achieved rate (Hz)"]) > 0.0
-    assert int(values["missed deadlines"]) >= 0
-    assert values["log file"] == "disabled"
-    for key in ("dead point distance (deg)", "transmission angle (deg)"):
+    assert float(values['alpha (rad)']) == math.pi / 2.0
+    assert float(values['alpha (deg)']) == pytest.approx(90.0)
+    assert float(values['loop closure residual']) < 1e-12
+    assert float(values['achieved rate (Hz)']) > 0.0
+    assert int(values['missed deadlines']) >= 0
+    assert values['log file'] == 'disabled'
+    for key in ('dead point distance (deg)', 'transmission angle (deg)'):
         assert key in values
 
 
@@ -212,13 +212,13 @@ def test_fixed_step_publishes_exact_steps_and_drive_law_times(listener, tmp_path
     step = math.radians(0.5)
     status = _listen_to_run(
         listener,
-        {**QUIET, "mode": "fixed_step", "omega0": drive.omega0, "k": drive.k, "rate_hz": 200.0},
-        tmp_path / "node.log",
+        {**QUIET, 'mode': 'fixed_step', 'omega0': drive.omega0, 'k': drive.k, 'rate_hz': 200.0},
+        tmp_path / 'node.log',
     )
 
-    assert status == 0, (tmp_path / "node.log").read_text()
+    assert status == 0, (tmp_path / 'node.log').read_text()
     _assert_matches_library(listener, drive)
-    alphas = [message.position[0] for message in listener.received["/joint_states"]]
+    alphas = [message.position[0] for message in listener.received['/joint_states']]
     assert alphas[-1] == math.pi / 2.0
     for alpha in alphas[:-1]:
         assert alpha == round(alpha / step) * step
@@ -226,9 +226,9 @@ def test_fixed_step_publishes_exact_steps_and_drive_law_times(listener, tmp_path
 
 
 @pytest.mark.parametrize(
-    ("alpha_end", "expected_status", "expected_level"),
+    ('alpha_end', 'expected_status', 'expected_level'),
     [(math.radians(-1.5), 0, DiagnosticStatus.WARN), (DEAD_POINT, 1, DiagnosticStatus.ERROR)],
-    ids=["near-dead-point", "at-dead-point"],
+    ids=['near-dead-point', 'at-dead-point'],
 )
 def test_diagnostics_near_and_at_a_dead_point(
     listener, tmp_path, alpha_end, expected_status, expected_level
@@ -237,66 +237,66 @@ def test_diagnostics_near_and_at_a_dead_point(
     drive = DriveLaw(-0.02)
     status = _listen_to_run(
         listener,
-        {**QUIET, "omega0": drive.omega0, "alpha_end": alpha_end, "rate_hz": 500.0},
-        tmp_path / "node.log",
+        {**QUIET, 'omega0': drive.omega0, 'alpha_end': alpha_end, 'rate_hz': 500.0},
+        tmp_path / 'node.log',
     )
 
-    output = (tmp_path / "node.log").read_text()
+    output = (tmp_path / 'node.log').read_text()
     assert status == expected_status, output
     _assert_matches_library(listener, drive)
-    final = listener.received["/diagnostics"][-1].status[0]
+    final = listener.received['/diagnostics'][-1].status[0]
     assert final.level == expected_level
-    assert "dead point" in final.message
-    alphas = [message.position[0] for message in listener.received["/joint_states"]]
+    assert 'dead point' in final.message
+    alphas = [message.position[0] for message in listener.received['/joint_states']]
     assert all(math.isfinite(alpha) and alpha > DEAD_POINT for alpha in alphas)
     if expected_level == DiagnosticStatus.ERROR:
         assert alphas[-1] - DEAD_POINT < 1e-3
-        assert "cannot go on" in output
+        assert 'cannot go on' in output
     else:
         assert alphas[-1] == alpha_end
 
 
 @pytest.mark.parametrize(
-    "signal_number", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+    'signal_number', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 def test_signal_ends_a_logging_run_cleanly(listener, tmp_path, signal_number):
-    bags = tmp_path / "bags"
+    bags = tmp_path / 'bags'
     process = start_node(
-        {"end_behavior": "loop", "rate_hz": 200.0, "log.folder": str(bags)},
+        {'end_behavior': 'loop', 'rate_hz': 200.0, 'log.folder': str(bags)},
         DOMAIN_ID,
-        tmp_path / "node.log",
+        tmp_path / 'node.log',
     )
     try:
         # Every topic is in the bag once the listener has heard it (markers come at the display
         # rate, diagnostics once a second).
-        assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+        assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
         # A subscriber that joins late still gets the description (transient local).
-        listener.subscribe("/robot_description", String, transient_local=True)
-        assert listener.spin_until(lambda: listener.received["/robot_description"])
-        assert listener.received["/robot_description"][0].data == urdf_text(PAPER)
+        listener.subscribe('/robot_description', String, transient_local=True)
+        assert listener.spin_until(lambda: listener.received['/robot_description'])
+        assert listener.received['/robot_description'][0].data == urdf_text(PAPER)
         process.send_signal(signal_number)
         status = process.wait(timeout=PROCESS_TIMEOUT)
     finally:
         stop_process(process)
 
-    assert status == 0, (tmp_path / "node.log").read_text()
-    assert listener.received["/diagnostics"][-1].status[0].level == DiagnosticStatus.OK
+    assert status == 0, (tmp_path / 'node.log').read_text()
+    assert listener.received['/diagnostics'][-1].status[0].level == DiagnosticStatus.OK
     (bag,) = bags.iterdir()
-    metadata = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
-    with open(bag / metadata["relative_file_paths"][0], "rb") as stream:
+    metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    with open(bag / metadata['relative_file_paths'][0], 'rb') as stream:
         reader = make_reader(stream, decoder_factories=[DecoderFactory()])
-        assert reader.get_summary() is not None, "the bag was not finalized"
+        assert reader.get_summary() is not None, 'the bag was not finalized'
         recorded = {}
         for _, channel, _, message in reader.iter_decoded_messages():
             recorded.setdefault(channel.topic, []).append(message)
         run_metadata = {record.name: record.metadata for record in reader.iter_metadata()}
-    assert set(recorded) == {*DATA_TOPICS, "/robot_description"}
-    assert recorded["/robot_description"][0].data == urdf_text(PAPER)
-    assert sum(map(len, recorded.values())) == metadata["message_count"]
+    assert set(recorded) == {*DATA_TOPICS, '/robot_description'}
+    assert recorded['/robot_description'][0].data == urdf_text(PAPER)
+    assert sum(map(len, recorded.values())) == metadata['message_count']
     parameters = next(
-        value["parameters"] for value in run_metadata.values() if "parameters" in value)
+        value['parameters'] for value in run_metadata.values() if 'parameters' in value)
     assert '"end_behavior": "loop"' in parameters
-    diagnostics = _values(recorded["/diagnostics"][-1].status[0])
-    assert diagnostics["log file"] == str(bag)
+    diagnostics = _values(recorded['/diagnostics'][-1].status[0])
+    assert diagnostics['log file'] == str(bag)
 
 
 def _limit_file_size() -> None:
@@ -307,43 +307,43 @@ def _limit_file_size() -> None:
 
 
 def test_failed_recording_turns_diagnostics_to_error_and_publishing_goes_on(listener, tmp_path):
-    bags = tmp_path / "bags"
+    bags = tmp_path / 'bags'
     process = start_node(
-        {"end_behavior": "loop", "rate_hz": 1000.0, "log.folder": str(bags)},
-        DOMAIN_ID, tmp_path / "node.log", preexec_fn=_limit_file_size,
+        {'end_behavior': 'loop', 'rate_hz': 1000.0, 'log.folder': str(bags)},
+        DOMAIN_ID, tmp_path / 'node.log', preexec_fn=_limit_file_size,
     )
-    diagnostics = listener.received["/diagnostics"]
+    diagnostics = listener.received['/diagnostics']
     try:
         assert listener.spin_until(
             lambda: diagnostics and diagnostics[-1].status[0].level == DiagnosticStatus.ERROR)
-        assert "recording stopped" in diagnostics[-1].status[0].message
-        count = len(listener.received["/joint_states"])
-        assert listener.spin_until(lambda: len(listener.received["/joint_states"]) > count + 50)
+        assert 'recording stopped' in diagnostics[-1].status[0].message
+        count = len(listener.received['/joint_states'])
+        assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 50)
         process.send_signal(signal.SIGINT)
         status = process.wait(timeout=PROCESS_TIMEOUT)
     finally:
         stop_process(process)
 
-    assert status == 0, (tmp_path / "node.log").read_text()
+    assert status == 0, (tmp_path / 'node.log').read_text()
     (bag,) = bags.iterdir()
-    metadata = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
-    mcap_file = bag / metadata["relative_file_paths"][0]
+    metadata = yaml.safe_load((bag / 'metadata.yaml').read_text())['rosbag2_bagfile_information']
+    mcap_file = bag / metadata['relative_file_paths'][0]
     assert mcap_file.stat().st_size <= 100_000
-    assert mcap_file.read_bytes()[:8] == b"\x89MCAP0\r\n"
+    assert mcap_file.read_bytes()[:8] == b'\x89MCAP0\r\n'
 
 
 # --- pure motion functions --------------------------------------------------------------------
 
 
 def _configuration(**overrides):
-    return build_configuration(configuration_values(**{"log.enabled": False, **overrides}))
+    return build_configuration(configuration_values(**{'log.enabled': False, **overrides}))
 
 
 def test_loop_over_whole_turns_keeps_counting_alpha():
-    crank_rocker = preset("grashof_crank_rocker").geometry
+    crank_rocker = preset('grashof_crank_rocker').geometry
     config = _configuration(
-        preset="grashof_crank_rocker", rocker_length=crank_rocker.rocker_length,
-        ground_x=crank_rocker.ground_x, alpha_end=2.0 * TWO_PI, end_behavior="loop", k=0.1)
+        preset='grashof_crank_rocker', rocker_length=crank_rocker.rocker_length,
+        ground_x=crank_rocker.ground_x, alpha_end=2.0 * TWO_PI, end_behavior='loop', k=0.1)
     assert config.whole_turns
     duration = config.segment_duration
     sample = sample_at_time(config, 2.25 * duration)
@@ -359,7 +359,7 @@ def test_loop_over_whole_turns_keeps_counting_alpha():
 
 
 def test_loop_over_part_of_a_turn_restarts_at_alpha_start():
-    config = _configuration(end_behavior="loop")
+    config = _configuration(end_behavior='loop')
     assert not config.whole_turns
     sample = sample_at_time(config, config.segment_duration * 1.5)
     assert sample.alpha == pytest.approx(math.pi / 4.0, abs=1e-15)
@@ -368,7 +368,7 @@ def test_loop_over_part_of_a_turn_restarts_at_alpha_start():
 
 
 def test_bounce_plays_the_pass_backwards_with_negated_rates():
-    config = _configuration(end_behavior="bounce", k=0.3)
+    config = _configuration(end_behavior='bounce', k=0.3)
     duration = config.segment_duration
     forward = sample_at_time(config, 0.25 * duration)
     backward = sample_at_time(config, 1.75 * duration)
@@ -411,22 +411,22 @@ def test_stop_ends_exactly_at_alpha_end_or_not_at_all_at_a_dead_point():
 def _planar_chain(urdf: str, positions: dict[str, float]) -> dict[str, tuple[float, float, float]]:
     """Each link's frame (x, y, heading) from the URDF's joints: origin then rotation about z."""
     root = ElementTree.fromstring(urdf)
-    frames = {root.find("link").get("name"): (0.0, 0.0, 0.0)}
-    joints = root.findall("joint")
+    frames = {root.find('link').get('name'): (0.0, 0.0, 0.0)}
+    joints = root.findall('joint')
     while len(frames) < len(joints) + 1:
         for joint in joints:
-            parent = joint.find("parent").get("link")
-            child = joint.find("child").get("link")
+            parent = joint.find('parent').get('link')
+            child = joint.find('child').get('link')
             if parent not in frames or child in frames:
                 continue
-            assert joint.find("axis").get("xyz") == "0 0 1"
-            assert joint.find("origin").get("rpy") == "0 0 0"
-            x, y, _ = (float(v) for v in joint.find("origin").get("xyz").split())
+            assert joint.find('axis').get('xyz') == '0 0 1'
+            assert joint.find('origin').get('rpy') == '0 0 0'
+            x, y, _ = (float(v) for v in joint.find('origin').get('xyz').split())
             px, py, heading = frames[parent]
             frames[child] = (
                 px + x * math.cos(heading) - y * math.sin(heading),
                 py + x * math.sin(heading) + y * math.cos(heading),
-                heading + positions[joint.get("name")],
+                heading + positions[joint.get('name')],
             )
     return frames
 
@@ -436,19 +436,19 @@ def _point_in(frame: tuple[float, float, float], x: float) -> tuple[float, float
     return fx + x * math.cos(heading), fy + x * math.sin(heading)
 
 
-@pytest.mark.parametrize("alpha", [-0.03, 0.0, 0.7, math.pi / 2.0, 2.5, 3.17])
+@pytest.mark.parametrize('alpha', [-0.03, 0.0, 0.7, math.pi / 2.0, 2.5, 3.17])
 def test_urdf_forward_kinematics_lands_on_the_library_pins(alpha):
     state = solve(PAPER, alpha, DriveLaw(2.0))
     positions = dict(zip(messages.JOINT_NAMES, messages.joint_positions(state)))
     urdf = urdf_text(PAPER)
     frames = _planar_chain(urdf, positions)
-    assert set(frames) == {"linkage_base", "disk", "coupler", "rocker"}
-    assert frames["coupler"][:2] == pytest.approx((state.pin_a_x, state.pin_a_y), abs=1e-12)
-    assert frames["rocker"][:2] == pytest.approx((state.pin_b_x, state.pin_b_y), abs=1e-12)
-    rocker_end = _point_in(frames["rocker"], PAPER.rocker_length)
+    assert set(frames) == {'linkage_base', 'disk', 'coupler', 'rocker'}
+    assert frames['coupler'][:2] == pytest.approx((state.pin_a_x, state.pin_a_y), abs=1e-12)
+    assert frames['rocker'][:2] == pytest.approx((state.pin_b_x, state.pin_b_y), abs=1e-12)
+    rocker_end = _point_in(frames['rocker'], PAPER.rocker_length)
     assert rocker_end == pytest.approx((PAPER.ground_x, PAPER.ground_y), abs=1e-12)
     # The disk frame carries A at (0, −OA).
-    disk_x, disk_y, heading = frames["disk"]
+    disk_x, disk_y, heading = frames['disk']
     assert heading == alpha
     assert (disk_x + PAPER.crank_length * math.sin(heading),
             disk_y - PAPER.crank_length * math.cos(heading)) == pytest.approx(
@@ -456,13 +456,13 @@ def test_urdf_forward_kinematics_lands_on_the_library_pins(alpha):
 
 
 def test_installed_urdf_is_the_generated_paper_urdf():
-    assert (REPOSITORY / "urdf" / "linkage.urdf").read_text() == urdf_text(PAPER)
+    assert (REPOSITORY / 'urdf' / 'linkage.urdf').read_text() == urdf_text(PAPER)
 
 
 def test_launch_configs_hold_the_seed_scenarios():
-    for name, omega0, k in (("constant", 2.0, 0.0), ("variable", 0.10, 2.3)):
-        text = (REPOSITORY / "config" / f"seed_{name}.yaml").read_text()
-        parameters = yaml.safe_load(text)["/**/linkage_node"]["ros__parameters"]
+    for name, omega0, k in (('constant', 2.0, 0.0), ('variable', 0.10, 2.3)):
+        text = (REPOSITORY / 'config' / f'seed_{name}.yaml').read_text()
+        parameters = yaml.safe_load(text)['/**/linkage_node']['ros__parameters']
         config = _configuration(**parameters)
         assert (config.drive, config.alpha_start, config.alpha_end, config.end_behavior) == (
-            DriveLaw(omega0, k), 0.0, math.pi / 2.0, "stop")
+            DriveLaw(omega0, k), 0.0, math.pi / 2.0, 'stop')

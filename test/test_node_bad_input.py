@@ -48,61 +48,61 @@ from node_process import (
 )
 
 DOMAIN_ID = 70
-PAPER = preset("paper").geometry
+PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.941°, clockwise from 0
-DEFAULTS = {spec.name: spec.default for spec in parameter_specs("paper")}
+DEFAULTS = {spec.name: spec.default for spec in parameter_specs('paper')}
 
 # --- the expectation table ----------------------------------------------------------------------
 
-BAD_CLASSES = ("wrong type", "bool", "nan", "+inf", "-inf", "zero", "negative", "huge", "-huge")
+BAD_CLASSES = ('wrong type', 'bool', 'nan', '+inf', '-inf', 'zero', 'negative', 'huge', '-huge')
 # A value of the wrong type, by the type of the parameter's default.
-WRONG_TYPE = {float: "fast", int: "fast", str: 1.5, bool: "true"}
+WRONG_TYPE = {float: 'fast', int: 'fast', str: 1.5, bool: 'true'}
 # Where -1 is not the telling negative value: one that is valid for the parameter.
-NEGATIVE = {"alpha_start": -0.01, "alpha_end": -0.01, "omega0": -1.0, "ground_y": -0.1}
+NEGATIVE = {'alpha_start': -0.01, 'alpha_end': -0.01, 'omega0': -1.0, 'ground_y': -0.1}
 # Other values under which a parameter's case is judged (a clockwise drive needs a lower end).
-CONTEXT = {"omega0": {"alpha_end": -0.01}, "alpha_end": {"omega0": -1.0}}
+CONTEXT = {'omega0': {'alpha_end': -0.01}, 'alpha_end': {'omega0': -1.0}}
 
 # The classes whose value is valid for the parameter; every other class is refused with a
 # ConfigurationError that names the parameter. With the paper's mechanism from α = 0 to 90°:
 ACCEPTED = {
-    "preset": set(),
-    "crank_length": set(),                   # lengths: finite, > 0 and at most 1e6 m
-    "coupler_length": set(),
-    "rocker_length": set(),
-    "ground_x": {"negative"},                # C left of O; 0 puts C on O, where this cannot close
-    "ground_y": {"zero", "negative"},        # |ground_*| at most 1e6 m
-    "branch": {"negative"},                  # −1 is the other assembly; only ±1 exist
-    "omega0": {"negative"},                  # clockwise; 0 leaves the crank at rest
-    "k": {"zero", "negative"},               # constant law; ω = 2 − α still reaches 90°
-    "alpha_start": {"zero", "negative"},     # −0.01 rad is reachable (the dead point is at −0.034)
-    "alpha_end": {"negative"},               # driven clockwise; 0 would be an empty pass
-    "end_behavior": set(),
-    "mode": set(),
-    "alpha_step": set(),                     # in (0, 2π]
-    "rate_hz": set(),                        # in (0, 10000]
-    "display_rate_hz": set(),                # in (0, 1000]
-    "frame_id": set(),
-    "frame_prefix": set(),                   # any string, "" for none
-    "diagnostics.min_transmission_angle": {"zero"},  # 0 turns the warning off
-    "diagnostics.dead_point_warning": {"zero"},
-    "log.enabled": set(),
-    "log.folder": set(),
-    "cpu_affinity": {"zero", "negative"},    # CPU 0; −1 is no pinning; at most 1023
+    'preset': set(),
+    'crank_length': set(),                   # lengths: finite, > 0 and at most 1e6 m
+    'coupler_length': set(),
+    'rocker_length': set(),
+    'ground_x': {'negative'},                # C left of O; 0 puts C on O, where this cannot close
+    'ground_y': {'zero', 'negative'},        # |ground_*| at most 1e6 m
+    'branch': {'negative'},                  # −1 is the other assembly; only ±1 exist
+    'omega0': {'negative'},                  # clockwise; 0 leaves the crank at rest
+    'k': {'zero', 'negative'},               # constant law; ω = 2 − α still reaches 90°
+    'alpha_start': {'zero', 'negative'},     # −0.01 rad is reachable (the dead point is at −0.034)
+    'alpha_end': {'negative'},               # driven clockwise; 0 would be an empty pass
+    'end_behavior': set(),
+    'mode': set(),
+    'alpha_step': set(),                     # in (0, 2π]
+    'rate_hz': set(),                        # in (0, 10000]
+    'display_rate_hz': set(),                # in (0, 1000]
+    'frame_id': set(),
+    'frame_prefix': set(),                   # any string, "" for none
+    'diagnostics.min_transmission_angle': {'zero'},  # 0 turns the warning off
+    'diagnostics.dead_point_warning': {'zero'},
+    'log.enabled': set(),
+    'log.folder': set(),
+    'cpu_affinity': {'zero', 'negative'},    # CPU 0; −1 is no pinning; at most 1023
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
-ACCEPTED_IN_CONTEXT = [{"ground_x": 0.0, "ground_y": -1.3}, {"ground_x": 0, "ground_y": -1.3}]
+ACCEPTED_IN_CONTEXT = [{'ground_x': 0.0, 'ground_y': -1.3}, {'ground_x': 0, 'ground_y': -1.3}]
 # Where an accepted value shows in the configuration.
 CONFIGURED = {
-    "ground_x": lambda config: config.linkage.ground_x,
-    "ground_y": lambda config: config.linkage.ground_y,
-    "branch": lambda config: config.branch,
-    "omega0": lambda config: config.drive.omega0,
-    "k": lambda config: config.drive.k,
-    "alpha_start": lambda config: config.alpha_start,
-    "alpha_end": lambda config: config.alpha_end,
-    "diagnostics.min_transmission_angle": lambda config: config.min_transmission_angle,
-    "diagnostics.dead_point_warning": lambda config: config.dead_point_warning,
-    "cpu_affinity": lambda config: config.cpu_affinity,
+    'ground_x': lambda config: config.linkage.ground_x,
+    'ground_y': lambda config: config.linkage.ground_y,
+    'branch': lambda config: config.branch,
+    'omega0': lambda config: config.drive.omega0,
+    'k': lambda config: config.drive.k,
+    'alpha_start': lambda config: config.alpha_start,
+    'alpha_end': lambda config: config.alpha_end,
+    'diagnostics.min_transmission_angle': lambda config: config.min_transmission_angle,
+    'diagnostics.dead_point_warning': lambda config: config.dead_point_warning,
+    'cpu_affinity': lambda config: config.cpu_affinity,
 }
 
 
@@ -110,21 +110,21 @@ def bad_value(name: str, bad_class: str):
     """The value of ``bad_class`` for parameter ``name`` (typed like the parameter)."""
     integer = isinstance(DEFAULTS[name], int) and not isinstance(DEFAULTS[name], bool)
     return {
-        "wrong type": WRONG_TYPE[type(DEFAULTS[name])],
-        "bool": True,
-        "nan": math.nan,
-        "+inf": math.inf,
-        "-inf": -math.inf,
-        "zero": 0 if integer else 0.0,
-        "negative": -1 if integer else NEGATIVE.get(name, -1.0),
-        "huge": 2**62 if integer else 1e308,
-        "-huge": -(2**62) if integer else -1e308,
+        'wrong type': WRONG_TYPE[type(DEFAULTS[name])],
+        'bool': True,
+        'nan': math.nan,
+        '+inf': math.inf,
+        '-inf': -math.inf,
+        'zero': 0 if integer else 0.0,
+        'negative': -1 if integer else NEGATIVE.get(name, -1.0),
+        'huge': 2**62 if integer else 1e308,
+        '-huge': -(2**62) if integer else -1e308,
     }[bad_class]
 
 
 def applies(name: str, bad_class: str) -> bool:
     # True is the right type for log.enabled, whose wrong type is the string "true".
-    return not (bad_class == "bool" and isinstance(DEFAULTS[name], bool))
+    return not (bad_class == 'bool' and isinstance(DEFAULTS[name], bool))
 
 
 def refused_classes(name: str) -> list[str]:
@@ -139,7 +139,7 @@ def test_the_table_covers_every_parameter():
     assert set(CONFIGURED) == {name for name, classes in ACCEPTED.items() if classes}
 
 
-@pytest.mark.parametrize(("name", "bad_class"), MATRIX, ids=[f"{n}-{c}" for n, c in MATRIX])
+@pytest.mark.parametrize(('name', 'bad_class'), MATRIX, ids=[f'{n}-{c}' for n, c in MATRIX])
 def test_build_configuration_refuses_each_bad_value_naming_its_parameter(name, bad_class):
     value = bad_value(name, bad_class)
     values = configuration_values(**{**CONTEXT.get(name, {}), name: value})
@@ -150,12 +150,12 @@ def test_build_configuration_refuses_each_bad_value_naming_its_parameter(name, b
     with pytest.raises(ConfigurationError) as raised:
         build_configuration(values)
     error = raised.value
-    assert name in error.parameter.split(", "), str(error)
-    assert str(error) == f"{error.parameter}: {error.reason}"
-    assert "\n" not in str(error) and "nan°" not in str(error)
+    assert name in error.parameter.split(', '), str(error)
+    assert str(error) == f'{error.parameter}: {error.reason}'
+    assert '\n' not in str(error) and 'nan°' not in str(error)
 
 
-@pytest.mark.parametrize("overrides", ACCEPTED_IN_CONTEXT)
+@pytest.mark.parametrize('overrides', ACCEPTED_IN_CONTEXT)
 def test_values_valid_in_their_context_are_accepted(overrides):
     config = build_configuration(configuration_values(**overrides))
     assert (config.linkage.ground_x, config.linkage.ground_y) == (0.0, -1.3)
@@ -164,15 +164,15 @@ def test_values_valid_in_their_context_are_accepted(overrides):
 # --- start-up: one node process per class of bad value -----------------------------------------
 
 START_UP_CASES = {
-    "wrong type": ("frame_id", 1.5),
-    "bool": ("display_rate_hz", True),
-    "nan": ("diagnostics.dead_point_warning", math.nan),
-    "+inf": ("ground_y", math.inf),
-    "-inf": ("alpha_start", -math.inf),
-    "zero": ("rocker_length", 0.0),
-    "negative": ("rate_hz", -5.0),
-    "huge": ("crank_length", 1e308),
-    "huge drive": ("omega0", 1e308),
+    'wrong type': ('frame_id', 1.5),
+    'bool': ('display_rate_hz', True),
+    'nan': ('diagnostics.dead_point_warning', math.nan),
+    '+inf': ('ground_y', math.inf),
+    '-inf': ('alpha_start', -math.inf),
+    'zero': ('rocker_length', 0.0),
+    'negative': ('rate_hz', -5.0),
+    'huge': ('crank_length', 1e308),
+    'huge drive': ('omega0', 1e308),
 }
 
 
@@ -180,10 +180,10 @@ def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
     # All at once: each process ends during start-up, so they cannot disturb each other.
     runs = {}
     for case, (name, value) in START_UP_CASES.items():
-        folder = tmp_path / case.replace(" ", "_")
+        folder = tmp_path / case.replace(' ', '_')
         folder.mkdir()
-        runs[case] = (start_node({name: value, "log.folder": str(folder / "bags")}, DOMAIN_ID,
-                                 folder / "node.log"), folder)
+        runs[case] = (start_node({name: value, 'log.folder': str(folder / 'bags')}, DOMAIN_ID,
+                                 folder / 'node.log'), folder)
     try:
         statuses = {case: process.wait(timeout=PROCESS_TIMEOUT)
                     for case, (process, _) in runs.items()}
@@ -192,39 +192,39 @@ def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
             stop_process(process)
     for case, (name, _) in START_UP_CASES.items():
         folder = runs[case][1]
-        output = (folder / "node.log").read_text()
+        output = (folder / 'node.log').read_text()
         assert statuses[case] == 2, output
-        assert "Traceback" not in output
-        plain = [line for line in output.splitlines() if line.startswith("linkage_node: invalid")]
+        assert 'Traceback' not in output
+        plain = [line for line in output.splitlines() if line.startswith('linkage_node: invalid')]
         assert plain == [plain[0]] and plain[0].startswith(
-            f"linkage_node: invalid parameter {name}: "), output
-        assert any("[FATAL]" in line and name in line for line in output.splitlines()), output
-        assert not (folder / "bags").exists()
+            f'linkage_node: invalid parameter {name}: '), output
+        assert any('[FATAL]' in line and name in line for line in output.splitlines()), output
+        assert not (folder / 'bags').exists()
 
 
 # --- run time: every bad value through the parameter service, logging on -----------------------
 
 
 def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_path):
-    bags = tmp_path / "bags"
+    bags = tmp_path / 'bags'
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("bad_input_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        states = listener.received["/linkage/state"]
-        process = start_node({"end_behavior": "loop", "log.folder": str(bags)}, DOMAIN_ID,
-                             tmp_path / "node.log")
+        listener = Listener('bad_input_tester', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        states = listener.received['/linkage/state']
+        process = start_node({'end_behavior': 'loop', 'log.folder': str(bags)}, DOMAIN_ID,
+                             tmp_path / 'node.log')
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
             assert listener.spin_until(lambda: len(states) > 5)
             # The last good configuration differs from the start-up one.
             (result,) = listener.result_of(
-                client.set_parameters([Parameter("omega0", value=3.0)])).results
+                client.set_parameters([Parameter('omega0', value=3.0)])).results
             assert result.successful
             good = {name: parameter_value_to_python(value) for name, value in zip(
                 PARAMETER_NAMES, listener.result_of(client.get_parameters(PARAMETER_NAMES)).values)}
-            assert good == {**DEFAULTS, "omega0": 3.0, "log.folder": str(bags),
-                            "end_behavior": "loop"}
+            assert good == {**DEFAULTS, 'omega0': 3.0, 'log.folder': str(bags),
+                            'end_behavior': 'loop'}
             assert listener.spin_until(lambda: states[-1].points[0].velocities[0] == 3.0)
             before_rejections = stamp_ns(states[-1])
 
@@ -250,7 +250,7 @@ def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_p
             stop_process(process)
             listener.destroy()
 
-    assert status == 0, (tmp_path / "node.log").read_text()
+    assert status == 0, (tmp_path / 'node.log').read_text()
     faster = DriveLaw(3.0)
     for message in states[after_rejections:]:
         point = message.points[0]
@@ -273,7 +273,7 @@ def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_p
         assert rows.size > 5
         for row in rows:
             expected = solve(PAPER, float(logged.alpha[row]), DriveLaw(omega0))
-            for field in ("beta", "gamma", "omega_ab", "omega_bc", "pin_b_x", "acceleration_b_y"):
+            for field in ('beta', 'gamma', 'omega_ab', 'omega_bc', 'pin_b_x', 'acceleration_b_y'):
                 assert getattr(logged, field)[row] == getattr(expected, field), (row, field)
     assert np.all(np.isin(logged.omega, (2.0, 3.0)))
 
@@ -296,7 +296,7 @@ def _finite(message) -> bool:
 
 def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
     bounce = build_configuration(configuration_values(
-        omega0=-1.0, alpha_end=-0.1, end_behavior="bounce", **{"log.enabled": False}))
+        omega0=-1.0, alpha_end=-0.1, end_behavior='bounce', **{'log.enabled': False}))
     assert bounce.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
     duration = bounce.segment_duration
     samples = [sample_at_time(bounce, fraction * duration) for fraction in (0.5, 1.5, 2.5, 3.5)]
@@ -308,14 +308,14 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
     # Bounce meets the dead point at the end of each forward pass only; loop at every pass end.
     assert met_dead_point(bounce, 0, 1) and met_dead_point(bounce, 1, 3)
     assert not met_dead_point(bounce, 1, 2) and not met_dead_point(bounce, 2, 2)
-    loop = replace(bounce, end_behavior="loop")
+    loop = replace(bounce, end_behavior='loop')
     assert sample_at_time(loop, 2.5 * duration).pass_index == 2
     assert met_dead_point(loop, 1, 2)
-    clear = build_configuration(configuration_values(end_behavior="loop"))
+    clear = build_configuration(configuration_values(end_behavior='loop'))
     assert not met_dead_point(clear, 0, 1)
     assert dead_point_problem(bounce) == (
-        f"the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}° before "
-        f"alpha_end = {math.degrees(-0.1):.6f}°: it reverses")
+        f'the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}° before '
+        f'alpha_end = {math.degrees(-0.1):.6f}°: it reverses')
 
 
 def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(tmp_path):
@@ -325,34 +325,34 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
     warning = math.radians(3.0)  # the whole pass lies within 3° of the dead point
     drive = DriveLaw(-0.05)  # 0.68 s from 0 to the dead point
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("dead_point_tester", context)
-        for topic, msg_type in (("/diagnostics", DiagnosticArray),
-                                ("/linkage/state", JointTrajectory),
-                                ("/joint_states", JointState)):
+        listener = Listener('dead_point_tester', context)
+        for topic, msg_type in (('/diagnostics', DiagnosticArray),
+                                ('/linkage/state', JointTrajectory),
+                                ('/joint_states', JointState)):
             listener.subscribe(topic, msg_type)
-        diagnostics = listener.received["/diagnostics"]
+        diagnostics = listener.received['/diagnostics']
         process = start_node(
-            {"end_behavior": "loop", "omega0": drive.omega0, "alpha_end": -0.1,
-             "rate_hz": 200.0, "diagnostics.dead_point_warning": warning,
-             "log.folder": str(tmp_path / "bags")},
-            DOMAIN_ID, tmp_path / "node.log")
+            {'end_behavior': 'loop', 'omega0': drive.omega0, 'alpha_end': -0.1,
+             'rate_hz': 200.0, 'diagnostics.dead_point_warning': warning,
+             'log.folder': str(tmp_path / 'bags')},
+            DOMAIN_ID, tmp_path / 'node.log')
 
         def errors(behavior: str) -> list[DiagnosticArray]:
             return [array for array in diagnostics
                     if array.status[0].level == DiagnosticStatus.ERROR
-                    and _values(array.status[0])["end behavior"] == behavior]
+                    and _values(array.status[0])['end behavior'] == behavior]
 
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            assert listener.spin_until(lambda: errors("loop"))
+            assert listener.spin_until(lambda: errors('loop'))
             (result,) = listener.result_of(
-                client.set_parameters([Parameter("end_behavior", value="bounce")])).results
+                client.set_parameters([Parameter('end_behavior', value='bounce')])).results
             assert result.successful
             # Two turns at the dead point, so a whole pass back and out lies between them.
-            assert listener.spin_until(lambda: len(errors("bounce")) >= 2)
+            assert listener.spin_until(lambda: len(errors('bounce')) >= 2)
             (result,) = listener.result_of(
-                client.set_parameters([Parameter("end_behavior", value="stop")])).results
+                client.set_parameters([Parameter('end_behavior', value='stop')])).results
             assert result.successful
             assert listener.spin_until(lambda: process.poll() is not None)
             listener.drain()
@@ -361,32 +361,32 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
             stop_process(process)
             listener.destroy()
 
-    output = (tmp_path / "node.log").read_text()
+    output = (tmp_path / 'node.log').read_text()
     assert status == 1, output
-    where = f"the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}°"
-    for behavior, outcome in (("loop", "restarts from alpha_start"), ("bounce", "reverses"),
-                              ("stop", "stops")):
+    where = f'the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}°'
+    for behavior, outcome in (('loop', 'restarts from alpha_start'), ('bounce', 'reverses'),
+                              ('stop', 'stops')):
         assert errors(behavior), behavior
         for error in (array.status[0] for array in errors(behavior)):
             assert error.message.startswith(where), error.message
-            assert f": it {outcome}" in error.message
+            assert f': it {outcome}' in error.message
             # The last state shown is just before the dead point, on the reachable side.
-            alpha = float(_values(error)["alpha (rad)"])
+            alpha = float(_values(error)['alpha (rad)'])
             assert DEAD_POINT < alpha < DEAD_POINT + 0.01
     # Before it, while moving: WARN, saying how close the dead point is and that it lies ahead.
     moving = [array.status[0] for array in diagnostics
               if array.status[0].level != DiagnosticStatus.ERROR
-              and "alpha (rad)" in _values(array.status[0])]
-    assert any(_values(status_message)["end behavior"] == "bounce" for status_message in moving)
+              and 'alpha (rad)' in _values(array.status[0])]
+    assert any(_values(status_message)['end behavior'] == 'bounce' for status_message in moving)
     for status_message in moving:
         assert status_message.level == DiagnosticStatus.WARN
-        distance = math.radians(float(_values(status_message)["dead point distance (deg)"]))
+        distance = math.radians(float(_values(status_message)['dead point distance (deg)']))
         assert distance < warning
-        assert "from a dead point" in status_message.message
-        assert "before alpha_end" in status_message.message
+        assert 'from a dead point' in status_message.message
+        assert 'before alpha_end' in status_message.message
 
-    states = listener.received["/linkage/state"]
-    joint_states = listener.received["/joint_states"]
+    states = listener.received['/linkage/state']
+    joint_states = listener.received['/joint_states']
     assert all(map(_finite, states)) and all(map(_finite, joint_states))
     alphas = [message.points[0].positions[0] for message in states]
     assert all(DEAD_POINT < alpha <= 0.0 for alpha in alphas)
@@ -398,7 +398,7 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
         assert tuple(point.velocities[:3]) == (state.omega, -state.omega_bc, state.omega_ab)
     # Bounce, between two turns at the dead point: back from it to alpha_start (|α| decreasing,
     # ω > 0), then out again.
-    first_turn, second_turn = (stamp_ns(array) for array in errors("bounce")[:2])
+    first_turn, second_turn = (stamp_ns(array) for array in errors('bounce')[:2])
     # The ERROR carries the stamp of the tick that met the dead point, as does that tick's state.
     cycle = [message.points[0] for message in states
              if first_turn < stamp_ns(message) < second_turn]
@@ -413,12 +413,12 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
     assert all(speed < 0.0 for speed in speeds[peak + 1:])
     # Stop: the run ends just before the dead point.
     assert DEAD_POINT < alphas[-1] < DEAD_POINT + 1e-3
-    assert "cannot go on" in output
+    assert 'cannot go on' in output
     # The log holds every status and state heard, in time order.
-    (bag,) = (tmp_path / "bags").iterdir()
+    (bag,) = (tmp_path / 'bags').iterdir()
     logged = list(iter_messages(bag))
     log_times = [message.log_time_ns for message in logged]
     assert all(later >= earlier for earlier, later in zip(log_times, log_times[1:]))
-    for topic in ("/diagnostics", "/linkage/state"):
+    for topic in ('/diagnostics', '/linkage/state'):
         assert sum(message.topic == topic for message in logged) >= len(
             listener.received[topic])

@@ -33,21 +33,21 @@ NOT_AVAILABLE = min(set(range(1024)) - AVAILABLE)
 def thread_cpus(pid: int) -> dict[int, set[int]]:
     """The CPUs each thread of process ``pid`` may run on."""
     return {int(thread): os.sched_getaffinity(int(thread))
-            for thread in os.listdir(f"/proc/{pid}/task")}
+            for thread in os.listdir(f'/proc/{pid}/task')}
 
 
 def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(tmp_path: Path) -> None:
-    output = tmp_path / "node.log"
+    output = tmp_path / 'node.log'
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("cpu_affinity_tester", context)
-        listener.subscribe("/joint_states", JointState)
+        listener = Listener('cpu_affinity_tester', context)
+        listener.subscribe('/joint_states', JointState)
         process = start_node(
-            {"end_behavior": "loop", "rate_hz": 200.0, "cpu_affinity": NODE_CPU,
-             "log.folder": str(tmp_path / "bags")}, DOMAIN_ID, output)
+            {'end_behavior': 'loop', 'rate_hz': 200.0, 'cpu_affinity': NODE_CPU,
+             'log.folder': str(tmp_path / 'bags')}, DOMAIN_ID, output)
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            assert listener.spin_until(lambda: listener.received["/joint_states"])
+            assert listener.spin_until(lambda: listener.received['/joint_states'])
             writer = bag_writer_pid(process.pid)
             node_threads = thread_cpus(process.pid)
             # the main thread, Fast DDS's and the executor's
@@ -55,35 +55,35 @@ def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(tmp_path: Pat
             assert all(cpus == {NODE_CPU} for cpus in node_threads.values()), node_threads
             assert all(cpus == WRITER_CPUS for cpus in thread_cpus(writer).values())
 
-            successful, reason = set_parameter(client, listener, "cpu_affinity", NOT_AVAILABLE)
+            successful, reason = set_parameter(client, listener, 'cpu_affinity', NOT_AVAILABLE)
             assert not successful
-            assert reason == (f"cpu_affinity: CPU {NOT_AVAILABLE} is not one this process may "
+            assert reason == (f'cpu_affinity: CPU {NOT_AVAILABLE} is not one this process may '
                               f"run on (it may run on {', '.join(map(str, sorted(AVAILABLE)))})")
-            assert get_parameter(client, listener, "cpu_affinity") == NODE_CPU
+            assert get_parameter(client, listener, 'cpu_affinity') == NODE_CPU
             assert all(cpus == {NODE_CPU} for cpus in thread_cpus(process.pid).values())
 
             # -1 gives both processes every CPU back, and the motion goes on.
-            assert set_parameter(client, listener, "cpu_affinity", -1) == (True, "")
+            assert set_parameter(client, listener, 'cpu_affinity', -1) == (True, '')
             assert all(cpus == AVAILABLE for cpus in thread_cpus(process.pid).values())
             assert all(cpus == AVAILABLE for cpus in thread_cpus(writer).values())
-            count = len(listener.received["/joint_states"])
-            assert listener.spin_until(lambda: len(listener.received["/joint_states"]) > count + 5)
+            count = len(listener.received['/joint_states'])
+            assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 5)
             assert process.poll() is None
         finally:
             stop_process(process)
             listener.destroy()
     log = output.read_text()
-    assert (f"running on CPU {NODE_CPU}; the bag writer on CPU "
+    assert (f'running on CPU {NODE_CPU}; the bag writer on CPU '
             f"{', '.join(map(str, sorted(WRITER_CPUS)))}") in log
-    assert "no longer pinned to a CPU" in log
+    assert 'no longer pinned to a CPU' in log
 
 
-@pytest.mark.parametrize("value", [NOT_AVAILABLE, -2, 1024, "0"])
+@pytest.mark.parametrize('value', [NOT_AVAILABLE, -2, 1024, '0'])
 def test_a_cpu_the_process_may_not_use_is_a_start_up_error(tmp_path: Path, value) -> None:
-    bags = tmp_path / "bags"
-    status, output = run_node({"cpu_affinity": value, "log.folder": str(bags)}, DOMAIN_ID,
-                              tmp_path / "node.log")
+    bags = tmp_path / 'bags'
+    status, output = run_node({'cpu_affinity': value, 'log.folder': str(bags)}, DOMAIN_ID,
+                              tmp_path / 'node.log')
     assert status == 2, output
-    assert "linkage_node: invalid parameter cpu_affinity: " in output
-    assert "Traceback" not in output
+    assert 'linkage_node: invalid parameter cpu_affinity: ' in output
+    assert 'Traceback' not in output
     assert not bags.exists()

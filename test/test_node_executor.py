@@ -40,25 +40,25 @@ STEP = 10_000_000  # ns of simulated time per /clock step: one period at 100 Hz,
 
 def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_path):
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("executor_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        states = listener.received["/linkage/state"]
-        process = start_node({"end_behavior": "loop", "rate_hz": 100.0, "log.enabled": False},
-                             DOMAIN_ID, tmp_path / "node.log")
+        listener = Listener('executor_tester', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        states = listener.received['/linkage/state']
+        process = start_node({'end_behavior': 'loop', 'rate_hz': 100.0, 'log.enabled': False},
+                             DOMAIN_ID, tmp_path / 'node.log')
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
             listed = listener.result_of(client.list_parameters([], 0)).result.names
             assert set(PARAMETER_NAMES) <= set(listed)
-            specs = {spec.name: spec for spec in parameter_specs("paper")}
-            (descriptor,) = listener.result_of(client.describe_parameters(["rate_hz"])).descriptors
-            assert descriptor.description == specs["rate_hz"].description
+            specs = {spec.name: spec for spec in parameter_specs('paper')}
+            (descriptor,) = listener.result_of(client.describe_parameters(['rate_hz'])).descriptors
+            assert descriptor.description == specs['rate_hz'].description
             (interval,) = descriptor.floating_point_range
-            assert (interval.from_value, interval.to_value) == specs["rate_hz"].floating_range
+            assert (interval.from_value, interval.to_value) == specs['rate_hz'].floating_range
             assert listener.spin_until(lambda: len(states) > 5)
 
             (result,) = listener.result_of(
-                client.set_parameters([Parameter("rate_hz", value=2.0)])).results
+                client.set_parameters([Parameter('rate_hz', value=2.0)])).results
             assert result.successful, result.reason
             # One state of the old timer may still be on its way.
             changed_at = len(states) + 1
@@ -75,27 +75,27 @@ def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_pa
 
 
 def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
-    bags = tmp_path / "bags"
+    bags = tmp_path / 'bags'
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("executor_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        states = listener.received["/linkage/state"]
-        clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
+        listener = Listener('executor_tester', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        states = listener.received['/linkage/state']
+        clock = listener.node.create_publisher(Clock, '/clock', QoSProfile(depth=10))
         process = start_node(
-            {"end_behavior": "loop", "rate_hz": 100.0, "display_rate_hz": 1.0,
-             "use_sim_time": True, "log.folder": str(bags)},
-            DOMAIN_ID, tmp_path / "node.log")
+            {'end_behavior': 'loop', 'rate_hz': 100.0, 'display_rate_hz': 1.0,
+             'use_sim_time': True, 'log.folder': str(bags)},
+            DOMAIN_ID, tmp_path / 'node.log')
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
-            assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
+            assert listener.spin_until(lambda: listener.node.count_subscribers('/clock') > 0)
+            assert listener.spin_until(lambda: listener.node.count_publishers('/linkage/state'))
             before = [CLOCK_START + n * STEP for n in range(6)]
             for clock_ns in before:
                 drive_sim_clock(listener, clock, states, clock_ns)
 
             (result,) = listener.result_of(
-                client.set_parameters([Parameter("rate_hz", value=50.0)])).results
+                client.set_parameters([Parameter('rate_hz', value=50.0)])).results
             assert result.successful, result.reason
             # The change restarts the motion, whose first state is published at once, at the
             # last /clock time; the new timer starts there too: its periods end on every second
@@ -117,10 +117,10 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
             stop_process(process)
             listener.destroy()
 
-    assert status == 0, (tmp_path / "node.log").read_text()
+    assert status == 0, (tmp_path / 'node.log').read_text()
     received = [stamp_ns(message) for message in states]
     assert received == before + [restarted] + after, [(stamp - CLOCK_START) // 1_000_000 for stamp in received]
     (bag,) = bags.iterdir()
     assert all(part.complete for part in bag_reader.bag_files(bag))
-    logged = [message.log_time_ns for message in bag_reader.iter_messages(bag, ["/linkage/state"])]
+    logged = [message.log_time_ns for message in bag_reader.iter_messages(bag, ['/linkage/state'])]
     assert logged == received

@@ -28,7 +28,7 @@ from node_process import (
 )
 
 DOMAIN_ID = 72
-CRANK_ROCKER = preset("grashof_crank_rocker").geometry
+CRANK_ROCKER = preset('grashof_crank_rocker').geometry
 DRIVE = DriveLaw(TWO_PI)  # one turn per second
 CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick
 STEP = 19_444_444  # ns of simulated time per tick: 7° of crank
@@ -47,26 +47,26 @@ def _run_on_sim_time(
     """Run a node with ``parameters`` on simulated time, stepping the clock through ``phases``
     (a state for each step); return the /linkage/state and /joint_states messages received."""
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("sim_time_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        listener.subscribe("/joint_states", JointState)
-        clock = listener.node.create_publisher(Clock, "/clock", QoSProfile(depth=10))
-        states = listener.received["/linkage/state"]
-        process = start_node({**parameters, "use_sim_time": True, "log.enabled": False},
-                             DOMAIN_ID, tmp_path / "node.log")
+        listener = Listener('sim_time_tester', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        listener.subscribe('/joint_states', JointState)
+        clock = listener.node.create_publisher(Clock, '/clock', QoSProfile(depth=10))
+        states = listener.received['/linkage/state']
+        process = start_node({**parameters, 'use_sim_time': True, 'log.enabled': False},
+                             DOMAIN_ID, tmp_path / 'node.log')
         try:
-            assert listener.spin_until(lambda: listener.node.count_subscribers("/clock") > 0)
-            assert listener.spin_until(lambda: listener.node.count_publishers("/linkage/state"))
+            assert listener.spin_until(lambda: listener.node.count_subscribers('/clock') > 0)
+            assert listener.spin_until(lambda: listener.node.count_publishers('/linkage/state'))
             for phase in phases:
                 for clock_ns in phase:
                     drive_sim_clock(listener, clock, states, clock_ns)
             assert listener.spin_until(
-                lambda: len(listener.received["/joint_states"]) >= len(states))
-            assert process.poll() is None, (tmp_path / "node.log").read_text()
+                lambda: len(listener.received['/joint_states']) >= len(states))
+            assert process.poll() is None, (tmp_path / 'node.log').read_text()
         finally:
             stop_process(process)
             listener.destroy()
-    return states, listener.received["/joint_states"]
+    return states, listener.received['/joint_states']
 
 
 def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path):
@@ -74,8 +74,8 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
               [CLOCK_START + JUMP + n * STEP for n in range(STEPS + 1)]]
     states, joint_states = _run_on_sim_time(
         tmp_path,
-        {"preset": "grashof_crank_rocker", "end_behavior": "loop", "alpha_start": 0.0,
-         "alpha_end": TWO_PI, "omega0": DRIVE.omega0, "rate_hz": 100.0},
+        {'preset': 'grashof_crank_rocker', 'end_behavior': 'loop', 'alpha_start': 0.0,
+         'alpha_end': TWO_PI, 'omega0': DRIVE.omega0, 'rate_hz': 100.0},
         phases)
 
     by_stamp = {stamp_ns(message): message.points[0] for message in states}
@@ -132,8 +132,8 @@ def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path
     assert all(abs(now - then) <= math.pi for now, then in zip(resumed[1:], last[1:]))
 
 
-PARALLELOGRAM = {"crank_length": 0.3, "coupler_length": 1.0, "rocker_length": 0.3,
-                 "ground_x": 1.0, "ground_y": 0.0}
+PARALLELOGRAM = {'crank_length': 0.3, 'coupler_length': 1.0, 'rocker_length': 0.3,
+                 'ground_x': 1.0, 'ground_y': 0.0}
 QUARTER = 250_000_000  # ns of simulated time: a quarter turn, from change point to change point
 TURNS = 1000
 
@@ -146,8 +146,8 @@ def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_pa
               [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER for n in range(9)]]
     states, joint_states = _run_on_sim_time(
         tmp_path,
-        {"preset": "", **PARALLELOGRAM, "branch": -1, "end_behavior": "loop",
-         "alpha_start": 0.0, "alpha_end": TWO_PI, "omega0": DRIVE.omega0},
+        {'preset': '', **PARALLELOGRAM, 'branch': -1, 'end_behavior': 'loop',
+         'alpha_start': 0.0, 'alpha_end': TWO_PI, 'omega0': DRIVE.omega0},
         phases)
 
     by_stamp = {stamp_ns(message): message.points[0] for message in states}

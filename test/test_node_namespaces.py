@@ -31,39 +31,39 @@ DOMAIN_ID = 76
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 # namespace → (preset, frame prefix); '' is a node with no namespace beside them.
 MECHANISMS = {
-    "/left": ("paper", "left/"),
-    "/right": ("grashof_crank_rocker", "right/"),
-    "": ("paper_full_turn", ""),
+    '/left': ('paper', 'left/'),
+    '/right': ('grashof_crank_rocker', 'right/'),
+    '': ('paper_full_turn', ''),
 }
-DRIVE = {"paper": DriveLaw(2.0), "grashof_crank_rocker": DriveLaw(2.0),
-         "paper_full_turn": DriveLaw(-2.0)}
+DRIVE = {'paper': DriveLaw(2.0), 'grashof_crank_rocker': DriveLaw(2.0),
+         'paper_full_turn': DriveLaw(-2.0)}
 
 
 def _topic(namespace: str, name: str) -> str:
-    return f"{namespace}/{name}"
+    return f'{namespace}/{name}'
 
 
 def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_path: Path):
-    bags = tmp_path / "bags"  # one folder for all three: bag names must not collide
+    bags = tmp_path / 'bags'  # one folder for all three: bag names must not collide
     processes = {}
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("namespace_tester", context)
+        listener = Listener('namespace_tester', context)
         for namespace in MECHANISMS:
-            listener.subscribe(_topic(namespace, "linkage/state"), JointTrajectory)
-            listener.subscribe(_topic(namespace, "joint_states"), JointState)
-            listener.subscribe(_topic(namespace, "linkage/markers"), MarkerArray)
-            listener.subscribe(_topic(namespace, "robot_description"), String,
+            listener.subscribe(_topic(namespace, 'linkage/state'), JointTrajectory)
+            listener.subscribe(_topic(namespace, 'joint_states'), JointState)
+            listener.subscribe(_topic(namespace, 'linkage/markers'), MarkerArray)
+            listener.subscribe(_topic(namespace, 'robot_description'), String,
                                transient_local=True)
         try:
             for namespace, (preset_name, prefix) in MECHANISMS.items():
                 drive = DRIVE[preset_name]
-                parameters = {"preset": preset_name, "omega0": drive.omega0,
-                              "alpha_end": -1.0 if drive.omega0 < 0 else 1.0,
-                              "end_behavior": "bounce", "frame_prefix": prefix,
-                              "log.folder": str(bags)}
+                parameters = {'preset': preset_name, 'omega0': drive.omega0,
+                              'alpha_end': -1.0 if drive.omega0 < 0 else 1.0,
+                              'end_behavior': 'bounce', 'frame_prefix': prefix,
+                              'log.folder': str(bags)}
                 processes[namespace] = start_node(
                     parameters, DOMAIN_ID, tmp_path / f"node{namespace.replace('/', '_')}.log",
-                    ros_arguments=["-r", f"__ns:={namespace}"] if namespace else [],
+                    ros_arguments=['-r', f'__ns:={namespace}'] if namespace else [],
                 )
             assert listener.wait_for_every_topic(count=3)
             for process in processes.values():
@@ -78,17 +78,17 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
     for namespace, (preset_name, prefix) in MECHANISMS.items():
         geometry = preset(preset_name).geometry
         # Every state on a namespace's topic is that mechanism's (its geometry, its drive).
-        for message in listener.received[_topic(namespace, "linkage/state")]:
+        for message in listener.received[_topic(namespace, 'linkage/state')]:
             point = message.points[0]
             state = solve(geometry, point.positions[0],
                           DriveLaw(point.velocities[0]))
             assert (point.positions[5], point.positions[6]) == (state.pin_b_x, state.pin_b_y)
-            assert message.header.frame_id == f"{prefix}linkage_base"
-        for message in listener.received[_topic(namespace, "linkage/markers")]:
+            assert message.header.frame_id == f'{prefix}linkage_base'
+        for message in listener.received[_topic(namespace, 'linkage/markers')]:
             assert {marker.header.frame_id for marker in message.markers} == {
-                f"{prefix}linkage_base"}
+                f'{prefix}linkage_base'}
         # robot_state_publisher expects the URDF unprefixed (it applies frame_prefix itself).
-        (description,) = listener.received[_topic(namespace, "robot_description")]
+        (description,) = listener.received[_topic(namespace, 'robot_description')]
         assert description.data == urdf_text(geometry)
 
     # Three bags, each holding only its own node's resolved topics (and /diagnostics).
@@ -96,15 +96,15 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
             for namespace in MECHANISMS}
     seen = set()
     for namespace, log in logs.items():
-        (recording,) = re.findall(r"recording to (\S+)", log)
-        (finalized, count) = re.findall(r"bag finalized: (\S+), (\d+) messages", log)[0]
+        (recording,) = re.findall(r'recording to (\S+)', log)
+        (finalized, count) = re.findall(r'bag finalized: (\S+), (\d+) messages', log)[0]
         assert recording == finalized and Path(recording).is_dir()
         assert Path(recording).parent == bags and recording not in seen
         seen.add(recording)
-        assert int(count) == bag_information(recording)["message_count"]
+        assert int(count) == bag_information(recording)['message_count']
         with Reader(recording) as reader:
             topics = {connection.topic for connection in reader.connections}
         assert topics == {_topic(namespace, name) for name in (
-            "joint_states", "linkage/state", "robot_description", "linkage/markers")} | {
-            "/diagnostics"}
+            'joint_states', 'linkage/state', 'robot_description', 'linkage/markers')} | {
+            '/diagnostics'}
     assert len(list(bags.iterdir())) == 3

@@ -37,55 +37,55 @@ from node_process import (
 )
 
 DOMAIN_ID = 11
-PAPER = preset("paper").geometry
+PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.94°
 
 # (parameter overrides, the parameter the error must name): one case per class of bad value.
 BAD_VALUES = {
-    "negative length": ({"crank_length": -1.0}, "crank_length"),
-    "zero length": ({"coupler_length": 0.0}, "coupler_length"),
-    "nan": ({"rocker_length": math.nan}, "rocker_length"),
-    "inf": ({"k": math.inf}, "k"),
-    "wrong type": ({"omega0": "fast"}, "omega0"),
-    "wrong type int": ({"branch": 1.0}, "branch"),
-    "branch not ±1": ({"branch": 0}, "branch"),
-    "unknown preset": ({"preset": "paper_v2"}, "preset"),
-    "no geometry without preset": ({"preset": ""}, "crank_length"),
-    "geometry cannot close": ({"ground_x": 5.0}, "ground_x"),
-    "unknown mode": ({"mode": "warp"}, "mode"),
-    "unknown end_behavior": ({"end_behavior": "explode"}, "end_behavior"),
-    "alpha_start unreachable": ({"alpha_start": 3.5}, "alpha_start"),
-    "alpha_start at a dead point": ({"alpha_start": DEAD_POINT}, "alpha_start"),
-    "alpha_end never reached": ({"alpha_end": -0.5}, "alpha_end"),
-    "alpha_end is alpha_start": ({"alpha_end": 0.0}, "alpha_end"),
-    "crank at rest": ({"omega0": 0.0}, "omega0"),
-    "rate zero": ({"rate_hz": 0.0}, "rate_hz"),
-    "rate too high": ({"rate_hz": 20000.0}, "rate_hz"),
-    "display rate negative": ({"display_rate_hz": -1.0}, "display_rate_hz"),
-    "alpha_step zero": ({"alpha_step": 0.0}, "alpha_step"),
-    "empty frame": ({"frame_id": ""}, "frame_id"),
-    "threshold out of range": ({"diagnostics.min_transmission_angle": 2.0},
-                               "diagnostics.min_transmission_angle"),
+    'negative length': ({'crank_length': -1.0}, 'crank_length'),
+    'zero length': ({'coupler_length': 0.0}, 'coupler_length'),
+    'nan': ({'rocker_length': math.nan}, 'rocker_length'),
+    'inf': ({'k': math.inf}, 'k'),
+    'wrong type': ({'omega0': 'fast'}, 'omega0'),
+    'wrong type int': ({'branch': 1.0}, 'branch'),
+    'branch not ±1': ({'branch': 0}, 'branch'),
+    'unknown preset': ({'preset': 'paper_v2'}, 'preset'),
+    'no geometry without preset': ({'preset': ''}, 'crank_length'),
+    'geometry cannot close': ({'ground_x': 5.0}, 'ground_x'),
+    'unknown mode': ({'mode': 'warp'}, 'mode'),
+    'unknown end_behavior': ({'end_behavior': 'explode'}, 'end_behavior'),
+    'alpha_start unreachable': ({'alpha_start': 3.5}, 'alpha_start'),
+    'alpha_start at a dead point': ({'alpha_start': DEAD_POINT}, 'alpha_start'),
+    'alpha_end never reached': ({'alpha_end': -0.5}, 'alpha_end'),
+    'alpha_end is alpha_start': ({'alpha_end': 0.0}, 'alpha_end'),
+    'crank at rest': ({'omega0': 0.0}, 'omega0'),
+    'rate zero': ({'rate_hz': 0.0}, 'rate_hz'),
+    'rate too high': ({'rate_hz': 20000.0}, 'rate_hz'),
+    'display rate negative': ({'display_rate_hz': -1.0}, 'display_rate_hz'),
+    'alpha_step zero': ({'alpha_step': 0.0}, 'alpha_step'),
+    'empty frame': ({'frame_id': ''}, 'frame_id'),
+    'threshold out of range': ({'diagnostics.min_transmission_angle': 2.0},
+                               'diagnostics.min_transmission_angle'),
 }
 # The classes checked in a node process too (each costs a process start).
 PROCESS_CASES = [
-    "negative length", "nan", "wrong type", "branch not ±1", "unknown preset",
-    "no geometry without preset", "unknown mode", "alpha_start unreachable",
-    "alpha_end never reached", "rate too high",
+    'negative length', 'nan', 'wrong type', 'branch not ±1', 'unknown preset',
+    'no geometry without preset', 'unknown mode', 'alpha_start unreachable',
+    'alpha_end never reached', 'rate too high',
 ]
 
 
-@pytest.mark.parametrize("case", list(BAD_VALUES))
+@pytest.mark.parametrize('case', list(BAD_VALUES))
 def test_build_configuration_names_the_bad_parameter(case):
     overrides, parameter = BAD_VALUES[case]
     values = configuration_values(**overrides)
-    if case == "no geometry without preset":
+    if case == 'no geometry without preset':
         values.update(dict.fromkeys(
-            ("crank_length", "coupler_length", "rocker_length", "ground_x", "ground_y")))
+            ('crank_length', 'coupler_length', 'rocker_length', 'ground_x', 'ground_y')))
     with pytest.raises(ConfigurationError) as raised:
         build_configuration(values)
     assert parameter in raised.value.parameter
-    assert str(raised.value).startswith(raised.value.parameter + ": ")
+    assert str(raised.value).startswith(raised.value.parameter + ': ')
 
 
 def test_defaults_are_the_seed_run():
@@ -93,7 +93,7 @@ def test_defaults_are_the_seed_run():
     assert config.linkage == PAPER
     assert config.drive == DriveLaw(2.0, 0.0)
     assert (config.alpha_start, config.alpha_end, config.end_behavior, config.mode) == (
-        0.0, math.pi / 2.0, "stop", "real_time")
+        0.0, math.pi / 2.0, 'stop', 'real_time')
     assert config.blocked_at is None
     assert config.segment_duration == math.pi / 4.0
     assert set(configuration_values()) == set(PARAMETER_NAMES)
@@ -102,8 +102,8 @@ def test_defaults_are_the_seed_run():
 def test_explicit_geometry_overrides_the_preset_and_integers_are_accepted():
     config = build_configuration(configuration_values(crank_length=0.25, ground_x=1))
     assert config.linkage == FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, 1.0, 0.0)
-    explicit = build_configuration(configuration_values(preset=""))
-    assert explicit.linkage == PAPER and explicit.preset == ""
+    explicit = build_configuration(configuration_values(preset=''))
+    assert explicit.linkage == PAPER and explicit.preset == ''
 
 
 def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
@@ -116,57 +116,57 @@ def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
 def test_only_motion_changes_restart_the_motion():
     config = build_configuration(configuration_values())
     display = build_configuration(configuration_values(
-        display_rate_hz=10.0, cpu_affinity=0, **{"diagnostics.dead_point_warning": 0.1}))
+        display_rate_hz=10.0, cpu_affinity=0, **{'diagnostics.dead_point_warning': 0.1}))
     faster = build_configuration(configuration_values(omega0=3.0))
     assert not display.restarts_motion(config)
     assert faster.restarts_motion(config)
 
 
-@pytest.mark.parametrize("case", PROCESS_CASES)
+@pytest.mark.parametrize('case', PROCESS_CASES)
 def test_bad_value_at_start_up_ends_the_node_with_one_clear_line(tmp_path, case):
     overrides, parameter = BAD_VALUES[case]
-    bags = tmp_path / "bags"
-    status, output = run_node({**overrides, "log.folder": str(bags)}, DOMAIN_ID,
-                              tmp_path / "node.log")
+    bags = tmp_path / 'bags'
+    status, output = run_node({**overrides, 'log.folder': str(bags)}, DOMAIN_ID,
+                              tmp_path / 'node.log')
     assert status == 2, output
-    assert "Traceback" not in output
-    plain = [line for line in output.splitlines() if line.startswith("linkage_node: invalid")]
+    assert 'Traceback' not in output
+    plain = [line for line in output.splitlines() if line.startswith('linkage_node: invalid')]
     assert len(plain) == 1, output
-    assert plain[0].startswith(f"linkage_node: invalid parameter {parameter}"), output
-    assert any("[FATAL]" in line and parameter in line for line in output.splitlines()), output
+    assert plain[0].startswith(f'linkage_node: invalid parameter {parameter}'), output
+    assert any('[FATAL]' in line and parameter in line for line in output.splitlines()), output
     assert not bags.exists()
 
 
 def test_unwritable_log_folder_is_a_start_up_error(tmp_path):
-    blocker = tmp_path / "not_a_folder"
-    blocker.write_text("")
-    status, output = run_node({"log.folder": str(blocker / "bags")}, DOMAIN_ID,
-                              tmp_path / "node.log")
+    blocker = tmp_path / 'not_a_folder'
+    blocker.write_text('')
+    status, output = run_node({'log.folder': str(blocker / 'bags')}, DOMAIN_ID,
+                              tmp_path / 'node.log')
     assert status == 2, output
-    assert "invalid parameter log.folder" in output
-    assert blocker.read_text() == ""
+    assert 'invalid parameter log.folder' in output
+    assert blocker.read_text() == ''
 
 
 def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("parameter_tester", context)
-        listener.subscribe("/joint_states", JointState)
-        listener.subscribe("/linkage/state", JointTrajectory)
+        listener = Listener('parameter_tester', context)
+        listener.subscribe('/joint_states', JointState)
+        listener.subscribe('/linkage/state', JointTrajectory)
         process = start_node(
-            {"end_behavior": "bounce", "rate_hz": 100.0, "log.enabled": False},
-            DOMAIN_ID, tmp_path / "node.log")
+            {'end_behavior': 'bounce', 'rate_hz': 100.0, 'log.enabled': False},
+            DOMAIN_ID, tmp_path / 'node.log')
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            assert listener.spin_until(lambda: listener.received["/joint_states"])
+            assert listener.spin_until(lambda: listener.received['/joint_states'])
 
             rejected = {
-                "crank_length": -1.0,       # bad on its own
-                "omega0": "fast",          # wrong type
-                "alpha_start": 3.5,        # fine on its own, unreachable for this mechanism
-                "rate_hz": 0.0,
-                "log.folder": "elsewhere",  # read-only
-                "preset": "",              # read-only
+                'crank_length': -1.0,       # bad on its own
+                'omega0': 'fast',          # wrong type
+                'alpha_start': 3.5,        # fine on its own, unreachable for this mechanism
+                'rate_hz': 0.0,
+                'log.folder': 'elsewhere',  # read-only
+                'preset': '',              # read-only
             }
             for name, value in rejected.items():
                 before = get_parameter(client, listener, name)
@@ -175,25 +175,25 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
                 assert name in reason
                 assert get_parameter(client, listener, name) == before
 
-            count = len(listener.received["/joint_states"])
-            assert listener.spin_until(lambda: len(listener.received["/joint_states"]) > count + 5)
+            count = len(listener.received['/joint_states'])
+            assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 5)
 
-            assert set_parameter(client, listener, "omega0", 4.0) == (True, "")
-            states = listener.received["/linkage/state"]
+            assert set_parameter(client, listener, 'omega0', 4.0) == (True, '')
+            states = listener.received['/linkage/state']
             assert listener.spin_until(lambda: states[-1].points[0].velocities[0] == 4.0)
             changed_at = len(states)
             assert listener.spin_until(lambda: len(states) > changed_at + 5)
             speeds = {abs(message.points[0].velocities[0]) for message in states[changed_at:]}
             assert speeds == {4.0}
 
-            listener.subscribe("/robot_description", String, transient_local=True)
-            listener.subscribe("/linkage/markers", MarkerArray)
-            assert set_parameter(client, listener, "crank_length", 0.25) == (True, "")
+            listener.subscribe('/robot_description', String, transient_local=True)
+            listener.subscribe('/linkage/markers', MarkerArray)
+            assert set_parameter(client, listener, 'crank_length', 0.25) == (True, '')
             smaller = FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, PAPER.ground_x)
-            descriptions = listener.received["/robot_description"]
+            descriptions = listener.received['/robot_description']
             assert listener.spin_until(
                 lambda: descriptions and descriptions[-1].data == urdf_text(smaller))
-            joint_states = listener.received["/joint_states"]
+            joint_states = listener.received['/joint_states']
             changed_at = len(joint_states)
             assert listener.spin_until(lambda: len(joint_states) > changed_at + 10)
             for message in joint_states[-5:]:
@@ -202,7 +202,7 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
                 assert tuple(message.velocity)[0] == state.omega
                 assert message.velocity[1] == state.omega_ab - state.omega
             # The scene follows the new geometry: the disk's diameter and pin A's circle.
-            scenes = listener.received["/linkage/markers"]
+            scenes = listener.received['/linkage/markers']
             assert listener.spin_until(
                 lambda: scenes and scenes[-1].markers[DISK_ID].scale.x == 0.5)
             changed_at = len(scenes) - 1
@@ -220,45 +220,45 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
 def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change_nothing(
     tmp_path,
 ):
-    output = tmp_path / "node.log"
+    output = tmp_path / 'node.log'
     with ros_context(DOMAIN_ID) as context:
-        listener = Listener("parameter_contract_tester", context)
-        listener.subscribe("/linkage/state", JointTrajectory)
-        states = listener.received["/linkage/state"]
+        listener = Listener('parameter_contract_tester', context)
+        listener.subscribe('/linkage/state', JointTrajectory)
+        states = listener.received['/linkage/state']
         process = start_node(
-            {"preset": "grashof_crank_rocker", "alpha_end": 2.0 * math.pi,
-             "end_behavior": "loop", "rate_hz": 50, "log.enabled": False},
+            {'preset': 'grashof_crank_rocker', 'alpha_end': 2.0 * math.pi,
+             'end_behavior': 'loop', 'rate_hz': 50, 'log.enabled': False},
             DOMAIN_ID, output)
         try:
-            client = AsyncParameterClient(listener.node, "linkage_node")
+            client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
 
             # Every numeric parameter's descriptor carries its range (/describe_parameters).
-            numeric = [spec.name for spec in parameter_specs("paper")
+            numeric = [spec.name for spec in parameter_specs('paper')
                        if isinstance(spec.default, (int, float))
                        and not isinstance(spec.default, bool)]
             descriptors = listener.result_of(client.describe_parameters(numeric)).descriptors
             for name, descriptor in zip(numeric, descriptors):
                 assert descriptor.name == name
                 assert descriptor.floating_point_range or descriptor.integer_range, name
-            (rate_range,) = descriptors[numeric.index("rate_hz")].floating_point_range
+            (rate_range,) = descriptors[numeric.index('rate_hz')].floating_point_range
             assert (rate_range.from_value, rate_range.to_value) == (0.0, 10000.0)
 
             # A whole number for a real parameter, at start-up and at run time, stays a real.
             def rate() -> object:
-                (value,) = listener.result_of(client.get_parameters(["rate_hz"])).values
+                (value,) = listener.result_of(client.get_parameters(['rate_hz'])).values
                 return parameter_value_to_python(value)
 
             assert rate() == 50.0 and isinstance(rate(), float)
-            assert set_parameter(client, listener, "rate_hz", 60) == (True, "")
+            assert set_parameter(client, listener, 'rate_hz', 60) == (True, '')
             assert rate() == 60.0 and isinstance(rate(), float)
-            successful, reason = set_parameter(client, listener, "rate_hz", 0)
-            assert not successful and reason == set_parameter(client, listener, "rate_hz", 0.0)[1]
+            successful, reason = set_parameter(client, listener, 'rate_hz', 0)
+            assert not successful and reason == set_parameter(client, listener, 'rate_hz', 0.0)[1]
 
             # Setting every writable parameter to its current value (as `ros2 param load` of the
             # node's own dump does) restarts nothing: time_from_start keeps counting.
             assert listener.spin_until(lambda: len(states) >= 3)
-            writable = [spec.name for spec in parameter_specs("grashof_crank_rocker")
+            writable = [spec.name for spec in parameter_specs('grashof_crank_rocker')
                         if not spec.read_only]
             values = listener.result_of(client.get_parameters(writable)).values
             before = len(states)
@@ -275,4 +275,4 @@ def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change
             stop_process(process)
             listener.destroy()
     log = output.read_text()
-    assert log.count("parameters changed") == 1 and "parameters changed: rate_hz=60.0" in log
+    assert log.count('parameters changed') == 1 and 'parameters changed: rate_hz=60.0' in log

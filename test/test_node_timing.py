@@ -19,7 +19,7 @@ DOMAIN_ID = 74
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 ALPHA_START = 0.3  # rad; far enough from the paper's dead point for an OK status
 ALPHA_END = math.pi / 2
-LAWS = {"constant": DriveLaw(4.0), "variable": DriveLaw(0.1, 2.3)}
+LAWS = {'constant': DriveLaw(4.0), 'variable': DriveLaw(0.1, 2.3)}
 
 
 def _stamp_ns(message) -> int:
@@ -36,25 +36,25 @@ def _logged(bag: Path) -> dict[str, list[tuple[int, object]]]:
     return logged
 
 
-@pytest.fixture(scope="module", params=[(mode, law) for mode in ("real_time", "fixed_step")
-                                        for law in LAWS], ids=lambda p: f"{p[0]}-{p[1]}")
+@pytest.fixture(scope='module', params=[(mode, law) for mode in ('real_time', 'fixed_step')
+                                        for law in LAWS], ids=lambda p: f'{p[0]}-{p[1]}')
 def run(request, tmp_path_factory) -> tuple[DriveLaw, dict[str, list[tuple[int, object]]], Path]:
     mode, law = request.param
     drive = LAWS[law]
-    folder = tmp_path_factory.mktemp(f"{mode}_{law}")
+    folder = tmp_path_factory.mktemp(f'{mode}_{law}')
     status, output = run_node(
-        {"mode": mode, "omega0": drive.omega0, "k": drive.k, "alpha_start": ALPHA_START,
-         "alpha_end": ALPHA_END, "alpha_step": math.radians(2.0),
-         "log.folder": str(folder / "bags")},
-        DOMAIN_ID, folder / "node.log")
+        {'mode': mode, 'omega0': drive.omega0, 'k': drive.k, 'alpha_start': ALPHA_START,
+         'alpha_end': ALPHA_END, 'alpha_step': math.radians(2.0),
+         'log.folder': str(folder / 'bags')},
+        DOMAIN_ID, folder / 'node.log')
     assert status == 0, output
-    (bag,) = (folder / "bags").iterdir()
+    (bag,) = (folder / 'bags').iterdir()
     return drive, _logged(bag), bag
 
 
 def test_each_state_is_stamped_when_the_drive_law_reaches_its_alpha(run) -> None:
     drive, logged, _ = run
-    states = logged["/linkage/state"]
+    states = logged['/linkage/state']
     start = _stamp_ns(states[0][1])
     for log_time, message in states:
         point = message.points[0]
@@ -74,17 +74,17 @@ def test_each_state_is_stamped_when_the_drive_law_reaches_its_alpha(run) -> None
 def test_the_log_spans_the_motion_and_starts_with_the_scene(run) -> None:
     drive, logged, bag = run
     everything = [(message.log_time_ns, message.topic) for message in iter_messages(bag)]
-    start = _stamp_ns(logged["/linkage/state"][0][1])
+    start = _stamp_ns(logged['/linkage/state'][0][1])
     # The scene comes first, so a viewer knows the frame before anything refers to it.
-    assert everything[0] == (start, "/linkage/markers")
+    assert everything[0] == (start, '/linkage/markers')
     assert everything[-1][0] - start == round(drive.time_to(ALPHA_START, ALPHA_END) * 1e9)
-    assert logged["/robot_description"][0][0] == start
+    assert logged['/robot_description'][0][0] == start
 
 
 def test_the_logged_diagnostics_follow_the_motion(run) -> None:
     _, logged, _ = run
     statuses = [(message.status[0].level, message.status[0].message)
-                for _, message in logged["/diagnostics"]]
-    assert statuses[0] == (0, "moving")
+                for _, message in logged['/diagnostics']]
+    assert statuses[0] == (0, 'moving')
     level, text = statuses[-1]
-    assert level == 0 and text.startswith("reached alpha_end = 90.000000°")
+    assert level == 0 and text.startswith('reached alpha_end = 90.000000°')

@@ -46,7 +46,7 @@ from test_bag_writer import (
     topic_counts,
 )
 
-LOOP_PARAMETERS = {"rate_hz": 200.0, "end_behavior": "loop"}
+LOOP_PARAMETERS = {'rate_hz': 200.0, 'end_behavior': 'loop'}
 # The bag writer's flush interval (1 s) plus one tick and scheduling slack.
 MAX_LOSS_AT_KILL_NS = 1_500_000_000
 # The node's last batch (16 messages, at most 50 ms old) plus scheduling slack.
@@ -61,7 +61,7 @@ def node_with_listener(
     """A node process (``start_node``'s arguments) and a listener to all its topics, on their
     own ROS domain; both ended on leaving."""
     with ros_context(domain) as context:
-        listener = listen_to_node_topics(context, f"faults_listener_{domain}")
+        listener = listen_to_node_topics(context, f'faults_listener_{domain}')
         process = start_node(parameters, domain, output, **start_options)
         try:
             yield listener, process
@@ -73,12 +73,12 @@ def node_with_listener(
 def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0) -> Path:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
-        mcap_files = list(folder.glob("*/*.mcap"))
+        mcap_files = list(folder.glob('*/*.mcap'))
         if mcap_files:
             return mcap_files[0].parent
-        assert process.poll() is None, f"the node ended with status {process.returncode}"
+        assert process.poll() is None, f'the node ended with status {process.returncode}'
         time.sleep(0.05)
-    raise AssertionError(f"no bag appeared in {folder}")
+    raise AssertionError(f'no bag appeared in {folder}')
 
 
 def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
@@ -87,7 +87,7 @@ def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
     complete chunk, without footer."""
     topics: dict[int, str] = {}
     messages: list[Message] = []
-    with open(mcap_path, "rb") as stream:
+    with open(mcap_path, 'rb') as stream:
         try:
             for record in StreamReader(stream, validate_crcs=True).records:
                 if isinstance(record, Channel):
@@ -107,7 +107,7 @@ def stream_topics(mcap_path: Path) -> set[str]:
 
 def recover(bag: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, "-m", "linkage_kinematics.replay", "--recover", str(bag)],
+        [sys.executable, '-m', 'linkage_kinematics.replay', '--recover', str(bag)],
         cwd=REPOSITORY, env=ros_environment(35), capture_output=True, text=True, timeout=60,
     )
 
@@ -118,15 +118,15 @@ def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
     them all, then SIGKILLs the node (and first its bag writer, if ``kill_writer``). The bag,
     the stamp of the last /joint_states heard and the wall time of the kill (ns)."""
     with node_with_listener(
-        {**LOOP_PARAMETERS, "log.folder": str(folder)}, domain, tmp_path / "node.log"
+        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, domain, tmp_path / 'node.log'
     ) as (listener, process):
         bag = wait_for_bag(folder, process)
-        (mcap_path,) = bag.glob("*.mcap")
+        (mcap_path,) = bag.glob('*.mcap')
         assert listener.spin_until(
             lambda: listener.heard_every_topic()
             and stream_topics(mcap_path) == set(NODE_TOPICS)
-        ), (tmp_path / "node.log").read_text()
-        last_heard_ns = stamp_ns(listener.received["/joint_states"][-1])
+        ), (tmp_path / 'node.log').read_text()
+        last_heard_ns = stamp_ns(listener.received['/joint_states'][-1])
         killed_at_ns = time.time_ns()
         if kill_writer:
             writer = bag_writer_pid(process.pid)
@@ -139,8 +139,8 @@ def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
 
 def wait_until_gone(pid: int) -> None:
     deadline = time.monotonic() + PROCESS_TIMEOUT
-    while Path(f"/proc/{pid}").exists() and b") Z" not in Path(f"/proc/{pid}/stat").read_bytes():
-        assert time.monotonic() < deadline, f"process {pid} still runs"
+    while Path(f'/proc/{pid}').exists() and b') Z' not in Path(f'/proc/{pid}/stat').read_bytes():
+        assert time.monotonic() < deadline, f'process {pid} still runs'
         time.sleep(0.05)
 
 
@@ -149,22 +149,22 @@ def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
 ) -> None:
     """The bag writer outlives a killed node: it writes what the node handed over (all but the
     last batch of at most 16 messages or 50 ms), the summary and the final metadata.yaml."""
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
     bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
         tmp_path, folder, 35, kill_writer=False)
     deadline = time.monotonic() + PROCESS_TIMEOUT
-    while bag_reader.bag_files(bag)[0].truncated or not bag_information(bag)["message_count"]:
-        assert time.monotonic() < deadline, "the bag writer did not finish the bag"
+    while bag_reader.bag_files(bag)[0].truncated or not bag_information(bag)['message_count']:
+        assert time.monotonic() < deadline, 'the bag writer did not finish the bag'
         time.sleep(0.1)
 
     logged = list(bag_reader.iter_messages(bag))
     assert {message.topic for message in logged} == set(NODE_TOPICS)
     assert last_heard_ns - MAX_LOSS_AT_NODE_KILL_NS < logged[-1].log_time_ns < killed_at_ns
-    with open(bag_reader.bag_files(bag)[0].path, "rb") as stream:
+    with open(bag_reader.bag_files(bag)[0].path, 'rb') as stream:
         summary = make_reader(stream).get_summary()
     assert summary is not None and summary.statistics.message_count == len(logged)
     information = bag_information(bag)
-    assert information["message_count"] == len(logged)
+    assert information['message_count'] == len(logged)
     by_rosbags = read_with_rosbags(bag)
     assert topic_counts(information) == {topic: len(entries)
                                          for topic, entries in by_rosbags.items()}
@@ -173,7 +173,7 @@ def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
 def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes_the_bag(
     tmp_path: Path,
 ) -> None:
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
     bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
         tmp_path, folder, 34, kill_writer=True)
 
@@ -189,40 +189,40 @@ def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes
 
     recovery = recover(bag)
     assert recovery.returncode == 0, recovery.stderr
-    assert f"({len(survivors)} messages)" in recovery.stdout
-    with open(mcap_file.path, "rb") as stream:
+    assert f'({len(survivors)} messages)' in recovery.stdout
+    with open(mcap_file.path, 'rb') as stream:
         summary = make_reader(stream).get_summary()
     assert summary is not None and summary.statistics.message_count == len(survivors)
     logged = read_with_rosbags(bag)
     assert sum(len(entries) for entries in logged.values()) == len(survivors)
     information = bag_information(bag)
-    assert information["message_count"] == len(survivors)
+    assert information['message_count'] == len(survivors)
     assert topic_counts(information) == {topic: len(entries) for topic, entries in logged.items()}
     assert [(m.topic, m.data, m.log_time_ns) for m in bag_reader.iter_messages(bag)] == [
         (m.topic, m.data, m.log_time_ns) for m in survivors
     ]
-    assert information["custom_data"]["parameters"]
+    assert information['custom_data']['parameters']
 
 
-@pytest.mark.parametrize("stop_signal", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
 def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal.Signals) -> None:
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 36, tmp_path / "node.log"
+        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 36, tmp_path / 'node.log'
     ) as (listener, process):
         bag = wait_for_bag(folder, process)
-        assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+        assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
         process.send_signal(stop_signal)
-        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / "node.log").read_text()
+        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / 'node.log').read_text()
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
-    with open(mcap_file.path, "rb") as stream:
+    with open(mcap_file.path, 'rb') as stream:
         summary = make_reader(stream).get_summary()
     logged = read_with_rosbags(bag)
     information = bag_information(bag)
     total = sum(len(entries) for entries in logged.values())
-    assert summary.statistics.message_count == information["message_count"] == total > 0
+    assert summary.statistics.message_count == information['message_count'] == total > 0
     counts = topic_counts(information)
     assert counts == {topic: len(entries) for topic, entries in logged.items()}
     assert set(counts) == set(NODE_TOPICS)
@@ -230,45 +230,45 @@ def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal
 
 def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(tmp_path: Path) -> None:
     # chmod does not stop root; a path under a regular file fails for everyone.
-    blocker = tmp_path / "afile"
-    blocker.write_text("not a folder")
-    folder = blocker / "bags"
+    blocker = tmp_path / 'afile'
+    blocker.write_text('not a folder')
+    folder = blocker / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 37, tmp_path / "node.log"
+        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 37, tmp_path / 'node.log'
     ) as (listener, process):
         assert listener.spin_until(stopped(process))
         listener.spin_until(lambda: False, timeout=1.0)  # anything published arrives by now
-    output = (tmp_path / "node.log").read_text()
+    output = (tmp_path / 'node.log').read_text()
     assert process.returncode != 0
     assert str(folder) in output
-    assert "Traceback" not in output
+    assert 'Traceback' not in output
     assert all(not messages for messages in listener.received.values())
-    assert blocker.read_text() == "not a folder"
+    assert blocker.read_text() == 'not a folder'
 
 
 def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_path: Path) -> None:
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
     folder.mkdir()
     now = time.time()
     taken = {}
     # Every name the node could pick in the next seconds is already a bag.
     for offset in range(-2, 30):
-        name = time.strftime("rosbag2_%Y_%m_%d-%H_%M_%S", time.localtime(now + offset))
+        name = time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S', time.localtime(now + offset))
         bag = folder / name
         bag.mkdir(exist_ok=True)
-        (bag / f"{name}_0.mcap").write_bytes(hashlib.sha256(name.encode()).digest() * 64)
-        (bag / "metadata.yaml").write_text(f"old run {name}\n")
+        (bag / f'{name}_0.mcap').write_bytes(hashlib.sha256(name.encode()).digest() * 64)
+        (bag / 'metadata.yaml').write_text(f'old run {name}\n')
         taken[name] = {p.name: p.read_bytes() for p in bag.iterdir()}
     status, output = run_node(
-        {"log.folder": str(folder), "rate_hz": 200.0, "omega0": 10.0}, 38, tmp_path / "node.log"
+        {'log.folder': str(folder), 'rate_hz': 200.0, 'omega0': 10.0}, 38, tmp_path / 'node.log'
     )
     assert status == 0, output
 
     new_bags = [path for path in folder.iterdir() if path.name not in taken]
     assert len(new_bags) == 1
     (new_bag,) = new_bags
-    assert new_bag.name.removesuffix("_1") in taken and new_bag.name.endswith("_1")
-    assert read_with_rosbags(new_bag)["/linkage/state"]
+    assert new_bag.name.removesuffix('_1') in taken and new_bag.name.endswith('_1')
+    assert read_with_rosbags(new_bag)['/linkage/state']
     for name, files in taken.items():
         assert {p.name: p.read_bytes() for p in (folder / name).iterdir()} == files
 
@@ -276,29 +276,29 @@ def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_pa
 def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_on(
     tmp_path: Path,
 ) -> None:
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, "log.folder": str(folder)}, 33, tmp_path / "node.log"
+        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 33, tmp_path / 'node.log'
     ) as (listener, process):
-        assert listener.wait_for_every_topic(), (tmp_path / "node.log").read_text()
+        assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
         writer = bag_writer_pid(process.pid)
         # a batch task: it never preempts the node when a batch wakes it
         assert os.sched_getscheduler(writer) == os.SCHED_BATCH
         os.kill(writer, signal.SIGKILL)
         assert listener.spin_until(lambda: any(
             status.level == DiagnosticStatus.ERROR
-            and "recording stopped" in status.message and "ended unexpectedly" in status.message
-            for array in listener.received["/diagnostics"] for status in array.status
+            and 'recording stopped' in status.message and 'ended unexpectedly' in status.message
+            for array in listener.received['/diagnostics'] for status in array.status
         ))
-        states_then = len(listener.received["/linkage/state"])
+        states_then = len(listener.received['/linkage/state'])
         assert listener.spin_until(
-            lambda: len(listener.received["/linkage/state"]) > states_then + 100)
+            lambda: len(listener.received['/linkage/state']) > states_then + 100)
         process.send_signal(signal.SIGINT)
         status = process.wait(timeout=PROCESS_TIMEOUT)
-    output = (tmp_path / "node.log").read_text()
+    output = (tmp_path / 'node.log').read_text()
     # The log could not be finalized: status 1, and the one error that says so.
     assert status == 1, output
-    assert "could not finalize the log" in output and "Traceback" not in output
+    assert 'could not finalize the log' in output and 'Traceback' not in output
     assert recover(only_bag(folder)).returncode == 0
 
 
@@ -309,34 +309,34 @@ def _limit_file_size() -> None:
 
 
 def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path: Path) -> None:
-    folder = tmp_path / "bags"
+    folder = tmp_path / 'bags'
 
     def recording_failed(got: dict) -> bool:
         return any(
-            status.level == DiagnosticStatus.ERROR and "recording" in status.message
-            for array in got.get("/diagnostics", [])
+            status.level == DiagnosticStatus.ERROR and 'recording' in status.message
+            for array in got.get('/diagnostics', [])
             for status in array.status
         )
 
     with node_with_listener(
-        {"log.folder": str(folder), "rate_hz": 1000.0, "end_behavior": "loop"}, 39,
-        tmp_path / "node.log", preexec_fn=_limit_file_size,
+        {'log.folder': str(folder), 'rate_hz': 1000.0, 'end_behavior': 'loop'}, 39,
+        tmp_path / 'node.log', preexec_fn=_limit_file_size,
     ) as (listener, process):
         assert listener.spin_until(lambda: recording_failed(listener.received))
-        states_at_failure = len(listener.received["/linkage/state"])
+        states_at_failure = len(listener.received['/linkage/state'])
         assert listener.spin_until(
-            lambda: len(listener.received["/linkage/state"]) > states_at_failure + 200
+            lambda: len(listener.received['/linkage/state']) > states_at_failure + 200
         )
         process.send_signal(signal.SIGINT)
         process.wait(timeout=PROCESS_TIMEOUT)
-    output = (tmp_path / "node.log").read_text()
-    assert "File too large" in output and "Traceback" not in output
+    output = (tmp_path / 'node.log').read_text()
+    assert 'File too large' in output and 'Traceback' not in output
 
     bag = only_bag(folder)
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.size <= FILE_SIZE_LIMIT_BYTES
     kept = list(bag_reader.iter_messages(bag))
-    assert len(kept) == bag_information(bag)["message_count"] > 0
+    assert len(kept) == bag_information(bag)['message_count'] > 0
     for message in kept:
         TYPESTORE.deserialize_cdr(message.data, message.schema_name)
     recovery = recover(bag)

@@ -18,7 +18,7 @@ from node_process import start_node, stop_process
 from test_bag_writer import TYPESTORE, bag_information, only_bag, topic_counts
 
 RATE_HZ = 1000.0
-SOAK_SECONDS = float(os.environ.get("LINKAGE_SOAK_SECONDS", "600"))
+SOAK_SECONDS = float(os.environ.get('LINKAGE_SOAK_SECONDS', '600'))
 WARM_UP_SECONDS = max(5.0, 0.1 * SOAK_SECONDS)
 # Growth allowed for allocator noise and the writer's per-chunk index (one entry per second).
 MAX_RSS_GROWTH_KIB = 8 * 1024
@@ -28,33 +28,33 @@ WINDOW_SECONDS = 10  # diagnostics come at 1 Hz: ten of them per window
 
 pytestmark = [
     pytest.mark.soak,
-    pytest.mark.skipif(os.environ.get("LINKAGE_SOAK") != "1", reason="set LINKAGE_SOAK=1 to run"),
+    pytest.mark.skipif(os.environ.get('LINKAGE_SOAK') != '1', reason='set LINKAGE_SOAK=1 to run'),
 ]
 
 
 def resident_kib(pid: int) -> int:
-    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
-        if line.startswith("VmRSS:"):
+    for line in Path(f'/proc/{pid}/status').read_text().splitlines():
+        if line.startswith('VmRSS:'):
             return int(line.split()[1])
-    raise AssertionError(f"no VmRSS for process {pid}")
+    raise AssertionError(f'no VmRSS for process {pid}')
 
 
 def missed_deadlines_by_time(bag: Path) -> list[tuple[int, int]]:
     """(log time ns, the node's 'missed deadlines' count) from each logged /diagnostics."""
     series = []
-    for message in bag_reader.iter_messages(bag, topics=["/diagnostics"]):
+    for message in bag_reader.iter_messages(bag, topics=['/diagnostics']):
         array = TYPESTORE.deserialize_cdr(message.data, message.schema_name)
         (status,) = array.status
         values = {kv.key: kv.value for kv in status.values}
-        series.append((message.log_time_ns, int(values["missed deadlines"])))
+        series.append((message.log_time_ns, int(values['missed deadlines'])))
     return series
 
 
 def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(tmp_path: Path) -> None:
-    folder = tmp_path / "bags"
-    output = tmp_path / "node.log"
+    folder = tmp_path / 'bags'
+    output = tmp_path / 'node.log'
     process = start_node(
-        {"log.folder": str(folder), "rate_hz": RATE_HZ, "end_behavior": "loop"}, 49, output
+        {'log.folder': str(folder), 'rate_hz': RATE_HZ, 'end_behavior': 'loop'}, 49, output
     )
     try:
         time.sleep(WARM_UP_SECONDS)
@@ -78,9 +78,9 @@ def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(tmp_path: Pat
         state_times = []
         for connection, log_time, _ in reader.messages():
             read_back[connection.topic] += 1
-            if connection.topic == "/linkage/state":
+            if connection.topic == '/linkage/state':
                 state_times.append(log_time)
-    assert information["message_count"] == sum(read_back.values())
+    assert information['message_count'] == sum(read_back.values())
     assert topic_counts(information) == read_back
 
     # Every tick publishes one state; a period without a tick is a missed deadline.
@@ -92,7 +92,7 @@ def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(tmp_path: Pat
     assert states <= due
     # The last diagnostics is up to one second older than the last state.
     assert states >= due - missed_reported - RATE_HZ * 1.0, (states, due, missed_reported)
-    assert read_back["/joint_states"] == states
+    assert read_back['/joint_states'] == states
 
     # Missed deadlines per window, after warm-up: the last third may not trend above the first.
     # Medians ignore bursts caused by other processes on a shared machine.
@@ -105,8 +105,8 @@ def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(tmp_path: Pat
     third = max(1, len(increments) // 3)
     early, late = statistics.median(increments[:third]), statistics.median(increments[-third:])
     print(
-        f"soak {SOAK_SECONDS:g} s: RSS {rss_start_kib} -> {rss_end_kib} KiB; {states} states of "
-        f"{due} due; missed deadlines {missed_reported}; per {WINDOW_SECONDS} s early {early}, "
-        f"late {late}"
+        f'soak {SOAK_SECONDS:g} s: RSS {rss_start_kib} -> {rss_end_kib} KiB; {states} states of '
+        f'{due} due; missed deadlines {missed_reported}; per {WINDOW_SECONDS} s early {early}, '
+        f'late {late}'
     )
     assert late <= 2 * early + MISSED_DEADLINE_ALLOWANCE * RATE_HZ * WINDOW_SECONDS, (early, late)
