@@ -11,12 +11,11 @@ from __future__ import annotations
 import math
 from math import atan2, cos, sin, sqrt
 
-import numpy as np
-import scipy.optimize
-
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import continued_branch, solve_many
+import numpy as np
+import scipy.optimize
 
 QUANTITIES = ('beta', 'gamma', 'omega_ab', 'omega_bc', 'omega_dot_ab', 'omega_dot_bc')
 States = dict[str, list[float]]

@@ -11,9 +11,8 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from mpmath import mp, mpf
-
 from linkage_kinematics.drive import DriveError, DriveLaw
+from mpmath import mp, mpf
 from timing import format_seconds, interleaved_medians, markdown_table
 
 LAWS = {'ω = 0.10 + 2.3·α': DriveLaw(0.1, 2.3), 'constant ω = 2 rad/s': DriveLaw(2.0)}

@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+import math
 from typing import Callable
-
-import numpy as np
-from mpmath import mp, mpf
 
 import competitors
 from competitors import QUANTITIES, States
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics import continued_branch, solve, solve_many
+from mpmath import mp, mpf
+import numpy as np
 from reference import continued_sides, reference_state
 from seed_formulation import seed_state
 from timing import format_error, format_seconds, interleaved_medians, markdown_table

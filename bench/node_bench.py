@@ -157,14 +157,13 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     topic, so both publishes really send over loopback.
     """
     os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
-    import rclpy
-    from rclpy.parameter import Parameter
-    from sensor_msgs.msg import JointState
-
     from linkage_kinematics import messages
     from linkage_kinematics.kinematics import solve
     from linkage_kinematics.motion import sample_at_time, solve_sample
     from linkage_kinematics.node import LinkageNode
+    import rclpy
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import JointState
 
     count = 300 if quick else 1500
     listener, output = listen(60.0, ['/joint_states', '/bench/joint_states'],

@@ -16,25 +16,23 @@ Errors are those of reference.state_errors: angles in rad, the rest normwise rel
 from __future__ import annotations
 
 import math
+from pathlib import Path
 import random
 import sys
-from pathlib import Path
-
-from mpmath import mpf
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'test'))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
+from linkage_kinematics.drive import DriveLaw  # noqa: E402
+from linkage_kinematics.geometry import FourBar, PRESETS  # noqa: E402
+from linkage_kinematics.kinematics import DeadPointError, solve  # noqa: E402
+from mpmath import mpf  # noqa: E402
 from reference import (  # noqa: E402
     input_floor,
     reference_singular_angles,
     reference_state,
     state_errors,
 )
-
-from linkage_kinematics.drive import DriveLaw  # noqa: E402
-from linkage_kinematics.geometry import PRESETS, FourBar  # noqa: E402
-from linkage_kinematics.kinematics import DeadPointError, solve  # noqa: E402
 
 DRIVES = (DriveLaw(2.0), DriveLaw(0.10, 2.3))
 GROUPS = {

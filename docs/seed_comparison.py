@@ -9,8 +9,8 @@ over the 90° turn, and (3) the reachable set of its "full revolution" redesign.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
+import sys
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 

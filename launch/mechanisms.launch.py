@@ -13,8 +13,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-
-from linkage_kinematics.parameters import NODE_NAME, mechanism_namespaces
+from linkage_kinematics.parameters import mechanism_namespaces, NODE_NAME
 
 
 def _start_mechanisms(context):

@@ -12,24 +12,23 @@ node write each message as it arrives).
 
 from __future__ import annotations
 
-import io
-import os
-import struct
 from collections.abc import Collection, Iterator
 from dataclasses import dataclass
+import io
+import os
 from pathlib import Path
+import struct
 from typing import Any, NamedTuple, Optional
 
-import numpy as np
-import yaml
-import zstandard
+from linkage_kinematics.kinematics import LinkageState
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.reader import NonSeekingReader
 from mcap.records import Channel, Message, Schema
 from mcap_ros2.decoder import DecoderFactory
-
-from linkage_kinematics.kinematics import LinkageState
+import numpy as np
+import yaml
+import zstandard
 
 STATE_TOPIC = '/linkage/state'
 STATE_TYPE = 'trajectory_msgs/msg/JointTrajectory'

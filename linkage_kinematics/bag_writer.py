@@ -17,22 +17,21 @@ This module is plain Python (no rclpy): bytes in, files out.
 """
 from __future__ import annotations
 
-import functools
-import json
-import os
-import shutil
-import time
 from collections.abc import Mapping
 from dataclasses import dataclass
+import functools
 from importlib import metadata as distribution_metadata
+import json
+import os
 from pathlib import Path
+import shutil
+import time
 from typing import Any
 
-import yaml
-from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
-from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
-
+from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
 from linkage_kinematics import bag_reader
+from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, Writer
+import yaml
 
 PACKAGE_NAME = 'linkage_kinematics'
 METADATA_RECORD_NAME = PACKAGE_NAME

@@ -23,22 +23,22 @@ Plain Python (no rclpy), as bag_writer.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping, Set
 import json
 import os
+from pathlib import Path
 import signal
 import struct
 import subprocess
 import sys
 import time
-from collections.abc import Mapping, Set
-from pathlib import Path
 from typing import Any, BinaryIO
 
 from linkage_kinematics.bag_writer import (
-    WRITE_BATCH,
     BagExistsError,
     BagWriteError,
     BagWriter,
+    WRITE_BATCH,
 )
 
 _FRAME = struct.Struct('<cI')

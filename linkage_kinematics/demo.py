@@ -10,12 +10,11 @@ Tables 1–4 from what was logged, and draws the four-panel figure beside each b
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 import subprocess
 import sys
-from pathlib import Path
 
-from ament_index_python.packages import PackageNotFoundError, get_package_share_directory
-
+from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
 from linkage_kinematics.bag_reader import BagError, read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.sweep import format_tables, write_plot

@@ -12,9 +12,8 @@ flow exact as k → 0, so a timer computes α from elapsed time and never accumu
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-
+import math
 
 # Below this |k·t| (or |k·Δα/ω_s|) e^{k t} − 1 equals k·t to double precision: the linear law
 # is then exact, and it avoids dividing a subnormal k·t, whose few bits would spoil the result.

@@ -24,9 +24,9 @@ All lengths are in metres and all angles in radians; degrees appear only in mess
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 from decimal import Decimal, localcontext
+import math
 
 TWO_PI = 2.0 * math.pi
 # Cosine bounds k± (computed exactly from the float lengths) within this distance of ±1 are

@@ -41,22 +41,21 @@ cache-sized pieces).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, fields
+import math
 from typing import Callable, Union
-
-import numpy as np
 
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import (
     _PLAIN,
     _TOUCH,
     ANGLE_TOLERANCE,
-    TWO_PI,
     FourBar,
     LoopClosure,
+    TWO_PI,
     UnreachableError,
 )
+import numpy as np
 
 FloatOrArray = Union[float, np.ndarray]
 

@@ -9,21 +9,20 @@ functions, into a layout prepared once per geometry (``recording.FixedShapeEncod
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
+import math
 
 from builtin_interfaces.msg import Duration, Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
-from sensor_msgs.msg import JointState
-from std_msgs.msg import ColorRGBA
-from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
-from visualization_msgs.msg import Marker, MarkerArray
-
 from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
 from linkage_kinematics.recording import FixedShapeEncoder
+from sensor_msgs.msg import JointState
+from std_msgs.msg import ColorRGBA
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+from visualization_msgs.msg import Marker, MarkerArray
 
 JOINT_NAMES = ('crank_joint', 'coupler_joint', 'rocker_joint')
 MARKER_NAMESPACE = 'linkage'

@@ -7,11 +7,11 @@ node reports when the crank meets a dead point on its way. No ROS.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
+import math
 
 from linkage_kinematics.geometry import TWO_PI
-from linkage_kinematics.kinematics import LinkageState, continued_branch, solve
+from linkage_kinematics.kinematics import continued_branch, LinkageState, solve
 from linkage_kinematics.parameters import RunConfiguration
 
 

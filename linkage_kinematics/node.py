@@ -16,14 +16,42 @@ import sys
 import time
 from typing import Any
 
-import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from linkage_kinematics import bag_reader, messages
+from linkage_kinematics.bag_writer import package_version
+from linkage_kinematics.bag_writer_process import set_process_affinity
+from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
+from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
+from linkage_kinematics.motion import (
+    blocked_note,
+    dead_point_problem,
+    met_dead_point,
+    MotionSample,
+    sample_at_step,
+    sample_at_time,
+    solve_sample,
+)
+from linkage_kinematics.parameters import (
+    build_configuration,
+    ConfigurationError,
+    describe_value,
+    NO_CPU_AFFINITY,
+    NODE_NAME,
+    PARAMETER_NAMES,
+    parameter_specs,
+    ParameterSpec,
+    REAL_PARAMETERS,
+    RunConfiguration,
+)
+from linkage_kinematics.recording import encode_cdr, Recorder
+from linkage_kinematics.urdf import urdf_text
 from rcl_interfaces.msg import (
     FloatingPointRange,
     IntegerRange,
     ParameterDescriptor,
     SetParametersResult,
 )
+import rclpy
 from rclpy.duration import Duration
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -37,35 +65,6 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
-
-from linkage_kinematics import bag_reader, messages
-from linkage_kinematics.bag_writer import package_version
-from linkage_kinematics.bag_writer_process import set_process_affinity
-from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
-from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
-from linkage_kinematics.motion import (
-    MotionSample,
-    blocked_note,
-    dead_point_problem,
-    met_dead_point,
-    sample_at_step,
-    sample_at_time,
-    solve_sample,
-)
-from linkage_kinematics.parameters import (
-    NODE_NAME,
-    NO_CPU_AFFINITY,
-    PARAMETER_NAMES,
-    REAL_PARAMETERS,
-    ConfigurationError,
-    ParameterSpec,
-    RunConfiguration,
-    build_configuration,
-    describe_value,
-    parameter_specs,
-)
-from linkage_kinematics.recording import Recorder, encode_cdr
-from linkage_kinematics.urdf import urdf_text
 
 DIAGNOSTIC_TASK = 'crank motion'
 DIAGNOSTICS_PERIOD = 1.0  # s

@@ -7,24 +7,23 @@ node, the demo and the tests all validate through it. README.md documents each p
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+import math
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from linkage_kinematics.drive import DriveError, DriveLaw
 from linkage_kinematics.geometry import (
-    TWO_PI,
     FourBar,
     GeometryError,
-    UnreachableError,
     preset,
+    TWO_PI,
+    UnreachableError,
 )
-from linkage_kinematics.kinematics import DeadPointError, continued_branch, solve
+from linkage_kinematics.kinematics import continued_branch, DeadPointError, solve
 from linkage_kinematics.urdf import DEFAULT_FRAME_ID
+import yaml
 
 NODE_NAME = 'linkage_node'
 END_BEHAVIORS = ('stop', 'loop', 'bounce')

@@ -18,15 +18,16 @@ messages), and leaves padding bytes as it finds them.
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Set
 import functools
 import importlib
 import operator
-import struct
-from collections.abc import Callable, Set
 from pathlib import Path
+import struct
 from typing import Any
 
-import yaml
+from linkage_kinematics.bag_writer import BagWriteError, message_definition
+from linkage_kinematics.bag_writer_process import BagWriterProcess
 from rclpy.qos import QoSProfile
 from rosidl_parser.definition import (
     AbstractNestedType,
@@ -36,9 +37,7 @@ from rosidl_parser.definition import (
     BasicType,
     NamespacedType,
 )
-
-from linkage_kinematics.bag_writer import BagWriteError, message_definition
-from linkage_kinematics.bag_writer_process import BagWriterProcess
+import yaml
 
 # XCDR1, little endian: the representation identifier and two option bytes.
 ENCAPSULATION_HEADER = b'\x00\x01\x00\x00'

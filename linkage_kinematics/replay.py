@@ -13,24 +13,23 @@ docs/logging.md).
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass
 import importlib
+from pathlib import Path
 import signal
 import sys
 import time
-from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
-
-import rclpy
-import yaml
-from rclpy.duration import Duration
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 
 from linkage_kinematics import bag_reader
 from linkage_kinematics.bag_writer import BagWriteError, recover_bag
 from linkage_kinematics.cli_types import number
+import rclpy
+from rclpy.duration import Duration
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
+import yaml
 
 TRANSIENT_LOCAL_TOPICS = frozenset({'/robot_description'})
 ACK_TIMEOUT_S = 2.0

@@ -8,29 +8,28 @@ this module only lays them out: a lossless CSV, the seed's head-and-tail tables
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 import dataclasses
+from decimal import Decimal, ROUND_FLOOR
 import io
 import math
 import os
-import sys
-import unicodedata
-from decimal import ROUND_FLOOR, Decimal
-from collections.abc import Sequence
 from pathlib import Path
+import sys
 from typing import Optional, TextIO
+import unicodedata
 
-import numpy as np
-
-from linkage_kinematics.bag_reader import BagError, bag_files, read_states
+from linkage_kinematics.bag_reader import bag_files, BagError, read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import PRESETS, FourBar, GeometryError, UnreachableError, preset
+from linkage_kinematics.geometry import FourBar, GeometryError, preset, PRESETS, UnreachableError
 from linkage_kinematics.kinematics import (
+    continued_branch,
     DeadPointError,
     LinkageState,
-    continued_branch,
     solve_many,
 )
+import numpy as np
 
 PROGRAM = 'linkage-sweep'
 CSV_COLUMNS = (

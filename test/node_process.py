@@ -6,29 +6,28 @@ running at the same time never see each other's nodes.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 import math
 import os
+from pathlib import Path
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
-from pathlib import Path
 from typing import Any
 
+from linkage_kinematics import messages
+from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.parameters import parameter_specs
 import rclpy
-from rosgraph_msgs.msg import Clock
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
-
-from linkage_kinematics import messages
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.parameters import parameter_specs
+from rosgraph_msgs.msg import Clock
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 PROCESS_TIMEOUT = 60.0  # s; a generous bound on any one wait in these tests, also on a busy machine

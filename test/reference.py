@@ -35,11 +35,10 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from mpmath import mp, mpf
-
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState
+from mpmath import mp, mpf
 
 # Enough digits that the reference's own error stays far below anything float64 can show, even
 # 1e-15 rad from a dead point where the square-root conditioning eats half of them.

@@ -5,25 +5,24 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import numpy as np
-import pytest
 from ament_index_python.packages import get_package_share_directory
-from mcap.writer import CompressionType
-from mcap.writer import Writer as McapWriter
-from mcap_ros2.decoder import DecoderFactory
-from mcap_ros2.writer import Writer
-
 from linkage_kinematics.bag_reader import (
-    STATE_JOINT_NAMES,
-    STATE_TOPIC,
-    BagError,
     bag_files,
+    BagError,
     iter_messages,
     read_states,
+    STATE_JOINT_NAMES,
+    STATE_TOPIC,
 )
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import LinkageState, solve_many
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from mcap_ros2.decoder import DecoderFactory
+from mcap_ros2.writer import Writer
+import numpy as np
+import pytest
 
 STATE_TYPE = 'trajectory_msgs/msg/JointTrajectory'
 STRING_TYPE = 'std_msgs/msg/String'

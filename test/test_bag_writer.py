@@ -7,68 +7,67 @@ with rosbags, its metadata.yaml) are shared with test_recording_faults.py and te
 """
 from __future__ import annotations
 
+from collections import defaultdict
+from collections.abc import Callable
 import json
 import math
+from pathlib import Path
 import re
 import signal
 import subprocess
 import sys
 import time
-from collections import defaultdict
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
-import pytest
-import rclpy
-import yaml
 from ament_index_python.packages import get_package_share_directory
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from mcap.reader import make_reader
-from mcap_ros2.reader import read_ros2_messages
-from rclpy.qos import QoSProfile
-from rclpy.serialization import deserialize_message, serialize_message
-from rosbags.rosbag2 import Reader
-from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import CameraInfo, JointState, Range
-from std_msgs.msg import Float64, String
-from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
-from visualization_msgs.msg import Marker, MarkerArray
-
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.bag_writer import (
-    DEFINITION_SEPARATOR,
     BagExistsError,
-    WRITE_BATCH,
     BagWriter,
+    DEFINITION_SEPARATOR,
     message_definition,
     package_version,
+    WRITE_BATCH,
 )
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.recording import (
-    FixedShapeEncoder,
-    Recorder,
     encode_cdr,
+    FixedShapeEncoder,
     offered_qos_profiles_yaml,
+    Recorder,
     ros_type_name,
 )
 from linkage_kinematics.replay import main as replay_main
+from mcap.reader import make_reader
+from mcap_ros2.reader import read_ros2_messages
 from node_process import (
     expected_state_point,
+    Listener,
     PROCESS_TIMEOUT,
     REPOSITORY,
-    Listener,
     ros_context,
     ros_environment,
-    start_node,
     stamp_ns,
+    start_node,
     stop_process,
 )
+import pytest
+import rclpy
+from rclpy.qos import QoSProfile
+from rclpy.serialization import deserialize_message, serialize_message
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import get_typestore, Stores
+from sensor_msgs.msg import CameraInfo, JointState, Range
+from std_msgs.msg import Float64, String
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+from visualization_msgs.msg import Marker, MarkerArray
+import yaml
 
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 NODE_TOPICS = {

@@ -10,19 +10,18 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-import pytest
-from reference import continued_sides, reference_singular_angles, reference_state, state_errors
-
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import (
+    continued_branch,
     DeadPointError,
     LinkageState,
-    continued_branch,
     solve,
     solve_many,
 )
+import numpy as np
+import pytest
+from reference import continued_sides, reference_singular_angles, reference_state, state_errors
 
 CONSTANT = DriveLaw(2.0)
 VARIABLE = DriveLaw(0.10, 2.3)

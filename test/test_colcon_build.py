@@ -3,24 +3,23 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 import shutil
 import signal
 import subprocess
 import sys
-from pathlib import Path
-
-from sensor_msgs.msg import JointState
 
 from linkage_kinematics import bag_reader
 from node_process import (
+    Listener,
     PROCESS_TIMEOUT,
     REPOSITORY,
-    Listener,
     ros_context,
     ros_environment,
     start_node,
     stop_process,
 )
+from sensor_msgs.msg import JointState
 
 DOMAIN_ID = 12
 PACKAGE_ENTRIES = (

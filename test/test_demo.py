@@ -3,16 +3,15 @@ printed from the logs carry the exact values (the seed's Table 1/2 rows and ω =
 
 import math
 import os
+from pathlib import Path
 import subprocess
 import sys
-from pathlib import Path
-
-import matplotlib.image
-import numpy as np
-import pytest
 
 from linkage_kinematics.bag_reader import bag_information, read_states
 from linkage_kinematics.drive import DriveLaw
+import matplotlib.image
+import numpy as np
+import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 

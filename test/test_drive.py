@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import math
 
-import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from mpmath import mp, mpf
-
 from linkage_kinematics.drive import DriveError, DriveLaw
+from mpmath import mp, mpf
+import pytest
 
 
 def exact_alpha(drive: DriveLaw, alpha_start: float, elapsed: float) -> float:

@@ -8,23 +8,22 @@ every logged message, and the values it reads are compared with the library and 
 """
 from __future__ import annotations
 
+from collections.abc import Iterator
 import json
 import math
 import re
-from collections.abc import Iterator
 from typing import Any
-
-import pytest
-from mcap.reader import make_reader
-from mcap_ros2.decoder import DecoderFactory
-from rosbags.interfaces import Nodetype
-from rosbags.typesys import get_types_from_msg
 
 from linkage_kinematics import messages
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
 from node_process import REPOSITORY, start_node, stop_process
+import pytest
+from rosbags.interfaces import Nodetype
+from rosbags.typesys import get_types_from_msg
 
 DOMAIN_ID = 40
 NODE_EXIT_TIMEOUT = 60.0  # s; the stop run ends by itself after 1.57 s of motion

@@ -4,20 +4,19 @@ from __future__ import annotations
 
 import math
 
-import pytest
-from reference import reference_singular_angles
-
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import (
-    PRESETS,
+    format_interval,
     FourBar,
     GeometryError,
-    UnreachableError,
-    format_interval,
     preset,
+    PRESETS,
+    UnreachableError,
     wrap_angle,
 )
 from linkage_kinematics.kinematics import solve
+import pytest
+from reference import reference_singular_angles
 
 
 @pytest.mark.parametrize('name', ['crank_length', 'coupler_length', 'rocker_length'])

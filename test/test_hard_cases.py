@@ -10,22 +10,21 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-import pytest
-from mpmath import mpf
-from reference import input_floor, reference_singular_angles, reference_state, state_errors
-
-from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics import kinematics
-from linkage_kinematics.geometry import PRESETS, FourBar, UnreachableError
+from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.geometry import FourBar, PRESETS, UnreachableError
 from linkage_kinematics.kinematics import (
-    RATE_ACCURACY,
     DeadPointError,
     LinkageState,
+    RATE_ACCURACY,
     solve,
     solve_many,
     solve_pose,
 )
+from mpmath import mpf
+import numpy as np
+import pytest
+from reference import input_floor, reference_singular_angles, reference_state, state_errors
 
 # The result's own rounding (relative, or rad for angles) allowed on top of 3× the input floor.
 ROUNDING = 2e-15

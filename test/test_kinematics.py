@@ -4,14 +4,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
-from reference import reference_singular_angles, reference_state, state_errors
-
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import PRESETS, FourBar, GeometryError, UnreachableError
+from linkage_kinematics.geometry import FourBar, GeometryError, PRESETS, UnreachableError
 from linkage_kinematics.kinematics import (
     DeadPointError,
     LinkageState,
@@ -20,6 +16,9 @@ from linkage_kinematics.kinematics import (
     solve,
     solve_many,
 )
+import numpy as np
+import pytest
+from reference import reference_singular_angles, reference_state, state_errors
 
 ANGLE_TOLERANCE = 1e-12  # rad
 RATE_TOLERANCE = 1e-9  # normwise relative, see reference.state_errors

@@ -6,21 +6,20 @@ with ``--params-file``, in the namespaces it is meant for."""
 from __future__ import annotations
 
 import ast
+from importlib.metadata import entry_points
 import math
+from pathlib import Path
 import re
 import xml.etree.ElementTree as ElementTree
-from importlib.metadata import entry_points
-from pathlib import Path
 
-import pytest
 from ament_index_python.packages import get_package_share_directory
-from rosbags.rosbag2 import Reader
-from rosbags.typesys import Stores, get_typestore
-
 from linkage_kinematics.bag_reader import read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.parameters import mechanism_namespaces
 from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
+import pytest
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import get_typestore, Stores
 
 DOMAIN_ID = 78
 SHARE = Path(get_package_share_directory('linkage_kinematics'))

@@ -5,43 +5,42 @@ Also the node's pure motion functions (loop, bounce, fixed steps) and the URDF's
 
 from __future__ import annotations
 
+from dataclasses import replace
 import math
+from pathlib import Path
 import resource
 import signal
 import xml.etree.ElementTree as ElementTree
-from dataclasses import replace
-from pathlib import Path
 
-import pytest
-import yaml
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from linkage_kinematics import messages
+from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
+from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.geometry import preset, TWO_PI
+from linkage_kinematics.kinematics import solve
+from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_sample
+from linkage_kinematics.parameters import build_configuration
+from linkage_kinematics.urdf import urdf_text
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
+from node_process import (
+    configuration_values,
+    expected_state_point,
+    Listener,
+    PROCESS_TIMEOUT,
+    REPOSITORY,
+    ros_context,
+    start_node,
+    stop_process,
+)
+import pytest
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
-
-from linkage_kinematics import messages
-from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import TWO_PI, preset
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_sample
-from linkage_kinematics.parameters import build_configuration
-from linkage_kinematics.urdf import urdf_text
-from node_process import (
-    expected_state_point,
-    PROCESS_TIMEOUT,
-    REPOSITORY,
-    Listener,
-    configuration_values,
-    ros_context,
-    start_node,
-    stop_process,
-)
+import yaml
 
 DOMAIN_ID = 10
 PAPER = preset('paper').geometry

@@ -8,18 +8,11 @@ message), and the dead point under 'loop', 'bounce' and 'stop'.
 
 from __future__ import annotations
 
+from dataclasses import replace
 import math
 import signal
-from dataclasses import replace
 
-import numpy as np
-import pytest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from rclpy.parameter import Parameter, parameter_value_to_python
-from rclpy.parameter_client import AsyncParameterClient
-from sensor_msgs.msg import JointState
-from trajectory_msgs.msg import JointTrajectory
-
 from linkage_kinematics.bag_reader import bag_files, iter_messages, read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
@@ -31,21 +24,27 @@ from linkage_kinematics.motion import (
     sample_at_time,
 )
 from linkage_kinematics.parameters import (
-    PARAMETER_NAMES,
-    ConfigurationError,
     build_configuration,
+    ConfigurationError,
+    PARAMETER_NAMES,
     parameter_specs,
 )
 from node_process import (
-    expected_state_point,
-    PROCESS_TIMEOUT,
-    Listener,
     configuration_values,
+    expected_state_point,
+    Listener,
+    PROCESS_TIMEOUT,
     ros_context,
     stamp_ns,
     start_node,
     stop_process,
 )
+import numpy as np
+import pytest
+from rclpy.parameter import Parameter, parameter_value_to_python
+from rclpy.parameter_client import AsyncParameterClient
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory
 
 DOMAIN_ID = 70
 PAPER = preset('paper').geometry

@@ -6,21 +6,20 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-import pytest
-from rclpy.parameter_client import AsyncParameterClient
-from sensor_msgs.msg import JointState
-
 from node_process import (
-    PROCESS_TIMEOUT,
-    Listener,
     bag_writer_pid,
     get_parameter,
+    Listener,
+    PROCESS_TIMEOUT,
     ros_context,
     run_node,
     set_parameter,
     start_node,
     stop_process,
 )
+import pytest
+from rclpy.parameter_client import AsyncParameterClient
+from sensor_msgs.msg import JointState
 
 DOMAIN_ID = 13
 AVAILABLE = os.sched_getaffinity(0)

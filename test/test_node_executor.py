@@ -15,23 +15,22 @@ from __future__ import annotations
 
 import signal
 
-from rclpy.parameter import Parameter
-from rclpy.parameter_client import AsyncParameterClient
-from rclpy.qos import QoSProfile
-from rosgraph_msgs.msg import Clock
-from trajectory_msgs.msg import JointTrajectory
-
 from linkage_kinematics import bag_reader, messages
 from linkage_kinematics.parameters import PARAMETER_NAMES, parameter_specs
 from node_process import (
     drive_sim_clock,
-    PROCESS_TIMEOUT,
     Listener,
+    PROCESS_TIMEOUT,
     ros_context,
     stamp_ns,
     start_node,
     stop_process,
 )
+from rclpy.parameter import Parameter
+from rclpy.parameter_client import AsyncParameterClient
+from rclpy.qos import QoSProfile
+from rosgraph_msgs.msg import Clock
+from trajectory_msgs.msg import JointTrajectory
 
 DOMAIN_ID = 77
 CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick

@@ -9,14 +9,8 @@ from __future__ import annotations
 
 import math
 
-import pytest
-from rclpy.qos import QoSProfile
-from rosgraph_msgs.msg import Clock
-from sensor_msgs.msg import JointState
-from trajectory_msgs.msg import JointTrajectory
-
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import TWO_PI, preset
+from linkage_kinematics.geometry import preset, TWO_PI
 from linkage_kinematics.kinematics import solve
 from node_process import (
     drive_sim_clock,
@@ -26,6 +20,11 @@ from node_process import (
     start_node,
     stop_process,
 )
+import pytest
+from rclpy.qos import QoSProfile
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from trajectory_msgs.msg import JointTrajectory
 
 DOMAIN_ID = 72
 CRANK_ROCKER = preset('grashof_crank_rocker').geometry

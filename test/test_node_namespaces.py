@@ -3,16 +3,9 @@ topics, log only those, carry their frame prefix, and say where their bag goes."
 
 from __future__ import annotations
 
+from pathlib import Path
 import re
 import signal
-from pathlib import Path
-
-from rosbags.rosbag2 import Reader
-from rosbags.typesys import Stores, get_typestore
-from sensor_msgs.msg import JointState
-from std_msgs.msg import String
-from trajectory_msgs.msg import JointTrajectory
-from visualization_msgs.msg import MarkerArray
 
 from linkage_kinematics.bag_reader import bag_information
 from linkage_kinematics.drive import DriveLaw
@@ -20,12 +13,18 @@ from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
-    PROCESS_TIMEOUT,
     Listener,
+    PROCESS_TIMEOUT,
     ros_context,
     start_node,
     stop_process,
 )
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import get_typestore, Stores
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from trajectory_msgs.msg import JointTrajectory
+from visualization_msgs.msg import MarkerArray
 
 DOMAIN_ID = 76
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)

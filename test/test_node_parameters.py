@@ -5,6 +5,28 @@ from __future__ import annotations
 
 import math
 
+from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.geometry import FourBar, preset
+from linkage_kinematics.kinematics import solve
+from linkage_kinematics.messages import DISK_ID, PIN_A_ID
+from linkage_kinematics.parameters import (
+    build_configuration,
+    ConfigurationError,
+    PARAMETER_NAMES,
+    parameter_specs,
+)
+from linkage_kinematics.urdf import urdf_text
+from node_process import (
+    configuration_values,
+    get_parameter,
+    Listener,
+    PROCESS_TIMEOUT,
+    ros_context,
+    run_node,
+    set_parameter,
+    start_node,
+    stop_process,
+)
 import pytest
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
@@ -12,29 +34,6 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
-
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.messages import DISK_ID, PIN_A_ID
-from linkage_kinematics.parameters import (
-    PARAMETER_NAMES,
-    ConfigurationError,
-    build_configuration,
-    parameter_specs,
-)
-from linkage_kinematics.urdf import urdf_text
-from node_process import (
-    PROCESS_TIMEOUT,
-    Listener,
-    configuration_values,
-    get_parameter,
-    ros_context,
-    run_node,
-    set_parameter,
-    start_node,
-    stop_process,
-)
 
 DOMAIN_ID = 11
 PAPER = preset('paper').geometry

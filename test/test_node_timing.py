@@ -7,13 +7,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import pytest
-from rosbags.rosbag2 import Reader
-from rosbags.typesys import Stores, get_typestore
-
 from linkage_kinematics.bag_reader import iter_messages
 from linkage_kinematics.drive import DriveLaw
 from node_process import run_node
+import pytest
+from rosbags.rosbag2 import Reader
+from rosbags.typesys import get_typestore, Stores
 
 DOMAIN_ID = 74
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)

@@ -2,32 +2,29 @@
 folder that cannot be created, a bag name already taken, and a disk that fills during the run."""
 from __future__ import annotations
 
+from collections.abc import Iterator
 import contextlib
 import hashlib
 import os
+from pathlib import Path
 import resource
 import signal
 import subprocess
 import sys
 import time
-from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
-import pytest
 from diagnostic_msgs.msg import DiagnosticStatus
+from linkage_kinematics import bag_reader
 from mcap.exceptions import EndOfFile
 from mcap.reader import make_reader
 from mcap.records import Channel, Message
 from mcap.stream_reader import StreamReader
-from rosbags.rosbag2 import Reader
-
-from linkage_kinematics import bag_reader
 from node_process import (
+    bag_writer_pid,
     Listener,
     PROCESS_TIMEOUT,
     REPOSITORY,
-    bag_writer_pid,
     ros_context,
     ros_environment,
     run_node,
@@ -35,15 +32,17 @@ from node_process import (
     start_node,
     stop_process,
 )
+import pytest
+from rosbags.rosbag2 import Reader
 from test_bag_writer import (
-    NODE_TOPICS,
-    TYPESTORE,
     bag_information,
     listen_to_node_topics,
+    NODE_TOPICS,
     only_bag,
     read_with_rosbags,
     stopped,
     topic_counts,
+    TYPESTORE,
 )
 
 LOOP_PARAMETERS = {'rate_hz': 200.0, 'end_behavior': 'loop'}

@@ -5,17 +5,16 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 import signal
 import statistics
 import time
-from pathlib import Path
-
-import pytest
-from rosbags.rosbag2 import Reader
 
 from linkage_kinematics import bag_reader
 from node_process import start_node, stop_process
-from test_bag_writer import TYPESTORE, bag_information, only_bag, topic_counts
+import pytest
+from rosbags.rosbag2 import Reader
+from test_bag_writer import bag_information, only_bag, topic_counts, TYPESTORE
 
 RATE_HZ = 1000.0
 SOAK_SECONDS = float(os.environ.get('LINKAGE_SOAK_SECONDS', '600'))

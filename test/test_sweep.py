@@ -5,19 +5,18 @@ from __future__ import annotations
 import csv
 import io
 import math
+from pathlib import Path
 import subprocess
 import sys
-from pathlib import Path
-
-import numpy as np
-import pytest
-from matplotlib.colors import to_rgb
-from matplotlib.image import imread
 
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import LinkageState, continued_branch, solve_many
+from linkage_kinematics.kinematics import continued_branch, LinkageState, solve_many
 from linkage_kinematics.sweep import CSV_COLUMNS, format_tables, main
+from matplotlib.colors import to_rgb
+from matplotlib.image import imread
+import numpy as np
+import pytest
 from test_bag_reader import write_bag_folder, write_mcap
 
 REPO = Path(__file__).resolve().parents[1]
