@@ -102,7 +102,9 @@ def minimal_states(
 #   F1 = OA·sin α + AB·cos γ + BC·cos β − x_C = 0
 #   F2 = −OA·cos α + AB·sin γ − BC·sin β − y_C = 0.
 
-def loop_residual(linkage: FourBar, alpha: float, gamma: float, beta: float) -> tuple[float, float]:
+def loop_residual(
+    linkage: FourBar, alpha: float, gamma: float, beta: float
+) -> tuple[float, float]:
     """(F1, F2) above."""
     return (
         linkage.crank_length * sin(alpha) + linkage.coupler_length * cos(gamma)
@@ -112,7 +114,9 @@ def loop_residual(linkage: FourBar, alpha: float, gamma: float, beta: float) -> 
     )
 
 
-def loop_jacobian(linkage: FourBar, gamma: float, beta: float) -> tuple[float, float, float, float]:
+def loop_jacobian(
+    linkage: FourBar, gamma: float, beta: float
+) -> tuple[float, float, float, float]:
     """∂(F1, F2)/∂(γ, β) as (J11, J12, J21, J22)."""
     b = linkage.coupler_length
     c = linkage.rocker_length
@@ -344,4 +348,3 @@ class PylinkageModel:
         for _ in self.model.step(iterations=count):
             pass
         return count
-

@@ -89,7 +89,8 @@ def run(quick: bool, repetitions: int) -> str:
                 rows.append([
                     law_name, horizon_name, f'{rate} Hz', str(ticks),
                     mp.nstr(exact, 6),
-                    _cell(*flow, rate, exact), _cell(*euler, rate, exact), _cell(*rk4, rate, exact),
+                    _cell(*flow, rate, exact), _cell(*euler, rate, exact),
+                    _cell(*rk4, rate, exact),
                 ])
     accuracy = markdown_table(
         ['law', 'until', 'timer', 'ticks', 'exact α (rad)', 'exact flow (alpha_at)',

@@ -133,7 +133,8 @@ def measure_errors(
                     per_point[index] = math.inf
                     continue
                 angle_error = max(
-                    float(abs(_wrap(mpf(values[name]) - exact[name]))) for name in ('beta', 'gamma')
+                    float(abs(_wrap(mpf(values[name]) - exact[name])))
+                    for name in ('beta', 'gamma')
                 )
                 rate_error = acceleration_error = 0.0
                 if method.note != 'no rates':
@@ -398,7 +399,8 @@ def plot(results: dict[str, object], path: str) -> None:
             axis.loglog(x, y, marker=marker, color=colour, markersize=9, linestyle='none',
                         label=method.family)
             label = _short_label(method)
-            if method.family == 'finite differences' and worst > 0.1 and set_name != '0°–90° sweep':
+            if (method.family == 'finite differences' and worst > 0.1
+                    and set_name != '0°–90° sweep'):
                 # every step size fails here; one label for the overlapping markers
                 if finite_differences_labelled:
                     continue

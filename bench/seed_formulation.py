@@ -29,8 +29,8 @@ def seed_state(linkage: FourBar, alpha: float, drive: DriveLaw) -> dict[str, flo
     cos_beta = 1.0 - l  # Eq. (2)
     if abs(cos_beta) > 1.0:
         nan = math.nan
-        return dict(beta=nan, gamma=nan, omega_ab=nan, omega_bc=nan, omega_dot_ab=nan,
-                    omega_dot_bc=nan)
+        return {'beta': nan, 'gamma': nan, 'omega_ab': nan, 'omega_bc': nan,
+                'omega_dot_ab': nan, 'omega_dot_bc': nan}
     beta = math.acos(cos_beta)
     n, o = math.sin(beta), cos_beta
     # Eqs. (3) and (4): opposite and adjacent sides of the right triangle on AB.
@@ -68,5 +68,5 @@ def seed_state(linkage: FourBar, alpha: float, drive: DriveLaw) -> dict[str, flo
         bc4 = omega_ab**2 * ab * (p**2 + q**2)
         bc5 = bc * (n * q + o * p)
         omega_dot_bc = (-bc1 - bc2 - bc3 + bc4) / bc5
-    return dict(beta=beta, gamma=gamma, omega_ab=omega_ab, omega_bc=omega_bc,
-                omega_dot_ab=omega_dot_ab, omega_dot_bc=omega_dot_bc)
+    return {'beta': beta, 'gamma': gamma, 'omega_ab': omega_ab, 'omega_bc': omega_bc,
+            'omega_dot_ab': omega_dot_ab, 'omega_dot_bc': omega_dot_bc}

@@ -147,7 +147,8 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
                 f"schema encoding {schema.encoding!r} (expected 'cdr' and 'ros2msg')"
             )
         point = _state_point(trajectory, where)
-        stamps.append(trajectory.header.stamp.sec * 1_000_000_000 + trajectory.header.stamp.nanosec)
+        stamp = trajectory.header.stamp
+        stamps.append(stamp.sec * 1_000_000_000 + stamp.nanosec)
         positions.append(point.positions[:_READ_COORDINATES])
         velocities.append(point.velocities[:_READ_COORDINATES])
         accelerations.append(point.accelerations[:_READ_COORDINATES])

@@ -67,8 +67,8 @@ def main(argv: list[str] | None = None) -> int:
             return 1
         figure = bag.parent / f'{bag.name}.png'
         write_plot(state, figure, title)
-        print(format_tables(state, rows=arguments.rows, title=f'{title}\nlogged in {bag}, '
-                                                                 f'figure {figure}'))
+        print(format_tables(state, rows=arguments.rows,
+                            title=f'{title}\nlogged in {bag}, figure {figure}'))
     return 0
 
 

@@ -172,8 +172,8 @@ def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -
     high, low = point
     difference = alpha - high
     value = sin(0.5 * (difference - low))
-    if (isinstance(value, np.ndarray) or not (-math.pi <= difference <= math.pi
-                                               or abs(value) >= _NEAR_HALF_SINE)):
+    if isinstance(value, np.ndarray) or not (
+            -math.pi <= difference <= math.pi or abs(value) >= _NEAR_HALF_SINE):
         return _corrected_half_sine(alpha, point, difference, value, sin)
     return value
 

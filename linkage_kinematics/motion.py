@@ -24,7 +24,7 @@ class MotionSample:
     forward passes are the even ones)."""
 
     alpha: float
-    reversed: bool = False
+    is_reversed: bool = False
     turn_offset: float = 0.0
     motion_time: float = 0.0
     final: bool = False
@@ -69,7 +69,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
     in_pass = 2.0 * duration - in_cycle if backwards else in_cycle
     return MotionSample(
         _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, in_pass)),
-        reversed=backwards,
+        is_reversed=backwards,
         motion_time=elapsed,
         pass_index=2 * cycles + backwards,
     )
@@ -119,14 +119,14 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
                             pass_index=2 * cycles)
     alpha = _step_alpha(config, per_cycle - index)
     return MotionSample(
-        alpha, reversed=True, motion_time=(cycles + 1) * 2.0 * duration - time_of(alpha),
+        alpha, is_reversed=True, motion_time=(cycles + 1) * 2.0 * duration - time_of(alpha),
         pass_index=2 * cycles + 1,
     )
 
 
 def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState:
     """The library's state for a motion sample (raises as ``kinematics.solve``)."""
-    drive = config.reverse_drive if sample.reversed else config.drive
+    drive = config.reverse_drive if sample.is_reversed else config.drive
     # `branch` names the assembly at alpha_start; through change points the mechanism goes on
     # on its smooth branch, which after an odd number of them is the other side.
     branch = continued_branch(

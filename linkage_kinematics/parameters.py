@@ -308,7 +308,8 @@ def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
 def _branch(values: Mapping[str, Any]) -> int:
     branch = values.get('branch')
     if isinstance(branch, bool) or not isinstance(branch, int) or branch not in (1, -1):
-        raise ConfigurationError('branch', f'must be the integer 1 or -1, got {describe_value(branch)}')
+        raise ConfigurationError(
+            'branch', f'must be the integer 1 or -1, got {describe_value(branch)}')
     return int(branch)
 
 

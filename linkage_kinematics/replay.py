@@ -161,7 +161,8 @@ def _policy(policy_enum: Any, value: Any) -> Any:
             return policy_enum(value)
         return policy_enum[str(value).upper()]
     except (KeyError, ValueError):
-        raise ReplayError(f"the bag's QoS has an unknown {policy_enum.__name__} {value!r}") from None
+        raise ReplayError(
+            f"the bag's QoS has an unknown {policy_enum.__name__} {value!r}") from None
 
 
 def _replay(bag: Path, plans: list[TopicPlan], rate: float, loop: bool, delay: float) -> int:

@@ -379,9 +379,10 @@ def _parser() -> argparse.ArgumentParser:
             'output:\n'
             '  Without --table or --plot: CSV on stdout, one row per crank angle, header\n'
             f"    {','.join(CSV_COLUMNS)}\n"
-            '  in SI units (m/s, rad/s, rad/s²), degrees only in the three angle columns, β and γ\n'
-            '  unwrapped, floats at full precision. --table prints the tables instead of CSV;\n'
-            '  --plot writes only the PNG; both together write the PNG and print the tables.\n'
+            '  in SI units (m/s, rad/s, rad/s²), degrees only in the three angle columns,\n'
+            '  β and γ unwrapped, floats at full precision. --table prints the tables instead\n'
+            '  of CSV; --plot writes only the PNG; both together write the PNG and print the\n'
+            '  tables.\n'
             '  When the range leaves the reachable set nothing is written.\n'
             'exit status:\n'
             '  0 success; 2 bad arguments, including a range that leaves the reachable set or\n'

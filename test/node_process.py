@@ -30,7 +30,8 @@ from rclpy.task import Future
 from rosgraph_msgs.msg import Clock
 
 REPOSITORY = Path(__file__).resolve().parent.parent
-PROCESS_TIMEOUT = 60.0  # s; a generous bound on any one wait in these tests, also on a busy machine
+# s; a generous bound on any one wait in these tests, also on a busy machine
+PROCESS_TIMEOUT = 60.0
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:

@@ -340,7 +340,8 @@ def test_a_fixed_shape_encoder_of_one_field_and_one_naming_no_field() -> None:
     encoder = FixedShapeEncoder(Float64(data=0.0), ['data'])
     assert encoder.value_count == 1
     assert encoder.encode((2.5,)) == encode_cdr(Float64(data=2.5))
-    with pytest.raises(ValueError, match=r"std_msgs/msg/Float64 has no fixed-size field \['dat'\]"):
+    with pytest.raises(ValueError,
+                       match=r"std_msgs/msg/Float64 has no fixed-size field \['dat'\]"):
         FixedShapeEncoder(Float64(data=0.0), ['dat'])
 
 
@@ -400,7 +401,8 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
         assert yaml.safe_load(channel_record.metadata['offered_qos_profiles'])[0]['depth'] == 7
         assert channel_record.metadata['topic_type_hash'].startswith('RIHS01_')
         records = {record.name: record.metadata for record in reader.iter_metadata()}
-    assert records['linkage_kinematics'] == {'package_version': package_version(), 'rate_hz': '200'}
+    assert records['linkage_kinematics'] == {
+        'package_version': package_version(), 'rate_hz': '200'}
     rosbag2_record = yaml.safe_load(records['rosbag2']['serialized_metadata'])
     assert rosbag2_record['version'] == 9 and rosbag2_record['message_count'] == 1_999
     information = bag_information(bag)
@@ -475,7 +477,8 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         try:
             assert listener.wait_for_every_topic(count=2), (run_folder / 'node.log').read_text()
             process.send_signal(signal.SIGINT)
-            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (run_folder / 'node.log').read_text()
+            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (
+                (run_folder / 'node.log').read_text())
         finally:
             stop_process(process)
             listener.destroy()

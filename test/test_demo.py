@@ -40,7 +40,8 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
         assert len(log_times) == 181
         assert states.alpha == pytest.approx(np.radians(np.arange(181) * 0.5), abs=1e-15)
         elapsed_ns = log_times - log_times[0]
-        assert list(elapsed_ns) == [round(drive.time_to(0.0, alpha) * 1e9) for alpha in states.alpha]
+        assert list(elapsed_ns) == [
+            round(drive.time_to(0.0, alpha) * 1e9) for alpha in states.alpha]
     assert [round(bag_information(bag)['duration']['nanoseconds'] * 1e-6) for bag in bags] == [
         785, 1571]
     constant, variable = completed.stdout.split('Variable law')

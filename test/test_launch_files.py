@@ -87,7 +87,8 @@ def test_the_scenario_launch_files_name_existing_parameters_files() -> None:
     (parameters,) = node.iter('param')
     for scenario in choices:
         path = parameters.get('from').replace(
-            '$(find-pkg-share linkage_kinematics)', str(SHARE)).replace('$(var scenario)', scenario)
+            '$(find-pkg-share linkage_kinematics)', str(SHARE)
+        ).replace('$(var scenario)', scenario)
         assert Path(path).is_file()
     assert not re.search(r'\$\((?!find-pkg-share |var )', parameters.get('from'))
 

@@ -371,7 +371,7 @@ def test_bounce_plays_the_pass_backwards_with_negated_rates():
     duration = config.segment_duration
     forward = sample_at_time(config, 0.25 * duration)
     backward = sample_at_time(config, 1.75 * duration)
-    assert not forward.reversed and backward.reversed
+    assert not forward.is_reversed and backward.is_reversed
     assert backward.alpha == pytest.approx(forward.alpha, abs=1e-15)
     ahead = solve_sample(config, forward)
     back = solve_sample(config, replace(backward, alpha=forward.alpha))
@@ -383,7 +383,7 @@ def test_bounce_plays_the_pass_backwards_with_negated_rates():
     end_index = config.step_count
     assert sample_at_step(config, end_index).alpha == math.pi / 2.0
     assert sample_at_step(config, end_index + 1).alpha == (end_index - 1) * config.alpha_step
-    assert sample_at_step(config, end_index + 1).reversed
+    assert sample_at_step(config, end_index + 1).is_reversed
     assert sample_at_step(config, 2 * end_index).alpha == 0.0
 
 

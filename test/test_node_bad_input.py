@@ -220,8 +220,9 @@ def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_p
             (result,) = listener.result_of(
                 client.set_parameters([Parameter('omega0', value=3.0)])).results
             assert result.successful
-            good = {name: parameter_value_to_python(value) for name, value in zip(
-                PARAMETER_NAMES, listener.result_of(client.get_parameters(PARAMETER_NAMES)).values)}
+            values = listener.result_of(client.get_parameters(PARAMETER_NAMES)).values
+            good = {name: parameter_value_to_python(value)
+                    for name, value in zip(PARAMETER_NAMES, values)}
             assert good == {**DEFAULTS, 'omega0': 3.0, 'log.folder': str(bags),
                             'end_behavior': 'loop'}
             assert listener.spin_until(lambda: states[-1].points[0].velocities[0] == 3.0)
@@ -300,10 +301,10 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
     duration = bounce.segment_duration
     samples = [sample_at_time(bounce, fraction * duration) for fraction in (0.5, 1.5, 2.5, 3.5)]
     assert [sample.pass_index for sample in samples] == [0, 1, 2, 3]
-    assert [sample.reversed for sample in samples] == [False, True, False, True]
+    assert [sample.is_reversed for sample in samples] == [False, True, False, True]
     last_out = sample_at_step(bounce, bounce.step_count - 1)
     first_back = sample_at_step(bounce, bounce.step_count)
-    assert (last_out.pass_index, first_back.pass_index) == (0, 1) and first_back.reversed
+    assert (last_out.pass_index, first_back.pass_index) == (0, 1) and first_back.is_reversed
     # Bounce meets the dead point at the end of each forward pass only; loop at every pass end.
     assert met_dead_point(bounce, 0, 1) and met_dead_point(bounce, 1, 3)
     assert not met_dead_point(bounce, 1, 2) and not met_dead_point(bounce, 2, 2)

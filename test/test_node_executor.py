@@ -118,7 +118,8 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
 
     assert status == 0, (tmp_path / 'node.log').read_text()
     received = [stamp_ns(message) for message in states]
-    assert received == before + [restarted] + after, [(stamp - CLOCK_START) // 1_000_000 for stamp in received]
+    assert received == before + [restarted] + after, [
+        (stamp - CLOCK_START) // 1_000_000 for stamp in received]
     (bag,) = bags.iterdir()
     assert all(part.complete for part in bag_reader.bag_files(bag))
     logged = [message.log_time_ns for message in bag_reader.iter_messages(bag, ['/linkage/state'])]

@@ -227,7 +227,8 @@ def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal
     assert set(counts) == set(NODE_TOPICS)
 
 
-def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(tmp_path: Path) -> None:
+def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(
+        tmp_path: Path) -> None:
     # chmod does not stop root; a path under a regular file fails for everyone.
     blocker = tmp_path / 'afile'
     blocker.write_text('not a folder')
