@@ -1,4 +1,5 @@
-"""Other ways to get the four-bar's positions, rates and accelerations, for comparison.
+"""
+Other ways to get the four-bar's positions, rates and accelerations, for comparison.
 
 Each ``*_states`` function takes a list of crank angles (in sweep order, so that iterative
 solvers can warm-start from the previous angle, as a timer-driven node would) and returns the
@@ -25,8 +26,12 @@ def minimal_closed_form(
     crank: float, coupler: float, rocker: float, ground_x: float, ground_y: float,
     branch: int, omega0: float, k: float, alpha: float,
 ) -> tuple[float, ...]:
-    """The library's closed form as bare straight-line ``math`` code: no checks, no state
-    object, the same 22 outputs as a tuple. The yardstick for the scalar path's overhead."""
+    """
+    Return the library's closed form as bare straight-line ``math`` code.
+
+    No checks, no state object, the same 22 outputs as a tuple. The yardstick for the scalar path's
+    overhead.
+    """
     sin_alpha = sin(alpha)
     cos_alpha = cos(alpha)
     pin_a_x = crank * sin_alpha
@@ -82,8 +87,11 @@ def minimal_closed_form(
 def minimal_states(
     linkage: FourBar, alphas: list[float], drive: DriveLaw, sides: list[int]
 ) -> States:
-    """``minimal_closed_form`` at every angle, each on the given side of A→C. Where it divides
-    by a sine that rounded to zero, NaN (no result)."""
+    """
+    ``minimal_closed_form`` at every angle, each on the given side of A→C.
+
+    Where it divides by a sine that rounded to zero, NaN (no result).
+    """
     rows = []
     for alpha, side in zip(alphas, sides):
         try:
@@ -202,7 +210,11 @@ def scipy_root_states(
 def fsolve_states(
     linkage: FourBar, alphas: list[float], drive: DriveLaw, start: tuple[float, float]
 ) -> States:
-    """scipy.optimize.fsolve with its defaults (xtol 1.49e-8, numerical Jacobian), warm-started."""
+    """
+    scipy.optimize.fsolve with its defaults (xtol 1.49e-8, numerical Jacobian).
+
+    Warm-started.
+    """
     result: States = {name: [] for name in QUANTITIES}
     guess = np.array(start)
     for alpha in alphas:
@@ -227,9 +239,12 @@ def finite_difference_states(
     linkage: FourBar, alphas: np.ndarray, drive: DriveLaw, step: float, start: float = 0.0,
     branch: int = 1,
 ) -> States:
-    """Positions from solve_many, on the smooth motion that has ``branch`` at ``start``; rates
-    from central differences in α (forward ones where α − step is past the dead point), times
-    ω, with α̈ = k·ω for the accelerations."""
+    """
+    Positions from solve_many, on the smooth motion that has ``branch`` at ``start``.
+
+    Rates from central differences in α (forward ones where α − step is past the dead point), times
+    ω, with α̈ = k·ω for the accelerations.
+    """
     alphas = np.asarray(alphas, dtype=float)
     central = (np.full(alphas.shape, True) if linkage.reachability.full_rotation
                else alphas - step > linkage.reachability.intervals[0][0])
@@ -266,7 +281,8 @@ def finite_difference_states(
 # --- pylinkage -------------------------------------------------------------------------------
 
 class PylinkageModel:
-    """The mechanism in pylinkage 1.3: grounds O and C, a Crank OA, an RRR dyad for B.
+    """
+    The mechanism in pylinkage 1.3: grounds O and C, a Crank OA, an RRR dyad for B.
 
     pylinkage measures the crank angle from +x, so its angle is α − 90°; its crank advances by
     ``angular_velocity`` per step, and its kinematics take ω and α̈ per crank.
@@ -332,8 +348,12 @@ class PylinkageModel:
             (rocker_x * accelerations[3][1] - rocker_y * accelerations[3][0]) / rocker_squared)
 
     def sweep(self, count: int, drive: DriveLaw) -> int:
-        """pylinkage's own loop: ``count`` steps of step_with_derivatives from α = 0 (constant
-        ω, the only law its per-crank ω supports without resetting it every step)."""
+        """
+        Run pylinkage's own loop.
+
+        ``count`` steps of step_with_derivatives from α = 0 (constant ω, the only law its per-crank
+        ω supports without resetting it every step).
+        """
         r = self.linkage.crank_length
         self.crank.set_coord(0.0, -r)
         self.model.set_input_velocity(self.crank, drive.omega0, 0.0)
@@ -342,7 +362,7 @@ class PylinkageModel:
         return count
 
     def sweep_positions(self, count: int) -> int:
-        """pylinkage's positions-only loop (Linkage.step) for ``count`` steps from α = 0."""
+        """Run pylinkage's positions-only loop (Linkage.step) for ``count`` steps from α = 0."""
         r = self.linkage.crank_length
         self.crank.set_coord(0.0, -r)
         for _ in self.model.step(iterations=count):

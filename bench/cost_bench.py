@@ -1,4 +1,5 @@
-"""Section "cost": linkage_node against the rclpy node a lab would write by hand, side by side.
+"""
+Section "cost": linkage_node against the rclpy node a lab would write by hand, side by side.
 
 Both run as processes at the same time, at the same timer rate, nothing subscribed:
 linkage_node at ``rate_hz`` with logging on (``end_behavior:=bounce``) and
@@ -33,7 +34,7 @@ CLOCK_TICKS = os.sysconf('SC_CLK_TCK')
 
 
 def cpu_seconds(pid: int) -> float:
-    """utime + stime so far (s) of a process and its children (a logging node's bag writer)."""
+    """Utime + stime so far (s) of a process and its children (a logging node's bag writer)."""
     total = 0
     for process in node_bench.with_children(pid):
         with open(f'/proc/{process}/stat', encoding='ascii') as stat:
@@ -49,8 +50,11 @@ def start_minimal_publisher(rate: float, executor: str, domain: int) -> subproce
 
 
 def side_by_side(rate: float, executor: str, domain_base: int) -> tuple[float, float]:
-    """CPU share of one core of (linkage_node logging, minimal publisher on ``executor``),
-    running at the same time at ``rate``, each alone on its ROS domain."""
+    """
+    CPU share of one core of (linkage_node logging, minimal publisher on ``executor``).
+
+    Running at the same time at ``rate``, each alone on its ROS domain.
+    """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_cost_') as folder:
         node = node_bench.start_node(
             {'rate_hz': f'{rate:.1f}', 'end_behavior': 'bounce', 'log.folder': folder},
@@ -76,9 +80,12 @@ def side_by_side(rate: float, executor: str, domain_base: int) -> tuple[float, f
 def missed_share(
     rate: float, seconds: float, domain_base: int, placement: dict[str, str]
 ) -> float:
-    """Share of ticks the node (logging on, ``placement`` its cpu_affinity, nothing but
-    /diagnostics subscribed) missed: 1 − its achieved rate over its /diagnostics windows
-    after the first ÷ ``rate``."""
+    """
+    Share of ticks the node.
+
+    (logging on, ``placement`` its cpu_affinity, nothing but /diagnostics subscribed) missed: 1 −
+    its achieved rate over its /diagnostics windows after the first ÷ ``rate``.
+    """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_cost_rate_') as folder:
         data = node_bench.observe(
             {'rate_hz': f'{rate:.1f}', 'end_behavior': 'bounce', 'log.folder': folder,
@@ -92,7 +99,11 @@ def missed_share(
 
 
 def run(quick: bool, ros_domain: int) -> str:
-    """The section as markdown; ``ros_domain`` is the first of the node sections' domains."""
+    """
+    Return the section as markdown.
+
+    ``ros_domain`` is the first of the node sections' domains.
+    """
     repetitions = 2 if quick else 3
     rows = []
     ratios = []

@@ -1,4 +1,5 @@
-"""Section 2: the drive law in time: the exact flow against explicit Euler and classical RK4.
+"""
+Section 2: the drive law in time: the exact flow against explicit Euler and classical RK4.
 
 A node ticking at a timer rate needs α at each tick. The library computes it from the elapsed
 time with the law's exact flow (DriveLaw.alpha_at); the alternative is to integrate

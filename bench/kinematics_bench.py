@@ -35,10 +35,13 @@ LABEL_OFFSETS = {'solve': (-10, -16), 'minimal': (-30, 8), 'Newton 1e-08': (-20,
 
 @dataclass
 class AngleSet:
-    """Crank angles of one motion of one linkage: the motion starts at ``start`` on ``branch``
-    and turns smoothly through ``alphas``; ``sides`` are the assemblies the reference's own
-    continuation finds there (what a method must follow); ``start_guess`` is the (γ, β) an
-    iterative solver starts from at ``start``."""
+    """
+    Crank angles of one motion of one linkage.
+
+    The motion starts at ``start`` on ``branch`` and turns smoothly through ``alphas``; ``sides``
+    are the assemblies the reference's own continuation finds there (what a method must follow);
+    ``start_guess`` is the (γ, β) an iterative solver starts from at ``start``.
+    """
 
     linkage: FourBar
     alphas: list[float]
@@ -76,9 +79,13 @@ class Errors:
 
 
 def angle_sets(linkage: FourBar, quick: bool) -> dict[str, AngleSet]:
-    """The seed's 0°–90° sweep; a sweep from 1e-3 rad down to 1e-13 rad above the dead point;
-    and the crossed parallelogram through its change point, from 1e-3 rad below it to 1e-13
-    rad below, on the float nearest it, and from 1e-13 to 1e-3 rad above."""
+    """
+    Return the seed's 0°–90° sweep.
+
+    A sweep from 1e-3 rad down to 1e-13 rad above the dead point; and the crossed parallelogram
+    through its change point, from 1e-3 rad below it to 1e-13 rad below, on the float nearest it,
+    and from 1e-13 to 1e-3 rad above.
+    """
     dead = linkage.reachability.intervals[0][0]
     sweep = np.radians(np.linspace(0.0, 90.0, 31 if quick else 91))
     offsets = np.logspace(-3, math.log10(NEAR_DEAD_CLOSEST), 11 if quick else 21)
@@ -103,7 +110,11 @@ def angle_sets(linkage: FourBar, quick: bool) -> dict[str, AngleSet]:
 
 
 def references(sets: dict[str, AngleSet]) -> dict[tuple[str, str], list[dict[str, mpf]]]:
-    """The mpmath reference at every angle of every set, under each law, on the set's sides."""
+    """
+    Return the mpmath reference at every angle of every set.
+
+    Under each law, on the set's sides.
+    """
     return {
         (set_name, law_name): [reference_state(angle_set.linkage, alpha, law, side)
                                for alpha, side in zip(angle_set.alphas, angle_set.sides)]
@@ -116,9 +127,13 @@ def measure_errors(
     method: Method, sets: dict[str, AngleSet],
     reference: dict[tuple[str, str], list[dict[str, mpf]]], set_name: str,
 ) -> Errors:
-    """Angles: largest |error| of β and γ (rad). Rates and accelerations: largest |error| of
-    the two bars', relative to the larger of the two at that angle (so the figure means the
-    same far from and close to the dead point, where the rates grow without bound)."""
+    """
+    Angles: largest |error| of β and γ (rad).
+
+    Rates and accelerations: largest |error| of the two bars', relative to the larger of the two at
+    that angle (so the figure means the same far from and close to the dead point, where the rates
+    grow without bound).
+    """
     position = rate = acceleration = 0.0
     missing = 0
     per_point = [0.0] * len(sets[set_name].alphas)
@@ -185,9 +200,12 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
         return {name: getattr(state, name) for name in QUANTITIES}
 
     def continued(function: Callable[..., States], *settings) -> Callable[..., States]:
-        """Iterative solvers march from the set's start position (for the paper mechanism the
-        seed's, at α = 0) to the set's first angle, as a node turning the crank would, then
-        along the set."""
+        """
+        March an iterative solver from the set's start position.
+
+        From there (for the paper mechanism the seed's, at α = 0) to the set's first angle, as a
+        node turning the crank would, then along the set.
+        """
         def states(angle_set: AngleSet, drive: DriveLaw) -> States:
             alphas = angle_set.alphas
             lead_in = [float(a) for a in np.linspace(angle_set.start, alphas[0], 20)]
@@ -261,14 +279,17 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
 
 
 def _library_branches(angle_set: AngleSet) -> list[int]:
-    """The library's own branch at each angle of the set's motion (continued_branch)."""
+    """Return the library's own branch at each angle of the set's motion (continued_branch)."""
     return [continued_branch(angle_set.linkage, angle_set.start, angle_set.branch, alpha)
             for alpha in angle_set.alphas]
 
 
 def _seed_states(angle_set: AngleSet, drive: DriveLaw) -> States:
-    """The seed's equations hold for its own mechanism only (OA = BC, C level with O, the
-    α = 0 start): no result for another linkage."""
+    """
+    Return the seed's equations hold for its own mechanism only.
+
+    (OA = BC, C level with O, the α = 0 start): no result for another linkage.
+    """
     if angle_set.linkage != preset('paper').geometry:
         return {name: [math.nan] * len(angle_set.alphas) for name in QUANTITIES}
     rows = [seed_state(angle_set.linkage, alpha, drive) for alpha in angle_set.alphas]
@@ -447,7 +468,7 @@ def _short_label(method: Method) -> str:
 
 
 def goals(results: dict[str, object]) -> str:
-    """The kinematics goals, each with its measured figure."""
+    """Return the kinematics goals, each with its measured figure."""
     ratio = results['scalar_over_minimal']
     rate = results['vector_rate']
     lines = [

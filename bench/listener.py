@@ -1,4 +1,5 @@
-"""A subscriber in its own process for the node benchmark.
+"""
+A subscriber in its own process for the node benchmark.
 
 Usage: python bench/listener.py OUTPUT.json SECONDS [TOPIC ...]
 

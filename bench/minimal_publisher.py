@@ -1,4 +1,5 @@
-"""The yardstick of the CPU comparison: the rclpy node a lab would write by hand.
+"""
+The yardstick of the CPU comparison: the rclpy node a lab would write by hand.
 
 Usage: python bench/minimal_publisher.py RATE_HZ [single|events]
 

@@ -1,4 +1,5 @@
-"""Section 3: the node: cost per tick, sustained rate, jitter, latency, log size, memory.
+"""
+Section 3: the node: cost per tick, sustained rate, jitter, latency, log size, memory.
 
 Nodes run as the tests run them (``python -m linkage_kinematics.node --ros-args ...`` in their
 own process, real Fast DDS over loopback, real MCAP logs); the cost split runs the node's own
@@ -117,8 +118,11 @@ def bag_figures(folder: pathlib.Path) -> tuple[int, int]:
 # --- memory ---------------------------------------------------------------------------------
 
 def memory_run(minutes: float, domain_base: int) -> str:
-    """Resident memory of a 1 kHz node, logging on, with its bag writer, from start to
-    ``minutes`` later."""
+    """
+    Resident memory of a 1 kHz node, logging on, with its bag writer.
+
+    From start to ``minutes`` later.
+    """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_memory_') as folder:
         node = start_node({'rate_hz': '1000.0', 'end_behavior': 'loop',
                            'log.folder': folder}, domain_base + DOMAIN_MEMORY)
@@ -151,7 +155,8 @@ def memory_run(minutes: float, domain_base: int) -> str:
 # --- cost per tick, in this process ---------------------------------------------------------
 
 def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, dict[str, float]]:
-    """Median time of each part of the node's tick and of a bare rclpy publish, side by side.
+    """
+    Median time of each part of the node's tick and of a bare rclpy publish, side by side.
 
     A listener in another process subscribes to /joint_states and to the bare publisher's
     topic, so both publishes really send over loopback.
@@ -274,8 +279,11 @@ def _percentile(values: list[float], fraction: float) -> float:
 
 def observe(parameters: dict[str, str], seconds: float, domain: int,
             topics: tuple[str, ...] | list[str] = ('/joint_states',)) -> dict[str, Any]:
-    """Run a node with ``parameters`` and a listener on /diagnostics and ``topics`` for
-    ``seconds``."""
+    """
+    Run a node with ``parameters`` and a listener for ``seconds``.
+
+    The listener hears /diagnostics and ``topics``.
+    """
     node = start_node({'end_behavior': 'loop', **parameters}, domain)
     try:
         time.sleep(STARTUP_S)
@@ -289,8 +297,12 @@ def observe(parameters: dict[str, str], seconds: float, domain: int,
 def sustained_rate(
     rate: float, logging: bool, seconds: float, domain_base: int
 ) -> tuple[float, int]:
-    """Fraction of ticks missed (1 − achieved/requested over the node's diagnostics windows
-    after the first) and the node's missed-deadline count."""
+    """
+    Fraction of ticks missed.
+
+    (1 − achieved/requested over the node's diagnostics windows after the first) and the node's
+    missed-deadline count.
+    """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_rate_') as folder:
         data = observe({'rate_hz': f'{rate:.1f}', 'log.enabled': str(logging).lower(),
                         'log.folder': folder}, seconds, domain_base + DOMAIN_RATE)
@@ -307,8 +319,11 @@ def sustained_rate(
 def timing_figures(
     rate: float, seconds: float, domain_base: int, parameters: dict[str, str] | None = None
 ) -> dict[str, float]:
-    """Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99, of a
-    node with ``parameters`` besides the rate."""
+    """
+    Timer jitter (|stamp interval − period|) and node → listener latency, p50 and p99.
+
+    Of a node with ``parameters`` besides the rate.
+    """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_timing_') as folder:
         data = observe({'rate_hz': f'{rate:.1f}', 'log.folder': folder, **(parameters or {})},
                        seconds, domain_base + DOMAIN_TIMING)
@@ -344,7 +359,7 @@ def rate_text(rate: float | None) -> str:
 
 
 def run(quick: bool, repetitions: int, domain_base: int) -> str:
-    """The node section as markdown."""
+    """Return the node section as markdown."""
     split, times = tick_split(quick, repetitions, domain_base)
     with_logging = times['whole tick, logging on (LinkageNode._tick)']
     ratio = with_logging / times['bare rclpy publish of the same JointState']

@@ -1,4 +1,5 @@
-"""The benchmark report: ``./dev bench`` (= ``python bench/run.py``) from the repository root.
+"""
+The benchmark report: ``./dev bench`` (= ``python bench/run.py``) from the repository root.
 
 Sections: kinematics (cost per configuration against error), drive (the drive law in time),
 node (the ROS node's tick, rates, jitter, latency and log size), cost (the node's CPU side by
@@ -26,7 +27,7 @@ SECTIONS = ('kinematics', 'drive', 'node', 'cost', 'memory')
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true',
                         help='fewer angles, shorter timings and node runs (about a minute)')
     parser.add_argument('--repetitions', type=int, default=None,

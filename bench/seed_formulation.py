@@ -1,4 +1,5 @@
-"""The seed paper's own formulation, transcribed as written, to measure its error.
+"""
+The seed paper's own formulation, transcribed as written, to measure its error.
 
 Not for use anywhere else: its position constraint (Eq. 2, sin α = 1 − cos β) is not a
 consequence of rigid links, and its variable-law accelerations take ω̇ = 4.4 rad/s² from

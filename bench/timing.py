@@ -15,7 +15,8 @@ import numpy as np
 def interleaved_medians(
     workloads: dict[str, Callable[[], int]], repetitions: int
 ) -> dict[str, float]:
-    """Median seconds per configuration of each workload, timed in turn ``repetitions`` times.
+    """
+    Median seconds per configuration of each workload, timed in turn ``repetitions`` times.
 
     Each workload runs once and returns how many configurations it did. Running all of them
     round-robin exposes each to the same drift of a shared machine, so their ratios hold even
@@ -46,7 +47,7 @@ def machine_description() -> str:
 
 
 def format_seconds(seconds: float) -> str:
-    """A duration with a unit that keeps 3 significant digits readable."""
+    """Return a duration with a unit that keeps 3 significant digits readable."""
     if not math.isfinite(seconds):
         return '–'
     for unit, scale in (('s', 1.0), ('ms', 1e-3), ('µs', 1e-6), ('ns', 1e-9)):
@@ -56,14 +57,14 @@ def format_seconds(seconds: float) -> str:
 
 
 def format_error(error: float) -> str:
-    """An error for a table: NaN becomes 'no result'."""
+    """Return an error for a table: NaN becomes 'no result'."""
     if math.isnan(error):
         return 'no result'
     return f'{error:.1e}'
 
 
 def markdown_table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    """A GitHub markdown table."""
+    """Return a GitHub markdown table."""
     lines = ['| ' + ' | '.join(header) + ' |', '|' + '---|' * len(header)]
     lines += ['| ' + ' | '.join(row) + ' |' for row in rows]
     return '\n'.join(lines)

@@ -1,4 +1,5 @@
-"""Measure the library's error near dead points and change points against test/reference.py.
+"""
+Measure the library's error near dead points and change points against test/reference.py.
 
 Run from the repository root:  .venv/bin/python docs/dead_point_accuracy.py
 Prints the tables of docs/kinematics.md:

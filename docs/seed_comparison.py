@@ -1,4 +1,5 @@
-"""The seed paper's numbers beside this package's, for docs/kinematics.md.
+"""
+The seed paper's numbers beside this package's, for docs/kinematics.md.
 
 Run from the repository root:  .venv/bin/python docs/seed_comparison.py
 Prints (1) the seed's Tables 3 and 4 (variable law ω = 0.10 + 2.3·α) beside the exact values at
@@ -34,7 +35,7 @@ LABELS = {'omega': 'ω (rad/s)', 'omega_dot': 'ω̇ (rad/s²)', 'v_a': 'V_A (m/s
 
 
 def with_seed_inputs(degrees: int) -> DriveLaw:
-    """A drive law whose ω and ω̇ at this α are the seed's (ω̇ = k·ω fixes k, then ω0)."""
+    """Return a drive law whose ω and ω̇ at this α are the seed's (ω̇ = k·ω fixes k, then ω0)."""
     omega, omega_dot = SEED[degrees]['omega'], SEED[degrees]['omega_dot']
     k = omega_dot / omega
     return DriveLaw(omega - k * math.radians(degrees), k)

@@ -1,5 +1,7 @@
-"""Start linkage_node with one of the seed's scenarios: ``scenario:=constant`` (default) or
-``scenario:=variable`` (config/seed_<scenario>.yaml).
+"""
+Start linkage_node with one of the seed's scenarios.
+
+``scenario:=constant`` (default) or ``scenario:=variable`` (config/seed_<scenario>.yaml).
 
 Plain launch actions only (no nested substitution lists), so that every Jazzy release of
 launch (3.4.0 and later) loads it.

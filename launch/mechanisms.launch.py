@@ -1,5 +1,7 @@
-"""Start one linkage_node per mechanism of a parameters file: ``mechanisms:=FILE`` (default
-config/two_mechanisms.yaml).
+"""
+Start one linkage_node per mechanism of a parameters file.
+
+``mechanisms:=FILE`` (default config/two_mechanisms.yaml).
 
 Each top-level key of the file, ``/<namespace>/linkage_node``, is one mechanism: a node named
 linkage_node in that namespace, which takes its own entry of the file. Plain launch actions

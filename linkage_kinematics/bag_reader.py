@@ -1,4 +1,5 @@
-"""Read the node's logged runs: rosbag2 MCAP bag folders or bare ``.mcap`` files.
+"""
+Read the node's logged runs: rosbag2 MCAP bag folders or bare ``.mcap`` files.
 
 Every file is read by streaming through its records, never through its summary, so a run that
 was killed (an MCAP with no summary and no footer, its last chunk cut short) reads the same way
@@ -75,12 +76,13 @@ class McapFile:
 
     @property
     def truncated(self) -> bool:
-        """True for a file that ends without its footer (a recorder that was killed)."""
+        """Return True for a file that ends without its footer (a recorder that was killed)."""
         return not self.complete
 
 
 def bag_files(path: str | os.PathLike[str]) -> list[McapFile]:
-    """The MCAP files of a bag folder (in recording order) or the one ``.mcap`` file given.
+    """
+    Return the MCAP files of a bag folder (in recording order) or the one ``.mcap`` file given.
 
     A folder's files are those its ``metadata.yaml`` lists, or every ``*.mcap`` in it when it has
     no ``metadata.yaml`` (a recorder killed before writing one).
@@ -98,7 +100,8 @@ def bag_files(path: str | os.PathLike[str]) -> list[McapFile]:
 def iter_messages(
     path: str | os.PathLike[str], topics: Optional[Collection[str]] = None
 ) -> Iterator[BagMessage]:
-    """Every message of a bag (only those on ``topics`` when given), in file order.
+    """
+    Every message of a bag (only those on ``topics`` when given), in file order.
 
     A truncated file yields its complete messages and then ends; check ``bag_files`` to know.
     """
@@ -115,7 +118,8 @@ def iter_messages(
 
 
 def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]:
-    """The states the node logged on ``linkage/state`` (in any namespace), in file order.
+    """
+    Return the states the node logged on ``linkage/state`` (in any namespace), in file order.
 
     Returns each state's header stamp (int64 ns) and a LinkageState of arrays. The message does
     not carry the transmission angle, so ``transmission_angle`` is all NaN. Other topics are
@@ -163,7 +167,7 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
 
 
 def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
-    """The ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml."""
+    """Return the ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml."""
     metadata_path = Path(folder) / 'metadata.yaml'
     try:
         return yaml.safe_load(metadata_path.read_text(encoding='utf-8'))[
@@ -270,13 +274,16 @@ def _iter_records(files: list[McapFile]) -> Iterator[tuple[Optional[Schema], Cha
 
 
 def _one_line(error: BaseException) -> str:
-    """An error's text on one line (YAML and decoder errors span several)."""
+    """Return an error's text on one line (YAML and decoder errors span several)."""
     return ' '.join(str(error).split())
 
 
 def _state_point(trajectory: Any, where: str) -> Any:
-    """The one point of a decoded ``/linkage/state`` message, checked against the topic contract
-    (the current joint names, or the seven of earlier bags)."""
+    """
+    Return the one point of a decoded ``/linkage/state`` message.
+
+    Checked against the topic contract (the current joint names, or the seven of earlier bags).
+    """
     names = tuple(trajectory.joint_names)
     if names not in (STATE_JOINT_NAMES, SEVEN_STATE_JOINT_NAMES):
         raise BagError(
@@ -299,8 +306,12 @@ def _state_point(trajectory: Any, where: str) -> Any:
 def _state_from_columns(
     positions: np.ndarray, velocities: np.ndarray, accelerations: np.ndarray
 ) -> LinkageState:
-    """Map the message's first seven coordinates (see README, topic ``/linkage/state``) onto
-    LinkageState; the last three (rocker angle, pin arcs) restate them."""
+    """
+    Map the message's first seven coordinates.
+
+    (see README, topic ``/linkage/state``) onto LinkageState; the last three (rocker angle, pin
+    arcs) restate them.
+    """
     return LinkageState(
         alpha=positions[:, 0],
         beta=positions[:, 1],

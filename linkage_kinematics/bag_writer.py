@@ -1,4 +1,5 @@
-"""rosbag2-compatible MCAP bags (Jazzy, metadata version 9) from already-serialized CDR bytes.
+"""
+rosbag2-compatible MCAP bags (Jazzy, metadata version 9) from already-serialized CDR bytes.
 
 A bag is a folder ``<name>/`` holding ``<name>_0.mcap`` and ``metadata.yaml``, as ``ros2 bag
 record -s mcap`` makes it, so ``ros2 bag play <name>``, ``ros2 bag info``, Foxglove, rosbags and
@@ -95,7 +96,11 @@ def _split_type_name(type_name: str) -> tuple[str, str]:
 
 
 def _field_base_type(line: str) -> str | None:
-    """The type a field (or constant) line refers to: ``pkg/Name``, ``Name`` or a primitive."""
+    """
+    Return the type a field (or constant) line refers to.
+
+    It is ``pkg/Name``, ``Name`` or a primitive.
+    """
     code = line.split('#', 1)[0].strip()
     if not code:
         return None
@@ -104,7 +109,8 @@ def _field_base_type(line: str) -> str | None:
 
 @functools.cache
 def message_definition(type_name: str) -> str:
-    """The full ros2msg schema text of ``type_name`` (``pkg/msg/Name``) as rosbag2 stores it.
+    """
+    Return the full ros2msg schema text of ``type_name`` (``pkg/msg/Name``) as rosbag2 stores it.
 
     The root .msg text comes first, then each dependency once, behind an 80-'=' line and a
     ``MSG: pkg/Name`` line. A dependency is named exactly as the referencing field spells it
@@ -150,7 +156,11 @@ def _dependencies(package: str, text: str) -> list[str]:
 
 @functools.cache
 def type_description_hash(type_name: str) -> str:
-    """The RIHS01 type hash rosidl generated for ``type_name``, or '' if it is not installed."""
+    """
+    Return the RIHS01 type hash rosidl generated for ``type_name``.
+
+    '' if it is not installed.
+    """
     package, name = _split_type_name(type_name)
     path = _interface_file(package, name, '.json')
     if path is None:
@@ -172,7 +182,8 @@ class _Topic:
 
 
 class BagWriter:
-    """Writes one rosbag2 MCAP bag folder; see the module docstring for the layout.
+    """
+    Writes one rosbag2 MCAP bag folder; see the module docstring for the layout.
 
     ``metadata`` (the run's parameters, strings) goes into the MCAP metadata record
     ``linkage_kinematics`` and into ``custom_data`` of metadata.yaml, together with
@@ -249,7 +260,10 @@ class BagWriter:
     def add_topic(
         self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str
     ) -> int:
-        """Registers a topic (``type_name`` like ``std_msgs/msg/String``); returns its channel id.
+        """
+        Register a topic (``type_name`` like ``std_msgs/msg/String``).
+
+        Returns its channel id.
 
         ``offered_qos_profiles`` is rosbag2's YAML text of the publisher's QoS list.
         """
@@ -280,7 +294,7 @@ class BagWriter:
         return channel_id
 
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
-        """Appends one serialized (CDR) message; raises BagWriteError if the disk refuses it."""
+        """Append one serialized (CDR) message; raises BagWriteError if the disk refuses it."""
         self._check_writable()
         if channel_id not in self._topics:
             raise ValueError(f'unknown channel id {channel_id} in bag {self.bag_path}')
@@ -291,9 +305,12 @@ class BagWriter:
             self.flush()
 
     def _add_queued(self) -> None:
-        """Hands the queued messages to the MCAP writer's open chunk, in one go: the writer's
-        Python then runs warm, at about a third of its cost per message when called once per
-        message between ticks."""
+        """
+        Hand the queued messages to the MCAP writer's open chunk, in one go.
+
+        The writer's Python then runs warm, at about a third of its cost per message when called
+        once per message between ticks.
+        """
         queued, self._queued = self._queued, []
         add_message = self._writer.add_message
         counts = self._pending_counts
@@ -311,7 +328,7 @@ class BagWriter:
         self._pending_end_ns = max(self._pending_end_ns, *log_times)
 
     def flush(self) -> None:
-        """Ends the open chunk and hands everything to the OS (survives a killed process)."""
+        """End the open chunk and hands everything to the OS (survives a killed process)."""
         self._check_writable()
         if self._queued:
             self._add_queued()
@@ -324,7 +341,8 @@ class BagWriter:
         self._commit_pending()
 
     def close(self) -> None:
-        """Writes the summary (indexes, statistics) and the final metadata.yaml. Idempotent.
+        """
+        Write the summary (indexes, statistics) and the final metadata.yaml. Idempotent.
 
         After a write failure the file is left as it was after the last successful flush
         (readable without summary, see ``recover_bag``) and metadata.yaml gets those counts;
@@ -448,7 +466,8 @@ class RecoveryResult:
 
 
 def recover_bag(bag_path: Path | str) -> RecoveryResult:
-    """Rewrites a bag's MCAP file with summary, indexes and true counts (e.g. after SIGKILL).
+    """
+    Rewrites a bag's MCAP file with summary, indexes and true counts (e.g. after SIGKILL).
 
     Every message of every complete record is kept with its topic and times; a partly written
     last chunk is dropped. Topics, types, QoS and the run's metadata come from the bag's

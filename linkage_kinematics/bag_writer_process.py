@@ -1,4 +1,5 @@
-"""A BagWriter in a process of its own, so that a node's timer never waits for the MCAP writer.
+"""
+A BagWriter in a process of its own, so that a node's timer never waits for the MCAP writer.
 
 The Python mcap writer stops for 4–15 ms each time it ends a chunk (it writes the chunk's
 message index entry by entry); at a 5 kHz timer that is 20–75 ticks. In a thread it would
@@ -52,9 +53,12 @@ CLOSE_TIMEOUT = 60.0  # s for the child to write the summary once the pipe is cl
 
 
 def set_process_affinity(pid: int, cpus: Set[int]) -> None:
-    """Let every thread of process ``pid`` run only on ``cpus`` (threads it starts later
-    inherit their starter's CPUs). A process that has ended meanwhile is left alone: whoever
-    waits for it learns how it ended."""
+    """
+    Let every thread of process ``pid`` run only on ``cpus``.
+
+    (threads it starts later inherit their starter's CPUs). A process that has ended meanwhile is
+    left alone: whoever waits for it learns how it ended.
+    """
     try:
         threads = os.listdir(f'/proc/{pid}/task')
     except FileNotFoundError:
@@ -67,8 +71,11 @@ def set_process_affinity(pid: int, cpus: Set[int]) -> None:
 
 
 class BagWriterProcess:
-    """The node's handle on a ``BagWriter`` in a child process: a new bag folder in
-    ``folder`` named after the local time (``rosbag2_%Y_%m_%d-%H_%M_%S``, ``_1``, … if taken).
+    """
+    The node's handle on a ``BagWriter`` in a child process.
+
+    A new bag folder in ``folder`` named after the local time (``rosbag2_%Y_%m_%d-%H_%M_%S``,
+    ``_1``, … if taken).
 
     Errors of the child's writer come back as BagWriteError from the next ``write`` (or
     ``close``) after the child reported them. ``cpus``, if given, are the CPUs the child may
@@ -127,8 +134,11 @@ class BagWriterProcess:
             self._send_queued()
 
     def close(self) -> None:
-        """Hands over what is queued, lets the child finish the bag and waits for it.
-        Idempotent; raises BagWriteError if the bag could not be finished."""
+        """
+        Hand over what is queued, lets the child finish the bag and waits for it.
+
+        Idempotent; raises BagWriteError if the bag could not be finished.
+        """
         if self._closed:
             return
         self._closed = True
@@ -182,7 +192,7 @@ class BagWriterProcess:
             raise BagWriteError(self._failure) from None
 
     def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
-        """Sends a frame and waits for the child's answer to it."""
+        """Send a frame and waits for the child's answer to it."""
         self._send(kind, json.dumps(payload).encode('utf-8'))
         os.set_blocking(self._process.stdout.fileno(), True)
         line = self._process.stdout.readline()
@@ -217,7 +227,7 @@ class BagWriterProcess:
 
 
 def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
-    """A new bag folder in ``folder``, named as ``ros2 bag record`` names it."""
+    """Return a new bag folder in ``folder``, named as ``ros2 bag record`` names it."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:

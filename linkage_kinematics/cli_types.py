@@ -1,4 +1,5 @@
-"""argparse value types shared by the command-line tools.
+"""
+Argparse value types shared by the command-line tools.
 
 Each refusal names the rule the value broke, so that argparse prints one line such as
 ``argument --rows: must be at least 1, got '0'`` instead of a traceback.
@@ -18,8 +19,12 @@ def number(
     at_least: float | None = None,
     rule: str = '',
 ) -> Callable[[str], float]:
-    """A type converting text to a finite ``kind`` (float or int) greater than ``above`` or at
-    least ``at_least`` when given; ``rule`` says the bound in the error message."""
+    """
+    Return a type converting text to a finite ``kind``.
+
+    (float or int) greater than ``above`` or at least ``at_least`` when given; ``rule`` says the
+    bound in the error message.
+    """
     noun = 'a whole number' if kind is int else 'a number'
 
     def convert(text: str) -> float:

@@ -1,4 +1,5 @@
-"""``linkage-demo``: the seed's numerical experiments, run through the real node and logged.
+"""
+``linkage-demo``: the seed's numerical experiments, run through the real node and logged.
 
 Runs ``linkage_node`` once per drive law of the paper (constant ω = 2 rad/s, and
 ω = 0.10 + 2.3·α) over the 90° turn in the seed's fixed steps of 0.5°, each step published when
@@ -45,7 +46,7 @@ def _run_node(params_file: Path, log_folder: Path) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``linkage-demo``."""
-    parser = argparse.ArgumentParser(prog='linkage-demo', description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog='linkage-demo', description=__doc__.strip().splitlines()[0])
     parser.add_argument('--log-folder', type=Path, default=Path('bags'),
                         help='folder that receives one new bag per run (default: bags)')
     parser.add_argument('--rows', type=number(int, at_least=1, rule='at least 1'), default=2,

@@ -1,4 +1,5 @@
-"""The crank's drive law ω = ω0 + k·α and its exact flow in time.
+"""
+The crank's drive law ω = ω0 + k·α and its exact flow in time.
 
 With ω = dα/dt = ω0 + k·α the crank angle follows, from α_s at t = 0,
 

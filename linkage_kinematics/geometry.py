@@ -1,4 +1,5 @@
-"""Geometry of a planar four-bar linkage: validation, presets and reachability.
+"""
+Geometry of a planar four-bar linkage: validation, presets and reachability.
 
 Conventions (the seed paper's, used everywhere in this package):
 
@@ -54,7 +55,7 @@ class UnreachableError(ValueError):
 
 
 def _is_real(value: object) -> bool:
-    """An int or float, but not a bool (which Python counts as an int)."""
+    """Return an int or float, but not a bool (which Python counts as an int)."""
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
@@ -71,7 +72,8 @@ def format_interval(interval: tuple[float, float]) -> str:
 
 @dataclass(frozen=True)
 class Reachability:
-    """Where the crank of a mechanism can go.
+    """
+    Where the crank of a mechanism can go.
 
     ``intervals`` are the closed crank-angle intervals (rad) where the loop closes, each written
     with its centre in (−π, π] and repeating every 2π. ``dead_points`` are the interval ends,
@@ -85,11 +87,11 @@ class Reachability:
 
     @property
     def full_rotation(self) -> bool:
-        """True when the crank can turn all the way round."""
+        """Return True when the crank can turn all the way round."""
         return not self.dead_points
 
     def interval_containing(self, alpha: float) -> tuple[float, float] | None:
-        """The interval that holds ``alpha`` (modulo 2π), or None."""
+        """Return the interval that holds ``alpha`` (modulo 2π), or None."""
         for low, high in self.intervals:
             past_low = (alpha - low) % TWO_PI
             if past_low <= high - low + ANGLE_TOLERANCE or past_low >= TWO_PI - ANGLE_TOLERANCE:
@@ -97,13 +99,17 @@ class Reachability:
         return None
 
     def describe(self) -> str:
-        """The reachable set in degrees, for messages."""
+        """Return the reachable set in degrees, for messages."""
         if self.full_rotation:
             return 'all crank angles (full rotation)'
         return ' and '.join(format_interval(interval) for interval in self.intervals)
 
     def require(self, alpha: float) -> tuple[float, float]:
-        """Return the interval holding ``alpha`` or raise UnreachableError naming the reachable set."""
+        """
+        Return the interval holding ``alpha``.
+
+        Raise UnreachableError naming the reachable set where none does.
+        """
         interval = self.interval_containing(alpha)
         if interval is None:
             raise UnreachableError(
@@ -113,20 +119,27 @@ class Reachability:
         return interval
 
     def dead_point_distance(self, alpha: float) -> float | None:
-        """Crank-angle distance (rad) from ``alpha`` to the nearest dead point (mod 2π).
+        """
+        Crank-angle distance (rad) from ``alpha`` to the nearest dead point (mod 2π).
 
         None when the crank turns fully (a linkage without dead points).
         """
         return _nearest(self.dead_points, alpha)
 
     def change_point_distance(self, alpha: float) -> float | None:
-        """Crank-angle distance (rad) from ``alpha`` to the nearest change point (mod 2π), where
-        the two assemblies meet and the motion continues smoothly; None if there is none."""
+        """
+        Crank-angle distance (rad) from ``alpha`` to the nearest change point (mod 2π).
+
+        Where the two assemblies meet and the motion continues smoothly; None if there is none.
+        """
         return _nearest(self.change_points, alpha)
 
     def first_dead_point(self, alpha_from: float, alpha_to: float) -> float | None:
-        """The first dead point the crank meets turning from ``alpha_from`` to ``alpha_to``
-        (``alpha_to`` included), as an unwrapped crank angle; None if the way is clear.
+        """
+        Return the first dead point the crank meets turning from ``alpha_from`` to ``alpha_to``.
+
+        ``alpha_to`` is included; the dead point is an unwrapped crank angle, None if the way is
+        clear.
 
         Change points do not stop the crank (it continues through them on its smooth branch,
         see ``kinematics.continued_branch``), so they are not counted here.
@@ -192,7 +205,7 @@ class FourBar:
         return lengths[0] + lengths[3] <= (lengths[1] + lengths[2]) * (1.0 + TOUCH_TOLERANCE)
 
     def scaled(self, factor: float) -> FourBar:
-        """The same mechanism with every length multiplied by ``factor``."""
+        """Return the same mechanism with every length multiplied by ``factor``."""
         return FourBar(
             self.crank_length * factor,
             self.coupler_length * factor,
@@ -227,7 +240,7 @@ _PI = Decimal('3.141592653589793238462643383279502884197169399375105820974944592
 
 
 def _cos_sin(angle: Decimal) -> tuple[Decimal, Decimal]:
-    """cos and sin of a decimal angle of a few radians, by their Taylor series."""
+    """Cos and sin of a decimal angle of a few radians, by their Taylor series."""
     cosine = sine = Decimal(0)
     term = Decimal(1)
     tiny = Decimal(10) ** -(_DIGITS + 5)
@@ -259,14 +272,15 @@ def _atan2(y: Decimal, x: Decimal) -> Decimal:
 
 
 def _split(value: Decimal) -> tuple[float, float]:
-    """The nearest float and the float nearest to what it leaves over (a double-double)."""
+    """Return the nearest float and the float nearest to what it leaves over (a double-double)."""
     high = float(value)
     return high, float(value - Decimal(high))
 
 
 @dataclass(frozen=True)
 class LoopFactor:
-    """One factor of Heron's product, and the form it is evaluated in (see the comment above).
+    """
+    One factor of Heron's product, and the form it is evaluated in (see the comment above).
 
     ``kind`` is ``_PLAIN`` (from d; ``length`` is AB + BC or |AB − BC|), ``_ROOTS`` (two dead
     points ``first`` and ``second``, double-doubles) or ``_TOUCH`` (``gap`` + 4·OA·OC·sin²(½(α −
@@ -286,7 +300,8 @@ class LoopFactor:
 
 @dataclass(frozen=True)
 class LoopClosure:
-    """Constants of the loop-closure evaluation of one linkage, computed once.
+    """
+    Constants of the loop-closure evaluation of one linkage, computed once.
 
     ``stretched`` and ``folded`` are the two factors; ``scale`` = 4·OA·OC; ``ground`` = OC;
     ``squares`` = AB² − BC²; ``direction`` is α₀ and ``opposite`` α₀ + π (double-doubles), the
@@ -321,7 +336,11 @@ def _closure_constants(linkage: FourBar, closure: LoopClosure) -> LoopClosure:
 
 
 def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
-    """The factors of the loop closure and the reachable crank angles, from exact arithmetic."""
+    """
+    Return the factors of the loop closure and the reachable crank angles.
+
+    Both come from exact arithmetic.
+    """
     with localcontext() as context:
         context.prec = _DIGITS
         r = Decimal(linkage.crank_length)
@@ -360,8 +379,11 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
 
         def factor(cosine: Decimal, bound: int, touch_at: Decimal, length: Decimal
                    ) -> LoopFactor:
-            """The factor that vanishes where cos φ = ``cosine`` and whose extreme over a turn
-            is at cos φ = ``bound``."""
+            """
+            Return the factor that vanishes where cos φ = ``cosine``.
+
+            Its extreme over a turn is at cos φ = ``bound``.
+            """
             if abs(cosine - bound) <= TOUCH_TOLERANCE:
                 return LoopFactor(_TOUCH, float(length), _split(touch_at))
             gap = product * (cosine - bound) * bound  # the factor's least value over a turn

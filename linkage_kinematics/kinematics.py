@@ -1,4 +1,5 @@
-"""Exact positions, rates and accelerations of the four-bar, for one α or for arrays of α.
+"""
+Exact positions, rates and accelerations of the four-bar, for one α or for arrays of α.
 
 Positions come from loop closure: B is where the circle of radius AB about A meets the circle of
 radius BC about C. With d = |C − A|, u the unit vector A→C and u⊥ it turned by +90°,
@@ -70,7 +71,8 @@ class DeadPointError(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class LinkageState:
-    """Everything the seed tabulates and plots, for one configuration or an array of them.
+    """
+    Everything the seed tabulates and plots, for one configuration or an array of them.
 
     Angles in rad (seed conventions, see ``geometry``), angular rates counterclockwise-positive
     in rad/s and rad/s², pin coordinates in m, velocities in m/s, accelerations in m/s², all in
@@ -111,12 +113,13 @@ class LinkageState:
         return np.hypot(self.velocity_b_x, self.velocity_b_y)
 
     def at(self, index: int) -> LinkageState:
-        """The configuration at ``index`` of an array state, as a state of floats."""
+        """Return the configuration at ``index`` of an array state, as a state of floats."""
         return LinkageState(*(float(getattr(self, f.name)[index]) for f in fields(self)))
 
 
 class _StateBuilder:
-    """Storage laid out like LinkageState, filled by plain slot stores, then turned into one.
+    """
+    Storage laid out like LinkageState, filled by plain slot stores, then turned into one.
 
     A frozen dataclass sets each field through object.__setattr__, which for 22 fields costs
     more than the closed form's arithmetic; ``solve`` builds its result this way instead.
@@ -147,13 +150,15 @@ _NEAR_HALF_SINE = 0.25
 
 def _corrected_half_sine(alpha: FloatOrArray, point: tuple[float, float], difference: FloatOrArray,
                          value: FloatOrArray, sin: Callable) -> FloatOrArray:
-    """sin(½(α − a)) for a singular angle a (a double-double), given ``value`` =
-    sin(½((α − a_high) − a_low)) and ``difference`` = α − a_high: to rounding of the result even
-    where it vanishes. Within half a turn of a, ``value`` carries only the rounding of the
-    result; near another turn's image of a, α − a − 2π·k is taken exactly instead (Dekker's
-    product for 2π·k), so that the sine keeps its sign and relative accuracy next to the zero
-    after many turns too. Call it for a float only where -π ≤ difference ≤ π fails and
-    |value| < _NEAR_HALF_SINE.
+    """
+    sin(½(α − a)) for a singular angle a (a double-double).
+
+    Given ``value`` = sin(½((α − a_high) − a_low)) and ``difference`` = α − a_high: to rounding of
+    the result even where it vanishes. Within half a turn of a, ``value`` carries only the rounding
+    of the result; near another turn's image of a, α − a − 2π·k is taken exactly instead (Dekker's
+    product for 2π·k), so that the sine keeps its sign and relative accuracy next to the zero after
+    many turns too. Call it for a float only where -π ≤ difference ≤ π fails and |value| <
+    _NEAR_HALF_SINE.
     """
     if isinstance(value, np.ndarray):
         near = (np.abs(value) < _NEAR_HALF_SINE) & (np.abs(difference) > math.pi)
@@ -181,9 +186,11 @@ def _half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) -
 def _exact_factors(
     closure: LoopClosure, alpha: FloatOrArray, distance: FloatOrArray, xp: MathFunctions
 ) -> tuple[FloatOrArray, FloatOrArray, FloatOrArray, FloatOrArray | None]:
-    """Heron's two factors (AB + BC)² − d² and d² − (AB − BC)², each in the form
-    geometry.LoopFactor names: from d; from the offsets to its two dead points a₁, a₂ as
-    ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as gap + 4·OA·OC·sin²(½(α − a)).
+    """
+    Heron's two factors (AB + BC)² − d² and d² − (AB − BC)².
+
+    Each in the form geometry.LoopFactor names: from d; from the offsets to its two dead points a₁,
+    a₂ as ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as gap + 4·OA·OC·sin²(½(α − a)).
 
     Also whether the loop closes (a touching factor is ≥ 0 by construction, 0 at a change point,
     where the loop closes) and the least |sin(½(α − a))| over the dead points a (for a float,
@@ -243,7 +250,10 @@ def _smooth_rate_terms(
     folded: FloatOrArray, distance_squared: FloatOrArray, distance: FloatOrArray,
     xp: MathFunctions,
 ) -> tuple[FloatOrArray, ...]:
-    """p − OA, q, Q = q/h and dQ/dα of a change-point linkage, analytic through its change points.
+    """
+    P − OA, q, Q = q/h and dQ/dα of a change-point linkage.
+
+    Analytic through its change points.
 
     With p = C·â and q = C·â⊥ (â = A/OA, â⊥ its derivative in α), the rates are
     dγ/dα = −OA·((p − OA) + (x − d)·Q)/d² with Q = q/h (``_closed_form``). At a change point
@@ -305,9 +315,12 @@ def _closed_form(
     linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, drive: DriveLaw | None,
     xp: MathFunctions,
 ) -> tuple[FloatOrArray, ...]:
-    """Evaluate the closed form: the 22 LinkageState fields in order, then S = sin μ (signed),
-    whether the loop closes (both factors > 0, or a change factor ≥ 0), and the smallest
-    |sin(½(α − a))| over the dead points a (None without dead points or far from them).
+    """
+    Evaluate the closed form.
+
+    The 22 LinkageState fields in order, then S = sin μ (signed), whether the loop closes (both
+    factors > 0, or a change factor ≥ 0), and the smallest |sin(½(α − a))| over the dead points a
+    (None without dead points or far from them).
 
     With ``drive`` None, only the positions: α, β, γ, pin A, pin B, μ, then the same three.
     ``xp`` is (sin, cos, sqrt, atan2, abs) from ``math`` or ``numpy``.
@@ -454,8 +467,12 @@ def _check_branch(branch: int) -> None:
 
 
 def _too_close(alpha: float, nearest_dead: float | None) -> bool:
-    """Whether α is so close to a dead point that a one-ulp change of α moves the exact
-    accelerations by more than RATE_ACCURACY (they grow as δ^(−3/2): by 1.5·ulp(α)/δ)."""
+    """
+    Tell whether α is too close to a dead point for float64.
+
+    It is when a one-ulp change of α moves the exact accelerations by more than RATE_ACCURACY
+    (they grow as δ^(−3/2): by 1.5·ulp(α)/δ).
+    """
     # nearest_dead = |sin(½δ)| ≈ ½δ
     return nearest_dead is not None and 1.5 * math.ulp(alpha) > RATE_ACCURACY * 2.0 * nearest_dead
 
@@ -499,9 +516,12 @@ def _check_closure(linkage: FourBar, alpha: float, closes: bool,
 
 
 def _refuse(linkage: FourBar, alpha: float) -> ValueError:
-    """The error for an α where the loop does not close: UnreachableError for a non-finite α or
-    outside the reachable set (with its tolerance), DeadPointError at an interval end or with
-    pin A on the pivot C."""
+    """
+    Return the error for an α where the loop does not close.
+
+    UnreachableError for a non-finite α or outside the reachable set (with its tolerance),
+    DeadPointError at an interval end or with pin A on the pivot C.
+    """
     if not math.isfinite(alpha):
         return UnreachableError(f'crank angle α must be finite, got {alpha!r}')
     if linkage.closure.passes_through_pivot:
@@ -519,7 +539,8 @@ def _refuse(linkage: FourBar, alpha: float) -> ValueError:
 def solve(
     linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1
 ) -> LinkageState:
-    """The exact state at one crank angle (the node's hot path).
+    """
+    Return the exact state at one crank angle (the node's hot path).
 
     ``branch`` is the side of B relative to the line A→C at this α (+1 left, −1 right); at a
     change point itself, where the sides meet, the side just counterclockwise of it. To follow a
@@ -589,7 +610,8 @@ class LinkagePose:
 
 
 def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
-    """The positions alone at one crank angle, at a dead point too (where ``solve`` raises).
+    """
+    Return the positions alone at one crank angle, at a dead point too (where ``solve`` raises).
 
     ``branch`` as in ``solve``. Raises UnreachableError outside the reachable set.
     """
@@ -608,7 +630,8 @@ def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
 def solve_many(
     linkage: FourBar, alpha: np.ndarray, drive: DriveLaw, branch: int | np.ndarray = 1
 ) -> LinkageState:
-    """The exact states at an array of crank angles, as a LinkageState of arrays.
+    """
+    Return the exact states at an array of crank angles, as a LinkageState of arrays.
 
     ``branch`` is one side for all angles or an array of sides, one per angle (as
     ``continued_branch`` gives for a motion through change points). Raises, naming the first
@@ -641,7 +664,7 @@ def solve_many(
 def _raise_at_first_refusal(
     linkage: FourBar, alpha: np.ndarray, closes: np.ndarray, nearest_dead: np.ndarray | None
 ) -> None:
-    """The error ``solve`` would raise at the first α it refuses, if any."""
+    """Return the error ``solve`` would raise at the first α it refuses, if any."""
     closes = np.broadcast_to(closes, alpha.shape)
     refused = ~closes
     if nearest_dead is not None:
@@ -670,8 +693,10 @@ def reachable_mask(linkage: FourBar, alpha: np.ndarray) -> np.ndarray:
 def continued_branch(
     linkage: FourBar, alpha_from: float, branch: int, alpha_to: FloatOrArray, turns: int = 0
 ) -> int | np.ndarray:
-    """The branch at ``alpha_to`` + 2π·``turns`` of a motion that has ``branch`` at
-    ``alpha_from`` and turns the crank smoothly from there.
+    """
+    Return the branch at ``alpha_to`` + 2π·``turns`` of a smooth motion.
+
+    The motion has ``branch`` at ``alpha_from`` and turns the crank smoothly from there.
 
     Away from change points B stays on its side of the line A→C; through a change point the
     mechanism continues on the analytic branch (a parallelogram stays a parallelogram), and
@@ -700,7 +725,7 @@ _SPLITTER = 134217729.0  # 2^27 + 1, Veltkamp's splitting constant for doubles
 
 
 def _two_sum(a: FloatOrArray, b: FloatOrArray) -> tuple[FloatOrArray, FloatOrArray]:
-    """a + b as a double-double (Knuth): the rounded sum and its exact rounding error."""
+    """Return a + b as a double-double (Knuth): the rounded sum and its exact rounding error."""
     total = a + b
     b_part = total - a
     return total, (a - (total - b_part)) + (b - b_part)
@@ -729,8 +754,12 @@ def _offset(alpha: FloatOrArray, point: tuple[float, float], turns: FloatOrArray
 
 
 def _turns_past(alpha: FloatOrArray, point: tuple[float, float]) -> FloatOrArray:
-    """The largest k with point + 2π·k ≤ α: how many images of the point lie at or below α,
-    up to a constant. Exact near the images, where a rounded (α − point)/2π could be off by one."""
+    """
+    Return the largest k with point + 2π·k ≤ α.
+
+    How many images of the point lie at or below α, up to a constant. Exact near the images, where
+    a rounded (α − point)/2π could be off by one.
+    """
     turns = np.floor((alpha - point[0]) / TWO_PI)
     if isinstance(alpha, np.ndarray):
         turns = turns + (_offset(alpha, point, turns + 1.0) >= 0.0)

@@ -1,4 +1,5 @@
-"""ROS messages built from a LinkageState: the node's topics, reusable by benchmarks and tools.
+"""
+ROS messages built from a LinkageState: the node's topics, reusable by benchmarks and tools.
 
 Each builder is a plain function of the library's state (plus a stamp); none computes any
 kinematics. The node does not build its per-tick messages and the scene: their encoders
@@ -48,12 +49,12 @@ PIVOT_COLOR = _color(0.15, 0.15, 0.15)
 
 
 def time_msg(nanoseconds: int) -> Time:
-    """A builtin_interfaces/Time from integer nanoseconds."""
+    """Return a builtin_interfaces/Time from integer nanoseconds."""
     return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
 
 
 def duration_msg(seconds: float) -> Duration:
-    """A builtin_interfaces/Duration from (non-negative) seconds."""
+    """Return a builtin_interfaces/Duration from (non-negative) seconds."""
     sec, nanosec = duration_fields(seconds)
     return Duration(sec=sec, nanosec=nanosec)
 
@@ -70,7 +71,8 @@ def _stamp_paths(prefix: str) -> list[str]:
 def joint_positions(
     state: LinkageState, previous: Sequence[float] = (0.0, 0.0, 0.0)
 ) -> tuple[float, float, float]:
-    """URDF joint positions (crank, coupler, rocker) = (α, γ − α, −β − γ) in rad.
+    """
+    URDF joint positions (crank, coupler, rocker) = (α, γ − α, −β − γ) in rad.
 
     The coupler and rocker positions are shifted by whole turns to lie within π of
     ``previous`` (the last published positions), so a stream of them is continuous.
@@ -108,7 +110,11 @@ class JointStateEncoder:
         self._encoder = FixedShapeEncoder(template, [*_stamp_paths(''), 'position', 'velocity'])
 
     def encode(self, state: LinkageState, stamp_ns: int, positions: Sequence[float]) -> bytes:
-        """``positions`` are ``joint_positions`` of ``state``, unwrapped as the caller keeps them."""
+        """
+        ``positions`` are ``joint_positions`` of ``state``.
+
+        Unwrapped as the caller keeps them.
+        """
         return self._encoder.encode(
             (*divmod(stamp_ns, 1_000_000_000), *positions, *joint_velocities(state))
         )
@@ -117,8 +123,11 @@ class JointStateEncoder:
 def state_coordinates(
     linkage: FourBar, state: LinkageState
 ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-    """The positions, velocities and accelerations of ``STATE_JOINT_NAMES`` (see
-    ``linkage_state``)."""
+    """
+    Return the positions.
+
+    Velocities and accelerations of ``STATE_JOINT_NAMES`` (see ``linkage_state``).
+    """
     crank = linkage.crank_length
     rocker = linkage.rocker_length
     return (
@@ -148,7 +157,8 @@ def linkage_state(
     motion_time: float,
     frame_id: str,
 ) -> JointTrajectory:
-    """/linkage/state: the full state as one trajectory point (see README, "Topics").
+    """
+    /linkage/state: the full state as one trajectory point (see README, "Topics").
 
     ``positions``, ``velocities`` and ``accelerations`` hold each coordinate of
     ``STATE_JOINT_NAMES`` and its first and second time derivatives: α, β, γ, A_x, A_y, B_x,
@@ -171,8 +181,11 @@ def linkage_state(
 
 
 class LinkageStateEncoder:
-    """The bytes of ``linkage_state`` (encode_cdr) of one linkage and frame, straight from a
-    state."""
+    """
+    The bytes of ``linkage_state`` (encode_cdr) of one linkage and frame.
+
+    Straight from a state.
+    """
 
     def __init__(self, linkage: FourBar, frame_id: str) -> None:
         self._linkage = linkage
@@ -203,8 +216,11 @@ def _marker(marker_id: int, marker_type: int, frame_id: str, color: ColorRGBA) -
 
 
 def disk_orientation(state: LinkageState) -> tuple[float, float]:
-    """(z, w) of the disk's quaternion: the disk is symmetric about O, and turning it shows the
-    crank angle on the disk itself."""
+    """
+    (z, w) of the disk's quaternion.
+
+    The disk is symmetric about O, and turning it shows the crank angle on the disk itself.
+    """
     return math.sin(0.5 * state.alpha), math.cos(0.5 * state.alpha)
 
 
@@ -214,8 +230,12 @@ def marker_array(
     stamp: Time,
     frame_id: str,
 ) -> MarkerArray:
-    """/linkage/markers: disk (CYLINDER at O), the three bars (one LINE_LIST coloured per bar),
-    pins A and B (SPHEREs) and the ground pivots O and C (CUBEs), in namespace ``linkage``."""
+    """
+    /linkage/markers.
+
+    Disk (CYLINDER at O), the three bars (one LINE_LIST coloured per bar), pins A and B (SPHEREs)
+    and the ground pivots O and C (CUBEs), in namespace ``linkage``.
+    """
     message = _new_marker_array(linkage, frame_id)
     disk, bars, pin_a, pin_b, pivot_o, pivot_c = message.markers
     pin_a_point = Point(x=state.pin_a_x, y=state.pin_a_y)
@@ -233,8 +253,11 @@ def marker_array(
 
 
 class MarkerArrayEncoder:
-    """The bytes of ``marker_array`` (encode_cdr) of one linkage and frame, straight from a
-    state."""
+    """
+    The bytes of ``marker_array`` (encode_cdr) of one linkage and frame.
+
+    Straight from a state.
+    """
 
     _PIN_A_PATHS = (f'markers[{BARS_ID}].points[1]', f'markers[{BARS_ID}].points[2]',
                     f'markers[{PIN_A_ID}].pose.position')

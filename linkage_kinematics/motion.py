@@ -1,4 +1,7 @@
-"""The motion: pure functions from node-clock time or a step index to the crank angle to solve at.
+"""
+The motion.
+
+Pure functions from node-clock time or a step index to the crank angle to solve at.
 
 A RunConfiguration fixes one pass of the crank (alpha_start to ``segment_end``); these functions
 say where the crank is in it, how passes follow each other under each end behaviour, and what the
@@ -17,11 +20,14 @@ from linkage_kinematics.parameters import RunConfiguration
 
 @dataclass(frozen=True)
 class MotionSample:
-    """Where the motion is: the crank angle of the first pass to solve at, whether that pass
-    plays backwards (bounce), the whole turns to add to the published α (loop over whole turns),
-    the drive-law time since the motion left alpha_start (s), whether this is the final
-    state of a 'stop' motion, and how many passes have ended before this one (for bounce the
-    forward passes are the even ones)."""
+    """
+    Where the motion is.
+
+    The crank angle of the first pass to solve at, whether that pass plays backwards (bounce), the
+    whole turns to add to the published α (loop over whole turns), the drive-law time since the
+    motion left alpha_start (s), whether this is the final state of a 'stop' motion, and how many
+    passes have ended before this one (for bounce the forward passes are the even ones).
+    """
 
     alpha: float
     is_reversed: bool = False
@@ -39,7 +45,8 @@ def _clamp_to_segment(config: RunConfiguration, alpha: float) -> float:
 
 
 def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | None:
-    """The motion ``elapsed`` seconds after it started (real_time mode).
+    """
+    Return the motion ``elapsed`` seconds after it started (real_time mode).
 
     None when a 'stop' motion has reached a dead point before alpha_end: the crank cannot go on.
     """
@@ -82,7 +89,8 @@ def _step_alpha(config: RunConfiguration, index: int) -> float:
 
 
 def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
-    """The motion at tick ``step`` (fixed_step mode): α = alpha_start + n·alpha_step exactly.
+    """
+    Return the motion at tick ``step`` (fixed_step mode): α = alpha_start + n·alpha_step exactly.
 
     One pass visits the ``step_count`` steps before its end and then alpha_end itself (not a
     dead point, which has no state). None as in ``sample_at_time``.
@@ -125,7 +133,7 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
 
 
 def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState:
-    """The library's state for a motion sample (raises as ``kinematics.solve``)."""
+    """Return the library's state for a motion sample (raises as ``kinematics.solve``)."""
     drive = config.reverse_drive if sample.is_reversed else config.drive
     # `branch` names the assembly at alpha_start; through change points the mechanism goes on
     # on its smooth branch, which after an odd number of them is the other side.
@@ -140,7 +148,7 @@ def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState
 
 
 def blocked_note(config: RunConfiguration) -> str | None:
-    """What happens at a dead point that lies before alpha_end; None if there is none."""
+    """Return what happens at a dead point that lies before alpha_end; None if there is none."""
     if config.blocked_at is None:
         return None
     outcome = {
@@ -155,9 +163,12 @@ def blocked_note(config: RunConfiguration) -> str | None:
 
 
 def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: int) -> bool:
-    """Whether the crank met the dead point that cuts a pass short (``blocked_at``) between a
-    sample of pass ``previous_pass`` and one of pass ``current_pass``: 'loop' meets it at the
-    end of every pass, 'bounce' at the end of every forward (even) pass."""
+    """
+    Whether the crank met the dead point that cuts a pass short.
+
+    (``blocked_at``) between a sample of pass ``previous_pass`` and one of pass ``current_pass``:
+    'loop' meets it at the end of every pass, 'bounce' at the end of every forward (even) pass.
+    """
     if config.blocked_at is None or current_pass <= previous_pass:
         return False
     if config.end_behavior == 'bounce':
@@ -166,7 +177,7 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
 
 
 def dead_point_problem(config: RunConfiguration) -> str:
-    """The ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
+    """Return the ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
     outcome = {
         'stop': 'stops; the run cannot go on',
         'loop': 'restarts from alpha_start',

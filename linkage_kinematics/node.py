@@ -1,4 +1,7 @@
-"""``linkage_node``: turns the disk under the drive law and publishes the linkage's exact state.
+"""
+``linkage_node``.
+
+Turns the disk under the drive law and publishes the linkage's exact state.
 
 A thin shell over two pure modules: ``parameters`` validates the parameter values into a frozen
 RunConfiguration, ``motion`` maps node-clock time or a step index to the crank angle to solve
@@ -81,7 +84,7 @@ ROBOT_DESCRIPTION_QOS = QoSProfile(
 
 
 def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
-    """The ROS descriptor of a parameter (its range only ``with_range``)."""
+    """Return the ROS descriptor of a parameter (its range only ``with_range``)."""
     # dynamic_typing lets a wrongly typed value reach build_configuration, whose message
     # names the parameter; rclpy's own type check does not.
     descriptor = ParameterDescriptor(
@@ -104,8 +107,12 @@ def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> Parame
 def assess(
     config: RunConfiguration, state: LinkageState | None, problem: str | None, activity: str
 ) -> tuple[bytes, str]:
-    """Diagnostic level and message: ERROR for ``problem`` (the crank cannot go on, or the log
-    failed), WARN near a dead point or at a poor transmission angle, else OK with ``activity``."""
+    """
+    Diagnostic level and message.
+
+    ERROR for ``problem`` (the crank cannot go on, or the log failed), WARN near a dead point or at
+    a poor transmission angle, else OK with ``activity``.
+    """
     if problem is not None:
         return DiagnosticStatus.ERROR, problem
     if state is None:
@@ -139,8 +146,10 @@ def assess(
 
 
 class LinkageNode(Node):
-    """Publishes the linkage's state as the drive law moves the crank, markers at
-    display_rate_hz, diagnostics at 1 Hz and whenever the motion's activity changes.
+    """
+    Publishes the linkage's state as the drive law moves the crank.
+
+    Markers at display_rate_hz, diagnostics at 1 Hz and whenever the motion's activity changes.
 
     Construction raises ConfigurationError for bad parameters before anything is published or
     written. ``exit_code`` becomes an int when the node has finished (see README).
@@ -246,13 +255,16 @@ class LinkageNode(Node):
         return specs
 
     def parameter_values(self) -> dict[str, Any]:
-        """Current values of the node's own parameters (name → value)."""
+        """Return the current values of the node's own parameters (name → value)."""
         return {name: self.get_parameter(name).value for name in PARAMETER_NAMES}
 
     @staticmethod
     def _keep_declared_types(changed: list[Parameter]) -> list[Parameter]:
-        """Whole numbers given for real parameters become those reals, so that a parameter
-        never changes type (`ros2 param set /linkage_node rate_hz 50`)."""
+        """
+        Whole numbers given for real parameters become those reals.
+
+        So that a parameter never changes type (`ros2 param set /linkage_node rate_hz 50`).
+        """
         return [
             Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
             if p.name in REAL_PARAMETERS and p.type_ == Parameter.Type.INTEGER
@@ -261,8 +273,11 @@ class LinkageNode(Node):
         ]
 
     def _validate_change(self, changed: list[Parameter]) -> SetParametersResult:
-        """Validate the whole configuration the change would produce; keep it for the post-set
-        callback, which swaps it in once rclpy has stored the values."""
+        """
+        Validate the whole configuration the change would produce.
+
+        Keep it for the post-set callback, which swaps it in once rclpy has stored the values.
+        """
         current = self.parameter_values()
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
@@ -308,7 +323,7 @@ class LinkageNode(Node):
     # placement
 
     def _check_cpu(self, cpu: int) -> None:
-        """ConfigurationError naming cpu_affinity unless this process may be pinned to ``cpu``."""
+        """Raise ConfigurationError naming cpu_affinity unless this process may use ``cpu``."""
         if cpu == NO_CPU_AFFINITY:
             return
         if not hasattr(os, 'sched_setaffinity'):
@@ -321,13 +336,17 @@ class LinkageNode(Node):
             )
 
     def _place(self, cpu: int) -> set[int] | None:
-        """Pin every thread of this process (Fast DDS's included; threads started later
-        inherit it) to ``cpu``, or give a pinned process back every CPU it could use for -1;
-        return the CPUs for the bag writer process, None when the node is not pinned.
+        """
+        Pin every thread of this process.
+
+        (Fast DDS's included; threads started later inherit it) to ``cpu``, or give a pinned
+        process back every CPU it could use for -1; return the CPUs for the bag writer process,
+        None when the node is not pinned.
 
         On one CPU the executor's timer thread and the thread running the callbacks wake each
         other without crossing CPUs, and the bag writer cannot delay either
-        (docs/benchmarks.md, section 3)."""
+        (docs/benchmarks.md, section 3).
+        """
         self._check_cpu(cpu)
         if cpu == NO_CPU_AFFINITY and self._bag_writer_cpus is None:
             return None  # never pinned: the process stays as it was started
@@ -346,8 +365,11 @@ class LinkageNode(Node):
     # recording
 
     def _open_recorder(self) -> Recorder:
-        """A recorder for every topic, before anything is published; ConfigurationError naming
-        log.folder if it cannot be written."""
+        """
+        Return a recorder for every topic, before anything is published.
+
+        ConfigurationError naming log.folder if it cannot be written.
+        """
         metadata = {
             'parameters': json.dumps(self.parameter_values(), sort_keys=True),
             'package_version': package_version(),
@@ -370,8 +392,11 @@ class LinkageNode(Node):
         self._send(topic, encode_cdr(message), log_time_ns)
 
     def _send(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Publish a message encoded by ``encode_cdr`` (or an encoder equal to it) and log it:
-        subscribers get the very bytes that are logged."""
+        """
+        Publish a message encoded by ``encode_cdr``.
+
+        (or an encoder equal to it) and log it: subscribers get the very bytes that are logged.
+        """
         self._topic_publishers[topic].publish(data)
         if self._recorder is None or self._recording_error is not None:
             return
@@ -383,8 +408,11 @@ class LinkageNode(Node):
             self.get_logger().error(self._recording_error)
 
     def flush_publishers(self, timeout: float = 1.0) -> None:
-        """Give subscribers up to ``timeout`` seconds in all to acknowledge what was published
-        (the final state of a 'stop' run must not die with the process)."""
+        """
+        Give subscribers up to ``timeout`` seconds in all to acknowledge what was published.
+
+        The final state of a 'stop' run must not die with the process.
+        """
         deadline = time.monotonic() + timeout
         for publisher in self._topic_publishers.values():
             publisher.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))
@@ -406,8 +434,12 @@ class LinkageNode(Node):
     # motion
 
     def _timer_period(self) -> float:
-        """The state timer's period: rate_hz in real_time mode; in fixed_step mode the timer is
-        re-armed for each step's time, and this first period only starts it."""
+        """
+        Return the state timer's period: rate_hz in real_time mode.
+
+        In fixed_step mode the timer is re-armed for each step's time, and this first period only
+        starts it.
+        """
         if self.config.mode == 'real_time':
             return 1.0 / self.config.rate_hz
         return 1e-3
@@ -449,8 +481,11 @@ class LinkageNode(Node):
         self._publish_sample(sample, at)
 
     def _advance_steps(self, now: Time) -> None:
-        """Publish every step whose drive-law time has come, each stamped with that time, then
-        re-arm the timer for the next step's time."""
+        """
+        Publish every step whose drive-law time has come, each stamped with that time.
+
+        Then re-arm the timer for the next step's time.
+        """
         published = 0
         while self.exit_code is None:
             sample = sample_at_step(self.config, self._step)
@@ -472,7 +507,7 @@ class LinkageNode(Node):
             self._publish_sample(sample, due)
 
     def _motion_time(self, seconds: float) -> Time:
-        """The node-clock time ``seconds`` of drive-law time after the motion started."""
+        """Return the node-clock time ``seconds`` of drive-law time after the motion started."""
         return self._motion_start + Duration(nanoseconds=round(seconds * 1e9))
 
     def _publish_sample(self, sample: MotionSample, at: Time) -> None:
@@ -502,9 +537,12 @@ class LinkageNode(Node):
         self._window_ticks += 1
 
     def _publish_state(self, state: LinkageState, motion_time: float, at: Time) -> None:
-        """Publish a state stamped ``at``; the first of a motion comes after its scene (so a
-        viewer knows the frame before anything refers to it), the URDF if the geometry is new,
-        and the status that says the crank moves."""
+        """
+        Publish a state stamped ``at``.
+
+        The first of a motion comes after its scene (so a viewer knows the frame before anything
+        refers to it), the URDF if the geometry is new, and the status that says the crank moves.
+        """
         first = self._state is None
         self._state = state
         self._state_time = at
@@ -563,7 +601,7 @@ class LinkageNode(Node):
         self._publish(self._description_topic, message, at.nanoseconds)
 
     def _publish_markers(self) -> None:
-        """The scene of the latest state, stamped with that state's time."""
+        """Return the scene of the latest state, stamped with that state's time."""
         if self._state is None:
             return
         nanoseconds = self._state_time.nanoseconds
@@ -573,9 +611,12 @@ class LinkageNode(Node):
         )
 
     def _publish_diagnostics(self, event: str | None = None, at: Time | None = None) -> None:
-        """Publish the status, stamped ``at`` (by default the latest state's time, so that log
-        times never fall behind the states'); ``event``, a problem of this moment only, makes
-        it ERROR."""
+        """
+        Publish the status.
+
+        Stamped ``at`` (by default the latest state's time, so that log times never fall behind the
+        states'); ``event``, a problem of this moment only, makes it ERROR.
+        """
         now = self.get_clock().now()
         if at is None:
             at = self._state_time if self._state_time is not None else now
@@ -637,8 +678,11 @@ class LinkageNode(Node):
 
 
 def _report_configuration_error(error: ConfigurationError) -> None:
-    """The one line saying which parameter is bad and why: to the node's logger (console,
-    /rosout, log file) and plainly to stderr."""
+    """
+    Return the one line saying which parameter is bad and why.
+
+    To the node's logger (console, /rosout, log file) and plainly to stderr.
+    """
     get_logger(NODE_NAME).fatal(f'invalid parameter {error}')
     print(f'{NODE_NAME}: invalid parameter {error}', file=sys.stderr, flush=True)
 

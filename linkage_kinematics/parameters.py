@@ -1,4 +1,5 @@
-"""The node's parameters: their specifications, and their validation into a RunConfiguration.
+"""
+The node's parameters: their specifications, and their validation into a RunConfiguration.
 
 Pure functions of parameter values (name → value), no ROS: ``build_configuration`` checks every
 value and the motion they imply and raises ConfigurationError naming the first bad parameter; the
@@ -58,7 +59,8 @@ class ConfigurationError(ValueError):
 
 @dataclass(frozen=True)
 class RunConfiguration:
-    """Validated parameters plus the motion they imply; replaced as a whole, never mutated.
+    """
+    Validated parameters plus the motion they imply; replaced as a whole, never mutated.
 
     ``segment_end`` is where one pass of the motion ends: alpha_end, or ``blocked_at``, the
     first dead point the crank meets on its way there (change points do not stop it).
@@ -93,8 +95,11 @@ class RunConfiguration:
 
     @property
     def reverse_drive(self) -> DriveLaw:
-        """The drive law of the motion played backwards: ω and all rates negated, accelerations
-        unchanged."""
+        """
+        Return the drive law of the motion played backwards.
+
+        ω and all rates negated, accelerations unchanged.
+        """
         return DriveLaw(-self.drive.omega0, -self.drive.k)
 
     def restarts_motion(self, other: RunConfiguration) -> bool:
@@ -212,7 +217,7 @@ REAL_PARAMETERS = frozenset(
 
 
 def describe_value(value: object) -> str:
-    """A parameter value and its type, for error messages."""
+    """Return a parameter value and its type, for error messages."""
     if value is None:
         return 'no value'
     return f'{type(value).__name__} {value!r}'
@@ -353,7 +358,8 @@ def _motion(
 
 
 def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
-    """Validate parameter values (name → value) into a RunConfiguration.
+    """
+    Validate parameter values (name → value) into a RunConfiguration.
 
     Raises ConfigurationError naming the first offending parameter. Integers are accepted for
     real-valued parameters; anything else of the wrong type is rejected.
@@ -418,8 +424,11 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
 
 
 def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
-    """The namespaces of a parameters file's ``/<namespace>/linkage_node`` entries, in file
-    order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry."""
+    """
+    Return the namespaces of a parameters file's ``/<namespace>/linkage_node`` entries.
+
+    In file order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry.
+    """
     path = Path(parameters_file)
     try:
         entries = yaml.safe_load(path.read_text(encoding='utf-8'))

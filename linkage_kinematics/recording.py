@@ -1,4 +1,5 @@
-"""The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
+"""
+The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
 
 The node encodes each message once (``encode_cdr``, or for its per-tick messages and its
 scene a ``FixedShapeEncoder`` that writes the same bytes), publishes those bytes and logs the
@@ -81,8 +82,11 @@ def _fields(msg_type: type) -> list[tuple[str, Any]]:
 
 @functools.cache
 def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
-    """(attribute path, struct code, size) of every primitive of a message made only of
-    primitives and such messages, in order; None for any other message."""
+    """
+    Return (attribute path, struct code, size) of every primitive of a flat message, in order.
+
+    A flat message is made only of primitives and such messages; None for any other message.
+    """
     leaves: list[tuple[str, str, int]] = []
     for name, slot_type in _fields(msg_type):
         if isinstance(slot_type, BasicType):
@@ -98,8 +102,12 @@ def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
 
 
 def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tuple], tuple]:
-    """The getter of a run of fixed-size leaves (a tuple of their values) and its struct codes
-    and byte length for each start offset mod 8 (the padding depends on nothing else)."""
+    """
+    Return the getter of a run of fixed-size leaves.
+
+    (a tuple of their values) and its struct codes and byte length for each start offset mod 8 (the
+    padding depends on nothing else).
+    """
     layouts = []
     for phase in range(8):
         codes, offset = [], phase
@@ -122,8 +130,11 @@ def _run_entry(leaves: list[tuple[str, str, int]]) -> _Entry:
 
 @functools.cache
 def _plan(msg_type: type) -> tuple[_Entry, ...]:
-    """How ``encode_cdr`` writes ``msg_type``: its fields in order, each run of consecutive
-    fixed-size fields merged into one entry."""
+    """
+    How ``encode_cdr`` writes ``msg_type``.
+
+    Its fields in order, each run of consecutive fixed-size fields merged into one entry.
+    """
     plan: list[_Entry] = []
     run: list[tuple[str, str, int]] = []
     for name, slot_type in _fields(msg_type):
@@ -233,8 +244,12 @@ class _Slot:
 
 
 class _Template:
-    """A message seen through ``_walk``: the fields named in ``varying`` read as slots (one per
-    element of a sequence), every other field as the message's own value."""
+    """
+    A message seen through ``_walk``.
+
+    The fields named in ``varying`` read as slots (one per element of a sequence), every other
+    field as the message's own value.
+    """
 
     __slots__ = ('_message', '_path', '_varying')
 
@@ -261,9 +276,12 @@ def _is_sequence(value: Any) -> bool:
 
 
 class FixedShapeEncoder:
-    """``encode_cdr`` for a stream of messages that differ from ``template`` only in the
-    fixed-size fields named by ``varying`` (attribute paths such as ``header.stamp.sec``,
-    ``position`` or ``markers[1].points[2].x``; a sequence keeps the template's length).
+    """
+    Encode as ``encode_cdr`` does a stream of messages that differ only in some fields.
+
+    The messages differ from ``template`` only in the fixed-size fields named by ``varying``
+    (attribute paths such as ``header.stamp.sec``, ``position`` or ``markers[1].points[2].x``; a
+    sequence keeps the template's length).
 
     The template is walked once: its struct format and constant values are kept, so encoding
     a message is one ``struct.pack`` of the constants and the new values, without building the
@@ -302,7 +320,7 @@ class FixedShapeEncoder:
         self._struct = struct.Struct(''.join(codes))
 
     def encode(self, values: tuple) -> bytes:
-        """The message with ``values`` (``value_count`` of them) in the varying fields."""
+        """Return the message with ``values`` (``value_count`` of them) in the varying fields."""
         return ENCAPSULATION_HEADER + self._struct.pack(*self._order(self._constants + values))
 
 
@@ -327,8 +345,11 @@ def offered_qos_profiles_yaml(qos: QoSProfile) -> str:
 
 
 class Recorder:
-    """Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one),
-    written by a BagWriter in a process of its own (bag_writer_process)."""
+    """
+    Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one).
+
+    Written by a BagWriter in a process of its own (bag_writer_process).
+    """
 
     def __init__(
         self, folder: Path, *, metadata: dict[str, str], cpus: Set[int] | None = None
@@ -342,7 +363,7 @@ class Recorder:
 
     @property
     def size_bytes(self) -> int:
-        """The MCAP file's size as the writer last reported it (every 0.25 s at most)."""
+        """Return the MCAP file's size as the writer last reported it (every 0.25 s at most)."""
         return self._writer.size_bytes
 
     def add_topic(self, topic: str, msg_type: type, qos: QoSProfile) -> None:
@@ -359,7 +380,7 @@ class Recorder:
         self._writer.run_on(cpus)
 
     def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Logs ``data``, a message of ``topic`` encoded by ``encode_cdr``."""
+        """Log ``data``, a message of ``topic`` encoded by ``encode_cdr``."""
         try:
             self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
         except BagWriteError as error:

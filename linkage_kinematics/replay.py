@@ -1,4 +1,7 @@
-"""``linkage-replay``: republish a logged run for labs without rosbag2, or recover a killed one.
+"""
+``linkage-replay``.
+
+Republish a logged run for labs without rosbag2, or recover a killed one.
 
     linkage-replay BAG [--rate FACTOR] [--loop] [--topics TOPIC ...] [--delay SECONDS]
     linkage-replay --recover BAG
@@ -90,7 +93,7 @@ def _import_message_type(type_name: str) -> type | None:
 
 
 def _logged_topics(bag: Path) -> dict[str, tuple[str, dict[str, Any] | None]]:
-    """topic -> (type name, first offered QoS profile or None) of every logged topic."""
+    """Topic -> (type name, first offered QoS profile or None) of every logged topic."""
     metadata_path = bag / 'metadata.yaml'
     if bag.is_dir() and metadata_path.is_file():
         try:
@@ -155,7 +158,11 @@ def _qos(plan: TopicPlan) -> QoSProfile:
 
 
 def _policy(policy_enum: Any, value: Any) -> Any:
-    """An rclpy QoS policy from rosbag2's metadata (names since version 9, integers before)."""
+    """
+    Return an rclpy QoS policy from rosbag2's metadata.
+
+    The metadata has names since version 9, integers before.
+    """
     try:
         if isinstance(value, int):
             return policy_enum(value)

@@ -1,4 +1,7 @@
-"""``linkage-sweep``: the seed's tables and figures for any crank-angle range, or for a logged run.
+"""
+``linkage-sweep``.
+
+The seed's tables and figures for any crank-angle range, or for a logged run.
 
 States come from ``kinematics.solve_many`` (or, with ``--from-bag``, from a run the node logged);
 this module only lays them out: a lossless CSV, the seed's head-and-tail tables
@@ -62,7 +65,8 @@ class SweepRangeError(ValueError):
 
 
 def crank_angles(start_deg: float, end_deg: float, step_deg: float) -> np.ndarray:
-    """Crank angles in degrees from ``start_deg`` by ``step_deg`` up to ``end_deg``.
+    """
+    Crank angles in degrees from ``start_deg`` by ``step_deg`` up to ``end_deg``.
 
     The end is included when it lands on the grid; a negative step sweeps clockwise. The grid
     is counted in decimal, as the numbers were typed, so 0 to 1 by 0.1 ends on 1 and its fourth
@@ -90,7 +94,8 @@ def crank_angles(start_deg: float, end_deg: float, step_deg: float) -> np.ndarra
 def seed_columns(
     state: LinkageState, alpha_deg: Optional[np.ndarray] = None
 ) -> dict[str, np.ndarray]:
-    """The CSV columns (``CSV_COLUMNS``) of an array state: SI units, angles in degrees.
+    """
+    Return the CSV columns (``CSV_COLUMNS``) of an array state: SI units, angles in degrees.
 
     β and γ are unwrapped along the rows so they are continuous. ``alpha_deg``, when given, is
     the grid the state was computed on (``state.alpha`` is its radians): it is shown as given,
@@ -114,7 +119,8 @@ def seed_columns(
 def write_csv(
     state: LinkageState, stream: TextIO, alpha_deg: Optional[np.ndarray] = None
 ) -> None:
-    """The states as CSV with header ``CSV_COLUMNS``; repr floats, so the text is lossless.
+    """
+    Return the states as CSV with header ``CSV_COLUMNS``; repr floats, so the text is lossless.
 
     ``alpha_deg`` as in ``seed_columns``.
     """
@@ -135,7 +141,7 @@ def describe_mechanism(linkage: FourBar, name: Optional[str] = None) -> str:
 
 
 def describe_drive(drive: DriveLaw) -> str:
-    """The drive law in words, for titles."""
+    """Return the drive law in words, for titles."""
     if drive.k == 0.0:
         return f'constant ω = {drive.omega0:g} rad/s'
     sign = '+' if drive.k > 0.0 else '−'
@@ -143,7 +149,8 @@ def describe_drive(drive: DriveLaw) -> str:
 
 
 def format_tables(state: LinkageState, rows: int = 1, title: Optional[str] = None) -> str:
-    """The seed's Tables 1–4 layout: velocities, then accelerations; head, ⋮, tail rows.
+    """
+    Return the seed's Tables 1–4 layout: velocities, then accelerations; head, ⋮, tail rows.
 
     ``rows`` is how many rows to show at each end; a state with no more than ``2·rows`` rows is
     shown whole. Angles in degrees (β and γ unwrapped), rates to 4 significant digits.
@@ -164,7 +171,8 @@ def format_tables(state: LinkageState, rows: int = 1, title: Optional[str] = Non
 
 
 def write_plot(state: LinkageState, path: str | os.PathLike[str], title: str) -> None:
-    """The seed's Figs. 4 and 5 as a PNG at ``path``: four panels against α in degrees.
+    """
+    Return the seed's Figs. 4 and 5 as a PNG at ``path``: four panels against α in degrees.
 
     The image is rendered in memory first, so a failure leaves no file behind.
     """
@@ -263,7 +271,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 
 def _computed_sweep(args: argparse.Namespace) -> tuple[LinkageState, np.ndarray, str]:
-    """The states the options ask for, their crank angles in degrees, and a title."""
+    """Return the states the options ask for, their crank angles in degrees, and a title."""
     preset_name = args.preset or 'paper'
     chosen = preset(preset_name)
     overrides = {

@@ -1,4 +1,7 @@
-"""URDF of a four-bar linkage: the open chain base → disk → coupler → rocker whose end lands on C.
+"""
+URDF of a four-bar linkage.
+
+The open chain base → disk → coupler → rocker whose end lands on C.
 
 The closed loop is cut at the fixed pivot C. With the /joint_states positions
 (α, γ − α, −β − γ) the frames turn by α, γ and −β in the plane, so
@@ -79,7 +82,11 @@ _MATERIALS = (
 
 
 def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
-    """The URDF (XML text) of ``linkage`` with root link ``frame_id``; primitive shapes only."""
+    """
+    Return the URDF (XML text) of ``linkage`` with root link ``frame_id``.
+
+    Primitive shapes only.
+    """
     crank = linkage.crank_length
     coupler = linkage.coupler_length
     rocker = linkage.rocker_length

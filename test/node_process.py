@@ -1,4 +1,5 @@
-"""Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
+"""
+Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
 
 Every test module that starts nodes uses its own ROS_DOMAIN_ID so that tests
 running at the same time never see each other's nodes.
@@ -35,7 +36,7 @@ PROCESS_TIMEOUT = 60.0
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:
-    """The environment a node process (and the test's own rclpy) runs in."""
+    """Return the environment a node process (and the test's own rclpy) runs in."""
     environment = dict(os.environ)
     environment['ROS_DOMAIN_ID'] = str(domain_id)
     environment['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
@@ -62,8 +63,11 @@ def node_command(
     executable: list[str] | None = None,
     ros_arguments: Sequence[str] = (),
 ) -> list[str]:
-    """The command line of a node with ``parameters`` and further ``ros_arguments`` (e.g.
-    ``-r __ns:=/left``)."""
+    """
+    Return the command line of a node with ``parameters`` and further ``ros_arguments`` (e.g.
+
+    ``-r __ns:=/left``).
+    """
     command = executable or [sys.executable, '-m', 'linkage_kinematics.node']
     arguments = ['--ros-args']
     for name, value in parameters.items():
@@ -81,8 +85,11 @@ def start_node(
     preexec_fn: Callable[[], None] | None = None,
     ros_arguments: Sequence[str] = (),
 ) -> subprocess.Popen:
-    """Start a node process (by default the working tree's, from the repository root); its
-    stdout and stderr go to the file ``output``; ``preexec_fn`` runs in the child first."""
+    """
+    Start a node process (by default the working tree's, from the repository root).
+
+    Its stdout and stderr go to the file ``output``; ``preexec_fn`` runs in the child first.
+    """
     with open(output, 'w') as log:
         return subprocess.Popen(
             node_command(parameters, executable, ros_arguments),
@@ -112,7 +119,7 @@ def run_node(parameters: Mapping[str, Any], domain_id: int, output: Path) -> tup
 
 
 def bag_writer_pid(node_pid: int) -> int:
-    """The process id of the node's bag writer (bag_writer_process), its child."""
+    """Return the process id of the node's bag writer (bag_writer_process), its child."""
     for stat in Path('/proc').glob('[0-9]*/stat'):
         try:
             fields = stat.read_text().rsplit(')', 1)[1].split()
@@ -158,8 +165,11 @@ class Listener:
         return self.spin_until(lambda: self.node.count_publishers(topic) > 0, timeout)
 
     def heard_every_topic(self, count: int = 1) -> bool:
-        """Whether at least ``count`` messages (one on a transient-local topic) arrived on every
-        subscribed topic."""
+        """
+        Whether at least ``count`` messages.
+
+        (one on a transient-local topic) arrived on every subscribed topic.
+        """
         return all(
             len(messages) >= (1 if topic in self.latched else count)
             for topic, messages in self.received.items()
@@ -170,9 +180,12 @@ class Listener:
         return self.spin_until(lambda: self.heard_every_topic(count), timeout)
 
     def drain(self) -> None:
-        """Take every message that has already arrived, e.g. after the node exited (it waits for
-        its subscribers' acknowledgements first): spin until three spins in a row bring
-        nothing new."""
+        """
+        Take every message that has already arrived.
+
+        E.g. after the node exited (it waits for its subscribers' acknowledgements first): spin
+        until three spins in a row bring nothing new.
+        """
         idle = 0
         while idle < 3:
             before = sum(map(len, self.received.values()))
@@ -191,7 +204,7 @@ class Listener:
 
 @contextmanager
 def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
-    """A private rclpy context in the test process on ``domain_id``, loopback only."""
+    """Return a private rclpy context in the test process on ``domain_id``, loopback only."""
     previous = os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE')
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     context = rclpy.Context()
@@ -207,8 +220,11 @@ def ros_context(domain_id: int) -> Iterator[rclpy.Context]:
 
 
 def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int) -> None:
-    """Set simulated time to ``clock_ns`` and wait for the node's state of that instant (a lost
-    /clock message is sent again; the same time again makes no tick)."""
+    """
+    Set simulated time to ``clock_ns`` and wait for the node's state of that instant.
+
+    (a lost /clock message is sent again; the same time again makes no tick).
+    """
     message = Clock(clock=messages.time_msg(clock_ns))
 
     def ticked() -> bool:
@@ -222,15 +238,19 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
 
 
 def stamp_ns(message: Any) -> int:
-    """The header stamp of ``message`` in integer nanoseconds."""
+    """Return the header stamp of ``message`` in integer nanoseconds."""
     return message.header.stamp.sec * 1_000_000_000 + message.header.stamp.nanosec
 
 
 def expected_state_point(
     linkage: FourBar, state: LinkageState
 ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-    """The positions, velocities and accelerations /linkage/state carries for a library state,
-    in its joint order (README): α, β, γ, pins A and B, θ_BC = π − β, OA·α, BC·β."""
+    """
+    Return the positions.
+
+    Velocities and accelerations /linkage/state carries for a library state, in its joint order
+    (README): α, β, γ, pins A and B, θ_BC = π − β, OA·α, BC·β.
+    """
     crank, rocker = linkage.crank_length, linkage.rocker_length
     return (
         (state.alpha, state.beta, state.gamma, state.pin_a_x, state.pin_a_y, state.pin_b_x,
@@ -245,8 +265,11 @@ def expected_state_point(
 
 
 def configuration_values(**overrides: Any) -> dict[str, Any]:
-    """The node's default parameter values (preset 'paper') with ``overrides``, by name; dotted
-    names are passed as ``**{"log.enabled": False}``."""
+    """
+    Return the node's default parameter values (preset 'paper') with ``overrides``, by name.
+
+    Dotted names are passed as ``**{"log.enabled": False}``.
+    """
     return {**{spec.name: spec.default for spec in parameter_specs('paper')}, **overrides}
 
 

@@ -1,4 +1,5 @@
-"""Independent high-precision reference for the four-bar kinematics (mpmath, 50 digits).
+"""
+Independent high-precision reference for the four-bar kinematics (mpmath, 50 digits).
 
 Why it is independent of ``linkage_kinematics.kinematics``:
 
@@ -75,7 +76,11 @@ def _angles(linkage: FourBar, alpha: mpf, branch: int) -> tuple[mpf, mpf]:
 
 
 def _derivatives(function: Callable[[mpf], mpf], alpha: mpf) -> tuple[mpf, mpf, mpf]:
-    """An angle-valued function and its first two α-derivatives, unwrapped around ``alpha``."""
+    """
+    Return an angle-valued function and its first two α-derivatives.
+
+    Unwrapped around ``alpha``.
+    """
     centre = function(alpha)
     value, first, second = mp.diffs(lambda t: _wrap(function(t) - centre), alpha, 2)
     return centre + value, first, second
@@ -137,7 +142,8 @@ def reference_state(
 
 
 def reference_singular_angles(linkage: FourBar) -> list[mpf]:
-    """Crank angles in (−π, π] where coupler and rocker are collinear, ascending.
+    """
+    Crank angles in (−π, π] where coupler and rocker are collinear, ascending.
 
     These are the dead points (interval ends) and, for Grashof-equality linkages, the change
     points where the two branches meet (double roots).
@@ -167,8 +173,11 @@ def continued_sides(
     linkage: FourBar, alpha_start: float, branch: int, alphas: list[float],
     max_step: float = 0.01,
 ) -> list[int]:
-    """The assembly (``branch`` argument of ``reference_state``) at each of ``alphas`` for the
-    motion that starts at ``alpha_start`` on ``branch`` and turns smoothly through them.
+    """
+    Return the assembly.
+
+    (``branch`` argument of ``reference_state``) at each of ``alphas`` for the motion that starts
+    at ``alpha_start`` on ``branch`` and turns smoothly through them.
 
     ``alphas`` must run monotonically away from ``alpha_start``. Independent of the library's
     rule (change points flip the side): this follows the motion in steps of at most
@@ -247,7 +256,8 @@ def _group_errors(values: dict[str, mpf], reference: dict[str, mpf]) -> dict[str
 
 
 def state_errors(state: LinkageState, reference: dict[str, mpf]) -> dict[str, float]:
-    """How far a float ``LinkageState`` is from ``reference_state``, by kind of quantity.
+    """
+    How far a float ``LinkageState`` is from ``reference_state``, by kind of quantity.
 
     ``angle``: largest error of β and γ (rad). ``pin``: largest pin-coordinate error relative to
     the largest pin distance from O. The rest are normwise relative errors of a group: angular
@@ -263,9 +273,11 @@ def state_errors(state: LinkageState, reference: dict[str, mpf]) -> dict[str, fl
 def input_floor(
     linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1
 ) -> dict[str, float]:
-    """What a one-ulp change of the float α alone does to the exact answer, in the terms of
-    ``state_errors``: the larger change over the two neighbouring floats of α (only those on
-    which the loop closes), on the same assembly.
+    """
+    Return what a one-ulp change of the float α alone does to the exact answer.
+
+    In the terms of ``state_errors``: the larger change over the two neighbouring floats of α (only
+    those on which the loop closes), on the same assembly.
 
     No float64 evaluation from α can be expected to do better than this.
     """

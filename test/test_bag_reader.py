@@ -1,4 +1,8 @@
-"""bag_reader against bags written by an independent writer (mcap_ros2's), whole, cut and broken."""
+"""
+bag_reader against bags written by an independent writer (mcap_ros2's), whole.
+
+Cut and broken.
+"""
 
 from __future__ import annotations
 
@@ -41,7 +45,7 @@ _DEPENDENCIES = {
 
 
 def message_definition(type_name: str) -> str:
-    """The ros2msg schema text rosbag2 stores: the type, then each type it uses."""
+    """Return the ros2msg schema text rosbag2 stores: the type, then each type it uses."""
 
     def text(name: str) -> str:
         package, _, message = name.split('/')
@@ -57,9 +61,12 @@ def message_definition(type_name: str) -> str:
 def state_message(
     state: LinkageState, index: int, stamp_ns: int, elapsed_s: float, seven: bool = False
 ) -> dict:
-    """A /linkage/state JointTrajectory as the README's topic table defines it for the paper's
-    geometry; ``seven`` writes only the first seven coordinates, as bags logged before the rocker
-    angle and the pin arcs were added hold."""
+    """
+    Build a /linkage/state JointTrajectory as the README's topic table defines it.
+
+    The geometry is the paper's; ``seven`` writes only the first seven coordinates, as bags logged
+    before the rocker angle and the pin arcs were added hold.
+    """
     row = state.at(index)
     crank, rocker = PAPER.crank_length, PAPER.rocker_length
     seconds, nanoseconds = divmod(stamp_ns, 1_000_000_000)
@@ -102,7 +109,8 @@ def write_mcap(
     finish: bool = True,
     seven: bool = False,
 ) -> list[int]:
-    """Log ``state`` row by row on /linkage/state (with /chatter in between when ``foreign``).
+    """
+    Log ``state`` row by row on /linkage/state (with /chatter in between when ``foreign``).
 
     Returns the header stamps (ns). ``finish=False`` leaves the file as a killed recorder
     would: complete chunks only, no summary, no footer. ``seven``: as logged before the rocker
@@ -142,7 +150,7 @@ def write_metadata(folder: Path, files: list[str], storage: str = 'mcap') -> Non
 
 
 def write_bag_folder(folder: Path, state: LinkageState, foreign: bool = True) -> list[int]:
-    """A rosbag2 MCAP bag folder holding ``state``: metadata.yaml and one .mcap file."""
+    """Return a rosbag2 MCAP bag folder holding ``state``: metadata.yaml and one .mcap file."""
     folder.mkdir()
     stamps = write_mcap(folder / 'run_0.mcap', state, foreign=foreign)
     write_metadata(folder, ['run_0.mcap'])
@@ -150,7 +158,11 @@ def write_bag_folder(folder: Path, state: LinkageState, foreign: bool = True) ->
 
 
 def assert_states_equal(actual: LinkageState, expected: LinkageState, count: int) -> None:
-    """Every field except transmission_angle (not on the wire) equal to the first ``count`` rows."""
+    """
+    Every field except transmission_angle.
+
+    (not on the wire) equal to the first ``count`` rows.
+    """
     for name in LinkageState.__dataclass_fields__:
         if name == 'transmission_angle':
             assert np.all(np.isnan(actual.transmission_angle))

@@ -1,6 +1,9 @@
-"""Logging to rosbag2 MCAP: BagWriter and Recorder on their own, a real node run read back by two
-independent readers (rosbags and mcap-ros2-support), and linkage-replay (the Foxglove layout's
-tests are in test_foxglove_layout.py).
+"""
+Logging to rosbag2 MCAP.
+
+BagWriter and Recorder on their own, a real node run read back by two independent readers (rosbags
+and mcap-ros2-support), and linkage-replay (the Foxglove layout's tests are in
+test_foxglove_layout.py).
 
 Nodes run and are listened to through node_process; the bag helpers here (reading a bag back
 with rosbags, its metadata.yaml) are shared with test_recording_faults.py and test_soak.py.
@@ -105,7 +108,11 @@ def only_bag(folder: Path) -> Path:
 
 
 def read_with_rosbags(bag: Path) -> dict[str, list[tuple[int, Any, bytes]]]:
-    """topic -> [(log time ns, decoded message, raw CDR)] read with rosbags (needs the summary)."""
+    """
+    Topic -> [(log time ns, decoded message, raw CDR)] read with rosbags.
+
+    (needs the summary).
+    """
     logged: dict[str, list[tuple[int, Any, bytes]]] = defaultdict(list)
     with Reader(bag) as reader:
         for connection, log_time, raw in reader.messages():
@@ -120,7 +127,7 @@ def bag_information(bag: Path) -> dict[str, Any]:
 
 
 def topic_counts(information: dict[str, Any]) -> dict[str, int]:
-    """topic -> message count, as metadata.yaml states them."""
+    """Topic -> message count, as metadata.yaml states them."""
     return {
         entry['topic_metadata']['name']: entry['message_count']
         for entry in information['topics_with_message_count']
@@ -154,14 +161,18 @@ def sample_messages() -> list[Any]:
 
 
 def encoded_by_rosbags(data: bytes, type_name: str) -> bytes:
-    """``data`` decoded and encoded again by rosbags: exact length, alignment padding zeroed."""
+    """Decode ``data`` and encode it again by rosbags: exact length, alignment padding zeroed."""
     return bytes(TYPESTORE.serialize_cdr(TYPESTORE.deserialize_cdr(data, type_name), type_name))
 
 
 def assert_exact_encoding(data: bytes, message: Any) -> None:
-    """``data`` is ``message``: rclpy (Fast CDR) decodes it as it decodes its own serialization
-    of ``message`` (float32 fields rounded alike), and rosbags encodes what it decodes to the
-    very same bytes (exact length, zero padding)."""
+    """
+    Check that ``data`` is ``message``.
+
+    rclpy (Fast CDR) decodes it as it decodes its own serialization of ``message`` (float32 fields
+    rounded alike), and rosbags encodes what it decodes to the very same bytes (exact length, zero
+    padding).
+    """
     msg_type = type(message)
     assert deserialize_message(data, msg_type) == deserialize_message(
         serialize_message(message), msg_type)
@@ -224,10 +235,14 @@ def test_encoding_holds_for_bytes_booleans_nested_messages_and_their_sequences(
     level: int, texts: list[str], values: dict[str, str], points: list[tuple[float, float, float]],
     flags: list[bool],
 ) -> None:
-    """The other field kinds the node logs: a byte (the diagnostic level), a bool between wider
-    fields, sequences of messages inside sequences of messages, an empty uint8 sequence; and
-    a run of fixed-size fields (a uint8, then float32s) starting at every offset a string of
-    any length leaves; fixed-size arrays (numpy arrays in rclpy)."""
+    """
+    Return the other field kinds the node logs.
+
+    A byte (the diagnostic level), a bool between wider fields, sequences of messages inside
+    sequences of messages, an empty uint8 sequence; and a run of fixed-size fields (a uint8, then
+    float32s) starting at every offset a string of any length leaves; fixed-size arrays (numpy
+    arrays in rclpy).
+    """
     status = DiagnosticStatus(level=bytes([level]), name=texts[0], message=texts[1],
                               hardware_id=texts[2],
                               values=[KeyValue(key=k, value=v) for k, v in values.items()])
@@ -317,9 +332,12 @@ def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_message
     preset_name: str, alpha: float, stamp: int, motion_time: float, frame_id: str,
     previous: tuple[float, float, float],
 ) -> None:
-    """The per-tick messages and the scene, encoded straight from the state, are byte for byte
-    encode_cdr of the messages the builders make (frame ids of any length shift the alignment
-    of everything after them)."""
+    """
+    Return the per-tick messages and the scene, encoded straight from the state.
+
+    Are byte for byte encode_cdr of the messages the builders make (frame ids of any length shift
+    the alignment of everything after them).
+    """
     linkage = preset(preset_name).geometry
     try:
         state = solve(linkage, alpha, DriveLaw(2.0, 0.3))
@@ -412,8 +430,11 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
 
 @pytest.mark.parametrize('count', [1, WRITE_BATCH - 1, WRITE_BATCH, 3 * WRITE_BATCH + 1])
 def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: int) -> None:
-    """Messages wait in a queue before they enter the chunk; flush and close take them all, in
-    the order written, on their channels."""
+    """
+    Messages wait in a queue before they enter the chunk.
+
+    Flush and close take them all, in the order written, on their channels.
+    """
     writer = BagWriter(tmp_path / 'queued', metadata={}, flush_interval=3600.0)
     channels = [
         writer.add_topic(topic, 'std_msgs/msg/String', message_definition('std_msgs/msg/String'),
@@ -459,7 +480,8 @@ def test_recorder_refuses_a_log_folder_under_a_regular_file(tmp_path: Path) -> N
 
 @pytest.fixture(scope='module')
 def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    """A logging run that the listener has heard on every topic, ended by SIGINT.
+    """
+    Return a logging run that the listener has heard on every topic, ended by SIGINT.
 
     The node loops until the listener (whose discovery may take seconds on a busy machine) has
     received a few messages on every topic; the bag then holds everything the listener got.

@@ -1,4 +1,5 @@
-"""Change points: Grashof linkages with s + l = p + q turn through them on the smooth branch.
+"""
+Change points: Grashof linkages with s + l = p + q turn through them on the smooth branch.
 
 The library follows the smooth (analytic) branch by rule: B crosses to the other side of A→C at
 every change point (``continued_branch``). The reference follows the motion itself in small
@@ -44,8 +45,12 @@ def grid(direction: int) -> np.ndarray:
 
 
 def reference_indices(alphas: np.ndarray, linkage: FourBar) -> list[int]:
-    """Where to compare with the 50-digit reference: on every change point and the grid points
-    next to it, and every 37th grid point elsewhere (the reference is slow)."""
+    """
+    Where to compare with the 50-digit reference.
+
+    On every change point and the grid points next to it, and every 37th grid point elsewhere (the
+    reference is slow).
+    """
     points = linkage.reachability.change_points
     near = {
         index for index, alpha in enumerate(alphas)
@@ -76,9 +81,13 @@ def test_change_points_are_the_reference_s_double_roots(name: str) -> None:
 @pytest.mark.parametrize('branch', [1, -1])
 @pytest.mark.parametrize('direction', [1, -1], ids=['counterclockwise', 'clockwise'])
 def test_smooth_motion_through_two_turns(name: str, branch: int, direction: int) -> None:
-    """Both assemblies, both directions, two full turns: the library's branch rule picks the
-    root the reference's step-by-step continuation picks, at every 0.5°; and there (the change
-    points included) every quantity matches the reference to 1e-12, under both drive laws."""
+    """
+    Both assemblies, both directions, two full turns.
+
+    The library's branch rule picks the root the reference's step-by-step continuation picks, at
+    every 0.5°; and there (the change points included) every quantity matches the reference to
+    1e-12, under both drive laws.
+    """
     linkage = LINKAGES[name]
     alphas = grid(direction)
     branches = continued_branch(linkage, 0.0, branch, alphas)
@@ -108,8 +117,12 @@ def test_smooth_motion_through_two_turns(name: str, branch: int, direction: int)
 @pytest.mark.parametrize('drive', DRIVES, ids=['constant', 'variable'])
 @pytest.mark.parametrize('direction', [1, -1], ids=['counterclockwise', 'clockwise'])
 def test_parallelogram_stays_a_parallelogram(drive: DriveLaw, direction: int) -> None:
-    """Started as a parallelogram (B = A + C, branch −1 at α = 0), it stays one through ±720°,
-    change points included: γ = 0, ω_AB = 0, ω_BC = ω, ω̇_AB = 0, ω̇_BC = ω̇ to rounding."""
+    """
+    Started as a parallelogram (B = A + C, branch −1 at α = 0).
+
+    It stays one through ±720°, change points included: γ = 0, ω_AB = 0, ω_BC = ω, ω̇_AB = 0, ω̇_BC
+    = ω̇ to rounding.
+    """
     alphas = grid(direction)
     states = solve_many(PARALLELOGRAM, alphas, drive,
                         continued_branch(PARALLELOGRAM, 0.0, -1, alphas))
@@ -126,8 +139,12 @@ def test_parallelogram_stays_a_parallelogram(drive: DriveLaw, direction: int) ->
 
 @pytest.mark.parametrize('drive', DRIVES, ids=['constant', 'variable'])
 def test_kite_keeps_its_folded_assembly(drive: DriveLaw) -> None:
-    """The kite OA = AB = 0.4, BC = OC = 1 has an assembly with B on O (branch +1 at α = 0):
-    the rocker stands still and the coupler turns with the crank, through both change points."""
+    """
+    Return the kite OA = AB = 0.4.
+
+    BC = OC = 1 has an assembly with B on O (branch +1 at α = 0): the rocker stands still and the
+    coupler turns with the crank, through both change points.
+    """
     alphas = grid(1)
     states = solve_many(KITE, alphas, drive, continued_branch(KITE, 0.0, 1, alphas))
     assert np.max(np.hypot(states.pin_b_x, states.pin_b_y)) <= ROUNDING
@@ -136,8 +153,11 @@ def test_kite_keeps_its_folded_assembly(drive: DriveLaw) -> None:
 
 
 def test_one_change_point_per_turn_repeats_every_two_turns() -> None:
-    """With one change point per turn, a whole turn brings the other assembly: solving at α
-    with the branch for ``turns`` later turns gives the state at α + 2π·turns."""
+    """
+    With one change point per turn, a whole turn brings the other assembly.
+
+    Solving at α with the branch for ``turns`` later turns gives the state at α + 2π·turns.
+    """
     alpha = 0.3
     for turns in (1, 2, 3, -1, 1000, -1001):
         branch = continued_branch(GENERAL, 0.0, 1, alpha, turns=turns)
@@ -153,9 +173,12 @@ def test_one_change_point_per_turn_repeats_every_two_turns() -> None:
 
 
 def test_branch_flips_exactly_at_the_change_point() -> None:
-    """The change point at π/2 lies between the floats around it; continued_branch decides which
-    side each float is on from the change point held to twice double precision. At a change
-    point itself a branch names the side just counterclockwise of it."""
+    """
+    Return the change point at π/2 lies between the floats around it.
+
+    Continued_branch decides which side each float is on from the change point held to twice double
+    precision. At a change point itself a branch names the side just counterclockwise of it.
+    """
     change = math.pi / 2  # the float below π/2
     above = math.nextafter(change, math.inf)
     assert continued_branch(GENERAL, 0.0, 1, change) == 1
@@ -176,8 +199,12 @@ def test_branch_flips_exactly_at_the_change_point() -> None:
 
 
 def test_pin_passing_through_the_pivot_is_refused() -> None:
-    """OA = OC and AB = BC: pin A passes through C, where coupler and rocker lie on each other
-    and can turn together about it; solve refuses within PIVOT_PASSAGE of it, not beyond."""
+    """
+    OA = OC and AB = BC.
+
+    Pin A passes through C, where coupler and rocker lie on each other and can turn together about
+    it; solve refuses within PIVOT_PASSAGE of it, not beyond.
+    """
     folding = FourBar(1.0, 0.4, 0.4, 1.0, 0.0)
     assert folding.reachability.change_points == pytest.approx((math.pi / 2,), abs=1e-15)
     with pytest.raises(DeadPointError, match='on the pivot C'):

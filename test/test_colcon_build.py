@@ -29,7 +29,7 @@ PACKAGE_ENTRIES = (
 
 
 def _package_files() -> list[str]:
-    """The package's files as git knows them (tracked, or new and not ignored)."""
+    """Return the package's files as git knows them (tracked, or new and not ignored)."""
     listed = subprocess.run(
         ['git', 'ls-files', '--cached', '--others', '--exclude-standard', '--', *PACKAGE_ENTRIES],
         cwd=REPOSITORY, check=True, capture_output=True, text=True,
@@ -38,8 +38,12 @@ def _package_files() -> list[str]:
 
 
 def _colcon_environment(install: Path, base: dict[str, str]) -> dict[str, str]:
-    """What sourcing install/local_setup.sh would set: each package's hook .dsv files prepend
-    their paths (relative to the package prefix) to the named variables."""
+    """
+    Return what sourcing install/local_setup.sh would set.
+
+    Each package's hook .dsv files prepend their paths (relative to the package prefix) to the
+    named variables.
+    """
     environment = dict(base)
     for package_dsv in sorted(install.glob('*/share/*/package.dsv')):
         prefix = package_dsv.parents[2]

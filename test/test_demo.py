@@ -1,5 +1,9 @@
-"""`linkage-demo` end to end: the real node runs both seed scenarios, logs them, and the tables
-printed from the logs carry the exact values (the seed's Table 1/2 rows and ω = 3.713 at 90°)."""
+"""
+`linkage-demo` end to end.
+
+The real node runs both seed scenarios, logs them, and the tables printed from the logs carry the
+exact values (the seed's Table 1/2 rows and ω = 3.713 at 90°).
+"""
 
 import math
 import os

@@ -22,7 +22,7 @@ def exact_alpha(drive: DriveLaw, alpha_start: float, elapsed: float) -> float:
 
 
 def exact_time(drive: DriveLaw, alpha_start: float, alpha: float) -> float:
-    """t = ln(1 + k·(α − α_s)/ω_s)/k in 50 digits."""
+    """T = ln(1 + k·(α − α_s)/ω_s)/k in 50 digits."""
     with mp.workdps(50):
         k = mpf(drive.k)
         omega_start = mpf(drive.omega0) + k * mpf(alpha_start)

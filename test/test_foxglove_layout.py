@@ -1,6 +1,8 @@
-"""The shipped Foxglove/Lichtblick layout against a real node bag, read with independent readers
-(mcap, mcap-ros2-support, rosbags' message-definition parser), and the paper quantities it plots
-as plain fields of /linkage/state.
+"""
+The shipped Foxglove/Lichtblick layout against a real node bag.
+
+Read with independent readers (mcap, mcap-ros2-support, rosbags' message-definition parser), and
+the paper quantities it plots as plain fields of /linkage/state.
 
 The node runs once (the seed's variable-law turn) and logs a bag; every message path of the
 layout is then parsed, walked through the ``ros2msg`` schema stored in that bag and evaluated on
@@ -108,8 +110,11 @@ def layout_tree_panels(node: Any) -> list[str]:
 
 @pytest.fixture(scope='module')
 def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
-    """The seed's variable-law turn, logged by the real node: the bag's schemas, channels and
-    decoded messages per topic."""
+    """
+    Return the seed's variable-law turn, logged by the real node.
+
+    The bag's schemas, channels and decoded messages per topic.
+    """
     run_folder = tmp_path_factory.mktemp('layout_run')
     folder = run_folder / 'bags'
     process = start_node(
@@ -196,8 +201,12 @@ def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_a
 
 
 def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
-    """The disk (radius OA about O) and every place pin B can reach (radius BC about C) lie
-    inside the grid and inside the 2D camera's view of a square panel (wider panels see more)."""
+    """
+    Return the disk (radius OA about O) and every place pin B can reach.
+
+    (radius BC about C) lie inside the grid and inside the 2D camera's view of a square panel
+    (wider panels see more).
+    """
     [three_d] = [config for key, config in load_layout()['configById'].items()
                  if key.startswith('3D!')]
     margin = 0.1  # m
@@ -325,9 +334,12 @@ def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
 def test_rocker_angle_and_pin_arcs_are_the_papers_coordinates(
     drive: DriveLaw, alpha_deg: float
 ) -> None:
-    """θ_BC = π − β places B as C + BC·(cos θ, sin θ); V_A and V_B are the pins' velocities along
-    (cos α, sin α) and (sin β, cos β) (the paper's Eqs. 8a and 8b–9), their rates the tangential
-    accelerations."""
+    """
+    θ_BC = π − β places B as C + BC·(cos θ, sin θ).
+
+    V_A and V_B are the pins' velocities along (cos α, sin α) and (sin β, cos β) (the paper's Eqs.
+    8a and 8b–9), their rates the tangential accelerations.
+    """
     state = solve(PAPER, math.radians(alpha_deg), drive)
     point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, 'o').points[0]
     rocker_angle, pin_a_arc, pin_b_arc = point.positions[7:]

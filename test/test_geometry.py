@@ -106,8 +106,12 @@ def test_dead_point_distance() -> None:
 
 
 def test_change_points_are_not_dead_points() -> None:
-    """A parallelogram has change points and no dead points: distances and the first dead point
-    on the way say so, which is what lets a motion run through its change points."""
+    """
+    Return a parallelogram has change points and no dead points.
+
+    Distances and the first dead point on the way say so, which is what lets a motion run through
+    its change points.
+    """
     parallelogram = FourBar(0.3, 1.0, 0.3, 1.0, 0.0).reachability
     assert parallelogram.dead_point_distance(1.5) is None
     assert parallelogram.change_point_distance(1.5) == pytest.approx(math.pi / 2 - 1.5, abs=1e-15)

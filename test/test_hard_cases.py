@@ -1,4 +1,5 @@
-"""Numerical stability: dead points at float64's limit, scale, extreme rates and many turns.
+"""
+Numerical stability: dead points at float64's limit, scale, extreme rates and many turns.
 
 Near a dead point the exact answer is ill-conditioned: a one-ulp change of the float α alone
 moves it by what ``reference.input_floor`` computes (the "input floor"). The library must stay
@@ -48,7 +49,11 @@ def assert_finite(state: LinkageState) -> None:
 
 
 def paper_dead_points() -> list[tuple[mpf, int]]:
-    """The paper mechanism's two dead points, each with the direction of its reachable side."""
+    """
+    Return the paper mechanism's two dead points.
+
+    Each with the direction of its reachable side.
+    """
     points = reference_singular_angles(PAPER)
 
     def nearest(end: float) -> mpf:
@@ -59,8 +64,12 @@ def paper_dead_points() -> list[tuple[mpf, int]]:
 
 
 def refused_by_rule(alpha: float, dead: mpf) -> bool:
-    """Where solve must refuse: a one-ulp change of α moves the exact accelerations (which grow
-    as δ^(−3/2)) by more than RATE_ACCURACY."""
+    """
+    Where solve must refuse.
+
+    A one-ulp change of α moves the exact accelerations (which grow as δ^(−3/2)) by more than
+    RATE_ACCURACY.
+    """
     delta = abs(float(mpf(alpha) - dead))
     return 1.5 * math.ulp(alpha) / delta > RATE_ACCURACY if delta else True
 
@@ -74,8 +83,12 @@ def test_paper_dead_point_is_where_the_seed_starts_from() -> None:
 @pytest.mark.parametrize('drive', [CONSTANT, VARIABLE], ids=['constant', 'variable'])
 @pytest.mark.parametrize('branch', [1, -1])
 def test_approaching_the_paper_dead_points(offset: float, drive: DriveLaw, branch: int) -> None:
-    """Both dead points (−1.94° and 181.94°), from their reachable sides: every quantity within
-    3× what a one-ulp change of α does to the exact answer; solve_many agrees with solve."""
+    """
+    Both dead points (−1.94° and 181.94°), from their reachable sides.
+
+    Every quantity within 3× what a one-ulp change of α does to the exact answer; solve_many agrees
+    with solve.
+    """
     for dead, side in paper_dead_points():
         alpha = float(dead + side * offset)
         state = solve(PAPER, alpha, drive, branch)
@@ -92,9 +105,12 @@ def test_approaching_the_paper_dead_points(offset: float, drive: DriveLaw, branc
 
 @pytest.mark.parametrize('exponent', np.arange(-16.5, -10.9, 0.5))
 def test_refusal_zone_is_where_float64_cannot_follow(exponent: float) -> None:
-    """DeadPointError exactly where a one-ulp change of α moves the exact accelerations by more
-    than RATE_ACCURACY (about 1e-14 rad from the −1.94° dead point, 7e-13 rad from the
-    181.94° one), the same in solve and solve_many."""
+    """
+    Refuse with DeadPointError exactly where float64 cannot follow, in solve and solve_many.
+
+    That is where a one-ulp change of α moves the exact accelerations by more than
+    RATE_ACCURACY (about 1e-14 rad from the −1.94° dead point, 7e-13 rad from the 181.94° one).
+    """
     for dead, side in paper_dead_points():
         alpha = float(dead + side * mpf(10) ** mpf(float(exponent)))
         delta = abs(float(mpf(alpha) - dead))
@@ -152,8 +168,11 @@ def test_scale_invariance(factor: float) -> None:
 @pytest.mark.parametrize('omega0', [1e-6, -1e-6, 1e-3, 1.0, -7.5, 1e4, -1e4])
 @pytest.mark.parametrize('k', [0.0, 10.0, -10.0, 0.37])
 def test_extreme_drive_rates(omega0: float, k: float) -> None:
-    """Angular rates are ω times a geometric ratio; accelerations follow α̈ = k·ω; all match the
-    reference from 1e-6 to 1e4 rad/s."""
+    """
+    Angular rates are ω times a geometric ratio; accelerations follow α̈ = k·ω.
+
+    All match the reference from 1e-6 to 1e4 rad/s.
+    """
     for alpha in (0.05, 0.8, 2.0):
         drive = DriveLaw(omega0, k)
         omega = drive.angular_velocity(alpha)
@@ -214,8 +233,11 @@ def test_pose_is_the_full_state_s_positions(alpha: float, branch: int) -> None:
 
 @pytest.mark.parametrize('offset', [0.0, 1e-16, 1e-15, 1e-12, 1e-9])
 def test_positions_stay_exact_where_the_rates_are_singular(offset: float) -> None:
-    """Where solve() refuses (at and within ~1e-14 rad of the dead point), solve_pose() still
-    places the links; at every offset its angles are within 3× the input floor."""
+    """
+    Where solve() refuses (at and within ~1e-14 rad of the dead point).
+
+    Solve_pose() still places the links; at every offset its angles are within 3× the input floor.
+    """
     for dead, side in paper_dead_points():
         alpha = float(dead + side * offset)
         if refused_by_rule(alpha, dead):

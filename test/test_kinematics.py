@@ -35,8 +35,11 @@ GEOMETRIES = {
 
 
 def sample_angles(linkage: FourBar, count: int) -> list[float]:
-    """Evenly spread crank angles over each reachable interval, plus two within 1e-3 rad of
-    each dead point (on its reachable side)."""
+    """
+    Evenly spread crank angles over each reachable interval.
+
+    Plus two within 1e-3 rad of each dead point (on its reachable side).
+    """
     angles = []
     for low, high in linkage.reachability.intervals:
         angles.extend(np.linspace(low, high, count + 2)[1:-1])
@@ -92,8 +95,11 @@ def test_solve_many_equals_solve_and_closes_the_loop(name: str, branch: int) -> 
 
 @pytest.mark.parametrize('name', ['paper', 'drag_link', 'rocker_rocker_raised'])
 def test_finite_differences_of_positions_give_the_rates(name: str) -> None:
-    """Central differences in α of solve_many's positions, times ω (and α̈ = k·ω), reproduce
-    the closed-form velocities and accelerations."""
+    """
+    Central differences in α of solve_many's positions, times ω (and α̈ = k·ω).
+
+    Reproduce the closed-form velocities and accelerations.
+    """
     linkage = GEOMETRIES[name]
     step = 1e-4
     # Away from dead points, where the truncation error h²·β'''/6 stays small.
@@ -172,8 +178,11 @@ def test_random_linkages_match_reference(crank, coupler, rocker, ground_x, groun
 @given(crank=st.floats(0.1, 0.5), extra=st.lists(st.floats(0.2, 2.0), min_size=3, max_size=3),
        tilt=st.floats(-math.pi, math.pi))
 def test_grashof_crank_rocker_turns_fully(crank, extra, tilt) -> None:
-    """The crank as the strictly shortest link of a Grashof linkage turns fully, and the
-    reference agrees at every sampled angle."""
+    """
+    Return the crank as the strictly shortest link of a Grashof linkage turns fully.
+
+    And the reference agrees at every sampled angle.
+    """
     coupler, rocker, ground = (crank + length for length in extra)
     ordered = sorted((crank, coupler, rocker, ground))
     assume(ordered[0] + ordered[3] < 0.99 * (ordered[1] + ordered[2]))
@@ -188,7 +197,7 @@ def test_grashof_crank_rocker_turns_fully(crank, extra, tilt) -> None:
 
 
 def _row(state: LinkageState) -> dict[str, float]:
-    """The seed's table columns (degrees, m/s, rad/s, rad/s²)."""
+    """Return the seed's table columns (degrees, m/s, rad/s, rad/s²)."""
     return {
         'beta': math.degrees(state.beta),
         'gamma': math.degrees(state.gamma),
@@ -222,7 +231,7 @@ def test_seed_tables_1_and_2(alpha_degrees: float) -> None:
 
 
 def test_seed_values_at_alpha_zero_to_more_digits() -> None:
-    """The README's exact figures: ω_BC = −20/3, ω̇_AB = −57.78, ω̇_BC = 192.59 at α = 0."""
+    """Return the README's exact figures: ω_BC = −20/3, ω̇_AB = −57.78, ω̇_BC = 192.59 at α = 0."""
     state = solve(PRESETS['paper'].geometry, 0.0, CONSTANT)
     assert state.omega_bc == pytest.approx(-20.0 / 3.0, rel=1e-12)
     assert round(state.omega_dot_ab, 2) == -57.78
@@ -270,7 +279,7 @@ def test_unreachable_angle_names_the_interval() -> None:
 
 @pytest.mark.parametrize('name', sorted(GEOMETRIES))
 def test_dense_sweep_is_finite_and_reachable_mask_agrees(name: str) -> None:
-    """solve never returns NaN or inf: it answers or raises, at every angle of a dense sweep."""
+    """Solve never returns NaN or inf: it answers or raises, at every angle of a dense sweep."""
     linkage = GEOMETRIES[name]
     angles = np.linspace(-math.pi, math.pi, 2001)
     mask = reachable_mask(linkage, angles)

@@ -1,7 +1,11 @@
-"""The launch files and their parameters files, tested without `launch` (not installable here):
-what they name exists in the installed share/ and entry points, they use only launch API that
-every Jazzy release has (launch 3.4.0 on), and each parameters file starts the node to its end
-with ``--params-file``, in the namespaces it is meant for."""
+"""
+The launch files and their parameters files.
+
+Tested without `launch` (not installable here): what they name exists in the installed share/ and
+entry points, they use only launch API that every Jazzy release has (launch 3.4.0 on), and each
+parameters file starts the node to its end with ``--params-file``, in the namespaces it is meant
+for.
+"""
 
 from __future__ import annotations
 

@@ -1,4 +1,5 @@
-"""linkage_node end to end: a real node process, real rclpy and Fast DDS, a listener here.
+"""
+linkage_node end to end: a real node process, real rclpy and Fast DDS, a listener here.
 
 Also the node's pure motion functions (loop, bounce, fixed steps) and the URDF's kinematics.
 """
@@ -70,8 +71,10 @@ def listener(context, request):
 
 
 def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
-    """Run a node with ``parameters`` (end_behavior 'stop') to its end while listening; return
-    its exit status. Keep only what the listener heard of that run.
+    """
+    Run a node with ``parameters`` (end_behavior 'stop') to its end while listening.
+
+    Return its exit status. Keep only what the listener heard of that run.
 
     The node first loops; once the listener hears it (discovery may take seconds), switching
     end_behavior to 'stop' restarts the motion from alpha_start, so the listener sees the whole
@@ -105,7 +108,7 @@ def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
 
 
 def _header_of(message):
-    """The message, or for a MarkerArray its first marker: whatever carries the header."""
+    """Return the message, or for a MarkerArray its first marker: whatever carries the header."""
     return message.markers[0] if isinstance(message, MarkerArray) else message
 
 
@@ -299,8 +302,12 @@ def test_signal_ends_a_logging_run_cleanly(listener, tmp_path, signal_number):
 
 
 def _limit_file_size() -> None:
-    """In the node process: files may not grow past 100 kB (writes fail with EFBIG, as on a
-    full disk, instead of the default SIGXFSZ killing the process)."""
+    """
+    In the node process.
+
+    Files may not grow past 100 kB (writes fail with EFBIG, as on a full disk, instead of the
+    default SIGXFSZ killing the process).
+    """
     signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
     resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
 

@@ -1,5 +1,8 @@
-"""linkage_node under bad input: every parameter tried with wrong types, NaN, ±inf, zero,
-negative and huge values, at start-up and at run time, and a crank driven into a dead point.
+"""
+linkage_node under bad input.
+
+Every parameter tried with wrong types, NaN, ±inf, zero, negative and huge values, at start-up and
+at run time, and a crank driven into a dead point.
 
 The full matrix runs through ``build_configuration`` (pure); real node processes cover each class
 of bad value at start-up, all of them at run time (with logging on, so the bag must keep every
@@ -106,7 +109,7 @@ CONFIGURED = {
 
 
 def bad_value(name: str, bad_class: str):
-    """The value of ``bad_class`` for parameter ``name`` (typed like the parameter)."""
+    """Return the value of ``bad_class`` for parameter ``name`` (typed like the parameter)."""
     integer = isinstance(DEFAULTS[name], int) and not isinstance(DEFAULTS[name], bool)
     return {
         'wrong type': WRONG_TYPE[type(DEFAULTS[name])],
@@ -319,9 +322,12 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
 
 
 def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(tmp_path):
-    """The paper's mechanism driven clockwise from 0 towards −0.1 rad meets its dead point at
-    ≈ −1.941°: 'loop' restarts there, 'bounce' reverses there, 'stop' ends with status 1; each
-    time diagnostics report ERROR at once, and WARN (close to the dead point) before it."""
+    """
+    Drive the paper's mechanism clockwise from 0 into its dead point at ≈ −1.941°.
+
+    Aiming at −0.1 rad: 'loop' restarts there, 'bounce' reverses there, 'stop' ends with status 1;
+    each time diagnostics report ERROR at once, and WARN (close to the dead point) before it.
+    """
     warning = math.radians(3.0)  # the whole pass lies within 3° of the dead point
     drive = DriveLaw(-0.05)  # 0.68 s from 0 to the dead point
     with ros_context(DOMAIN_ID) as context:

@@ -1,5 +1,9 @@
-"""cpu_affinity: the node's threads on one CPU and its bag writer process on the others, set at
-start-up and at run time; a CPU the process may not use is refused naming the parameter."""
+"""
+cpu_affinity.
+
+The node's threads on one CPU and its bag writer process on the others, set at start-up and at run
+time; a CPU the process may not use is refused naming the parameter.
+"""
 
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ NOT_AVAILABLE = min(set(range(1024)) - AVAILABLE)
 
 
 def thread_cpus(pid: int) -> dict[int, set[int]]:
-    """The CPUs each thread of process ``pid`` may run on."""
+    """Return the CPUs each thread of process ``pid`` may run on."""
     return {int(thread): os.sched_getaffinity(int(thread))
             for thread in os.listdir(f'/proc/{pid}/task')}
 

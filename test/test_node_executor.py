@@ -1,4 +1,5 @@
-"""linkage_node's executor: what it must deliver besides ticks.
+"""
+linkage_node's executor: what it must deliver besides ticks.
 
 On wall time the node spins on rclpy.experimental.EventsExecutor, which dispatches timers from
 C++ and takes timers and services from the node when they change; on simulated time on rclpy's

@@ -1,5 +1,8 @@
-"""linkage_node over a long run: a Grashof crank driven through 10 000 revolutions on simulated
-time stays exact, and its published angles stay continuous.
+"""
+linkage_node over a long run.
+
+A Grashof crank driven through 10 000 revolutions on simulated time stays exact, and its published
+angles stay continuous.
 
 The test process owns the clock: the node runs with use_sim_time and ticks on each /clock step
 (7° of crank per step); the clock then jumps 10 000 s (10 000 turns at 1 turn/s) and steps on.
@@ -43,8 +46,12 @@ def _seconds(nanoseconds: int) -> float:
 def _run_on_sim_time(
     tmp_path, parameters: dict, phases: list[list[int]]
 ) -> tuple[list, list]:
-    """Run a node with ``parameters`` on simulated time, stepping the clock through ``phases``
-    (a state for each step); return the /linkage/state and /joint_states messages received."""
+    """
+    Run a node with ``parameters`` on simulated time.
+
+    Stepping the clock through ``phases`` (a state for each step); return the /linkage/state and
+    /joint_states messages received.
+    """
     with ros_context(DOMAIN_ID) as context:
         listener = Listener('sim_time_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
@@ -138,9 +145,13 @@ TURNS = 1000
 
 
 def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_path):
-    """OA = BC, AB = OC: both cranks turn fully, and at α = 90° and 270° (where every tick of
-    this run lands) the two assemblies meet. The node never ends a pass there: the parallelogram
-    stays a parallelogram (γ = 0, ω_AB = 0, ω_BC = ω), α keeps counting, joints stay continuous."""
+    """
+    OA = BC, AB = OC.
+
+    Both cranks turn fully, and at α = 90° and 270° (where every tick of this run lands) the two
+    assemblies meet. The node never ends a pass there: the parallelogram stays a parallelogram (γ =
+    0, ω_AB = 0, ω_BC = ω), α keeps counting, joints stay continuous.
+    """
     phases = [[CLOCK_START + n * QUARTER for n in range(9)],
               [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER for n in range(9)]]
     states, joint_states = _run_on_sim_time(

@@ -1,5 +1,9 @@
-"""Several mechanisms in one ROS graph: nodes in their own namespaces publish only on their own
-topics, log only those, carry their frame prefix, and say where their bag goes."""
+"""
+Several mechanisms in one ROS graph.
+
+Nodes in their own namespaces publish only on their own topics, log only those, carry their frame
+prefix, and say where their bag goes.
+"""
 
 from __future__ import annotations
 

@@ -1,5 +1,9 @@
-"""linkage_node's parameters: validation as pure functions, rejection at start-up (one line naming
-the parameter, exit status 2, nothing written) and at run time over the parameter services."""
+"""
+linkage_node's parameters.
+
+Validation as pure functions, rejection at start-up (one line naming the parameter, exit status 2,
+nothing written) and at run time over the parameter services.
+"""
 
 from __future__ import annotations
 

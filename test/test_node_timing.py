@@ -1,6 +1,10 @@
-"""Stamps are mechanism time: every logged state sits at the node-clock time at which the drive
-law puts the crank at its α, in both modes and under both laws, and the log shows the motion's
-activity as it changes. Real node runs, read back with rosbags."""
+"""
+Stamps are mechanism time.
+
+Every logged state sits at the node-clock time at which the drive law puts the crank at its α, in
+both modes and under both laws, and the log shows the motion's activity as it changes. Real node
+runs, read back with rosbags.
+"""
 
 from __future__ import annotations
 
@@ -26,7 +30,7 @@ def _stamp_ns(message) -> int:
 
 
 def _logged(bag: Path) -> dict[str, list[tuple[int, object]]]:
-    """topic -> [(log time ns, decoded message)] in log order."""
+    """Topic -> [(log time ns, decoded message)] in log order."""
     logged: dict[str, list[tuple[int, object]]] = {}
     with Reader(bag) as reader:
         for connection, log_time, raw in reader.messages():

@@ -1,5 +1,9 @@
-"""What the node's log survives: SIGKILL (and the documented recovery), SIGINT/SIGTERM, a log
-folder that cannot be created, a bag name already taken, and a disk that fills during the run."""
+"""
+What the node's log survives.
+
+SIGKILL (and the documented recovery), SIGINT/SIGTERM, a log folder that cannot be created, a bag
+name already taken, and a disk that fills during the run.
+"""
 from __future__ import annotations
 
 from collections.abc import Iterator
@@ -57,8 +61,11 @@ FILE_SIZE_LIMIT_BYTES = 256 * 1024
 def node_with_listener(
     parameters: dict[str, Any], domain: int, output: Path, **start_options: Any
 ) -> Iterator[tuple[Listener, subprocess.Popen]]:
-    """A node process (``start_node``'s arguments) and a listener to all its topics, on their
-    own ROS domain; both ended on leaving."""
+    """
+    Return a node process (``start_node``'s arguments) and a listener to all its topics.
+
+    On their own ROS domain; both ended on leaving.
+    """
     with ros_context(domain) as context:
         listener = listen_to_node_topics(context, f'faults_listener_{domain}')
         process = start_node(parameters, domain, output, **start_options)
@@ -81,9 +88,12 @@ def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0)
 
 
 def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
-    """Channel topics by id and the messages that an mcap streaming reader (no summary needed)
-    gets from the file as it is: a running or killed recorder's file ends after its last
-    complete chunk, without footer."""
+    """
+    Channel topics by id and the messages that an mcap streaming reader.
+
+    (no summary needed) gets from the file as it is: a running or killed recorder's file ends after
+    its last complete chunk, without footer.
+    """
     topics: dict[int, str] = {}
     messages: list[Message] = []
     with open(mcap_path, 'rb') as stream:
@@ -99,7 +109,7 @@ def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
 
 
 def stream_topics(mcap_path: Path) -> set[str]:
-    """The topics of the messages in the complete chunks of a recorder's file so far."""
+    """Return the topics of the messages in the complete chunks of a recorder's file so far."""
     topics, messages = stream_records(mcap_path)
     return {topics[message.channel_id] for message in messages}
 
@@ -113,9 +123,12 @@ def recover(bag: Path) -> subprocess.CompletedProcess:
 
 def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
                                     kill_writer: bool) -> tuple[Path, int, int]:
-    """Runs a logging node until complete chunks hold every topic and a listener has heard
-    them all, then SIGKILLs the node (and first its bag writer, if ``kill_writer``). The bag,
-    the stamp of the last /joint_states heard and the wall time of the kill (ns)."""
+    """
+    Run a logging node until complete chunks hold every topic, then SIGKILL it.
+
+    A listener must have heard them all too; the bag writer is killed first if ``kill_writer``.
+    Return the bag, the stamp of the last /joint_states heard and the wall time of the kill (ns).
+    """
     with node_with_listener(
         {**LOOP_PARAMETERS, 'log.folder': str(folder)}, domain, tmp_path / 'node.log'
     ) as (listener, process):
@@ -146,8 +159,12 @@ def wait_until_gone(pid: int) -> None:
 def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
     tmp_path: Path,
 ) -> None:
-    """The bag writer outlives a killed node: it writes what the node handed over (all but the
-    last batch of at most 16 messages or 50 ms), the summary and the final metadata.yaml."""
+    """
+    Return the bag writer outlives a killed node.
+
+    It writes what the node handed over (all but the last batch of at most 16 messages or 50 ms),
+    the summary and the final metadata.yaml.
+    """
     folder = tmp_path / 'bags'
     bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
         tmp_path, folder, 35, kill_writer=False)

@@ -1,6 +1,9 @@
-"""Issue 6 soak: the node at 1 kHz with logging for ten minutes keeps its deadlines, its memory
-and a complete log. Skipped unless LINKAGE_SOAK=1; LINKAGE_SOAK_SECONDS shortens it for
-development (default 600)."""
+"""
+Issue 6 soak.
+
+The node at 1 kHz with logging for ten minutes keeps its deadlines, its memory and a complete log.
+Skipped unless LINKAGE_SOAK=1; LINKAGE_SOAK_SECONDS shortens it for development (default 600).
+"""
 from __future__ import annotations
 
 import math

@@ -48,7 +48,11 @@ def parse_csv(text: str) -> dict[str, np.ndarray]:
 
 
 def expected_columns(state: LinkageState, alpha_deg: np.ndarray) -> dict[str, np.ndarray]:
-    """The CSV's columns computed here from solve_many's state, as the header defines them."""
+    """
+    Return the CSV's columns computed here from solve_many's state.
+
+    As the header defines them.
+    """
     return {
         'alpha_deg': alpha_deg,
         'beta_deg': np.degrees(np.unwrap(state.beta)),
@@ -74,7 +78,7 @@ def assert_columns_equal(
 
 
 def assert_four_panels_of_two_curves(image: np.ndarray) -> None:
-    """A 1200×800 PNG whose four quadrants each hold a blue and an orange curve."""
+    """Return a 1200×800 PNG whose four quadrants each hold a blue and an orange curve."""
     assert image.shape == (800, 1200, 4)
     for colour in ('tab:blue', 'tab:orange'):
         drawn = np.all(np.abs(image[:, :, :3] - to_rgb(colour)) < 0.05, axis=2)
@@ -210,8 +214,12 @@ PARALLELOGRAM_ARGS = ('--crank-length', '0.3', '--coupler-length', '1.0', '--roc
 
 
 def test_parallelogram_turns_through_its_change_points() -> None:
-    """The issue's command: a parallelogram turns fully, through its change points at 90° and
-    270°, on the smooth branch the start names (here the crossed one), as one process."""
+    """
+    Return the issue's command.
+
+    A parallelogram turns fully, through its change points at 90° and 270°, on the smooth branch
+    the start names (here the crossed one), as one process.
+    """
     result = run_sweep(*PARALLELOGRAM_ARGS, '--alpha-start', '0', '--alpha-end', '360')
     assert result.returncode == 0, result.stderr
     assert result.stderr == ''
