@@ -46,7 +46,8 @@ def _run_node(params_file: Path, log_folder: Path) -> Path:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of ``linkage-demo``."""
-    parser = argparse.ArgumentParser(prog='linkage-demo', description=__doc__.strip().splitlines()[0])
+    parser = argparse.ArgumentParser(prog='linkage-demo',
+                                     description=__doc__.strip().splitlines()[0])
     parser.add_argument('--log-folder', type=Path, default=Path('bags'),
                         help='folder that receives one new bag per run (default: bags)')
     parser.add_argument('--rows', type=number(int, at_least=1, rule='at least 1'), default=2,
