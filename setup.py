@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 from glob import glob
 
 from setuptools import find_packages, setup

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Section "cost": linkage_node against the rclpy node a lab would write by hand, side by side.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Section 2: the drive law in time: the exact flow against explicit Euler and classical RK4.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """Section 1: cost per configuration against error, for the library and its alternatives."""
 
 from __future__ import annotations

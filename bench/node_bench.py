@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Section 3: the node: cost per tick, sustained rate, jitter, latency, log size, memory.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Measure the library's error near dead points and change points against test/reference.py.
 

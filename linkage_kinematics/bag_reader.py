@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Read the node's logged runs: rosbag2 MCAP bag folders or bare ``.mcap`` files.
 

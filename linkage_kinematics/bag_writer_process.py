@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 A BagWriter in a process of its own, so that a node's timer never waits for the MCAP writer.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 The crank's drive law ω = ω0 + k·α and its exact flow in time.
 

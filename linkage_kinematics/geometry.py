@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Geometry of a planar four-bar linkage: validation, presets and reachability.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Exact positions, rates and accelerations of the four-bar, for one α or for arrays of α.
 

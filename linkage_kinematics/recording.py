@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
 

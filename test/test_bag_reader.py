@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 bag_reader against bags written by an independent writer (mcap_ros2's), whole.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Change points: Grashof linkages with s + l = p + q turn through them on the smooth branch.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """The package builds in a colcon workspace and its installed linkage_node runs and publishes."""
 
 from __future__ import annotations

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """The drive law ω = ω0 + k·α and its exact flow α(t), checked against mpmath's closed form."""
 
 from __future__ import annotations

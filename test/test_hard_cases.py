@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Numerical stability: dead points at float64's limit, scale, extreme rates and many turns.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """Exact four-bar kinematics checked against the independent mpmath reference (reference.py)."""
 
 from __future__ import annotations

@@ -1,3 +1,6 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
 """linkage-sweep, run as a subprocess and in-process: CSV, tables, plot, bags and bad input."""
 
 from __future__ import annotations
