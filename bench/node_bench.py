@@ -166,6 +166,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     """
     os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
     from linkage_kinematics import messages
+    from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
     from linkage_kinematics.kinematics import solve
     from linkage_kinematics.motion import sample_at_time, solve_sample
     from linkage_kinematics.node import LinkageNode
@@ -192,18 +193,20 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             nodes.append(bare_node)
             bare_publisher = bare_node.create_publisher(JointState, '/bench/joint_states', 10)
             config = logging_node.config
-            recorder = logging_node._recorder
-            publishers = logging_node._topic_publishers
+            recorder = logging_node.outputs.recorder
+            publishers = logging_node.outputs._publishers
             clock = logging_node.get_clock()
             elapsed = [i * 1e-3 for i in range(count)]
             samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
             state = solve_sample(config, samples[0])
             stamp = clock.now()
-            bare_message = messages.joint_state(state, stamp.to_msg())
-            joint_state_encoder = messages.JointStateEncoder()
+            names = list(DEFAULT_JOINT_NAMES.values())
+            positions, velocities = tree_values(state, Driver.CRANK)
+            bare_message = messages.joint_state(names, positions, velocities, stamp.to_msg())
+            joint_state_encoder = messages.JointStateEncoder(names)
             state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
-            positions = messages.joint_positions(state)
-            joint_state_data = joint_state_encoder.encode(state, stamp.nanoseconds, positions)
+            joint_state_data = joint_state_encoder.encode(stamp.nanoseconds, positions,
+                                                          velocities)
             trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 

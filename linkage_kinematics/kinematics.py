@@ -73,6 +73,19 @@ class DeadPointError(ValueError):
 
 
 @dataclass(frozen=True, slots=True)
+class CrankRates:
+    """
+    The crank's angular velocity ω (rad/s) and acceleration ω̇ (rad/s²) at the α solved for.
+
+    Given instead of a drive law where the crank's motion is measured, not commanded: ``solve``
+    then takes its rates as they are.
+    """
+
+    omega: float
+    omega_dot: float
+
+
+@dataclass(frozen=True, slots=True)
 class LinkageState:
     """
     Everything the seed tabulates and plots, for one configuration or an array of them.
@@ -315,7 +328,8 @@ def _smooth_rate_terms(
 
 
 def _closed_form(
-    linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray, drive: DriveLaw | None,
+    linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray,
+    drive: DriveLaw | CrankRates | None,
     xp: MathFunctions,
 ) -> tuple[FloatOrArray, ...]:
     """
@@ -389,8 +403,12 @@ def _closed_form(
                 pin_a_y, ground_x + rocker_x, ground_y + rocker_y, atan2(abs(sine), cosine),
                 sine, closes, nearest_dead)
 
-    omega = drive.omega0 + drive.k * alpha
-    omega_dot = drive.k * omega
+    if type(drive) is CrankRates:
+        omega = drive.omega
+        omega_dot = drive.omega_dot
+    else:
+        omega = drive.omega0 + drive.k * alpha
+        omega_dot = drive.k * omega
     # v_A = OA·ω·(cos α, sin α); a_A = OA·ω̇·(cos α, sin α) − OA·ω²·(sin α, −cos α)
     crank_omega = crank * omega
     omega_squared = omega * omega
@@ -540,10 +558,13 @@ def _refuse(linkage: FourBar, alpha: float) -> ValueError:
 
 
 def solve(
-    linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1
+    linkage: FourBar, alpha: float, drive: DriveLaw | CrankRates, branch: int = 1
 ) -> LinkageState:
     """
     Return the exact state at one crank angle (the node's hot path).
+
+    The crank's rates come from ``drive``: a drive law's ω = ω0 + k·α and ω̇ = k·ω at α, or
+    ``CrankRates`` given as they are (a measured crank).
 
     ``branch`` is the side of B relative to the line A→C at this α (+1 left, −1 right); at a
     change point itself, where the sides meet, the side just counterclockwise of it. To follow a

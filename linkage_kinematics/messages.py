@@ -21,14 +21,13 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
 from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState, unwrap_near
+from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.recording import FixedShapeEncoder
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
 
-JOINT_NAMES = ('crank_joint', 'coupler_joint', 'rocker_joint')
 MARKER_NAMESPACE = 'linkage'
 # Marker ids are fixed so that every MarkerArray updates the same markers in place.
 DISK_ID, BARS_ID, PIN_A_ID, PIN_B_ID, PIVOT_O_ID, PIVOT_C_ID = range(6)
@@ -71,56 +70,30 @@ def _stamp_paths(prefix: str) -> list[str]:
     return [f'{prefix}header.stamp.sec', f'{prefix}header.stamp.nanosec']
 
 
-def joint_positions(
-    state: LinkageState, previous: Sequence[float] = (0.0, 0.0, 0.0)
-) -> tuple[float, float, float]:
-    """
-    URDF joint positions (crank, coupler, rocker) = (α, γ − α, −β − γ) in rad.
-
-    The coupler and rocker positions are shifted by whole turns to lie within π of
-    ``previous`` (the last published positions), so a stream of them is continuous.
-    """
-    return (
-        state.alpha,
-        unwrap_near(state.gamma - state.alpha, previous[1]),
-        unwrap_near(-state.beta - state.gamma, previous[2]),
-    )
-
-
-def joint_velocities(state: LinkageState) -> tuple[float, float, float]:
-    """URDF joint velocities (ω, ω_AB − ω, ω_BC − ω_AB) in rad/s."""
-    return (state.omega, state.omega_ab - state.omega, state.omega_bc - state.omega_ab)
-
-
 def joint_state(
-    state: LinkageState,
+    names: Sequence[str],
+    positions: Sequence[float],
+    velocities: Sequence[float],
     stamp: Time,
-    previous_positions: Sequence[float] = (0.0, 0.0, 0.0),
 ) -> JointState:
-    """/joint_states: the URDF's three joints; frame_id stays empty as joint_state_publisher's."""
-    message = JointState(name=list(JOINT_NAMES))
+    """/joint_states of ``joints.JointStream`` values, frame_id empty (joint_state_publisher's)."""
+    message = JointState(name=list(names), position=list(positions), velocity=list(velocities))
     message.header.stamp = stamp
-    message.position = joint_positions(state, previous_positions)
-    message.velocity = joint_velocities(state)
     return message
 
 
 class JointStateEncoder:
-    """The bytes of ``joint_state`` (encode_cdr), straight from a state."""
+    """The bytes of ``joint_state`` (encode_cdr) for fixed joint names, straight from values."""
 
-    def __init__(self) -> None:
-        template = JointState(name=list(JOINT_NAMES), position=[0.0] * 3, velocity=[0.0] * 3)
+    def __init__(self, names: Sequence[str]) -> None:
+        count = len(names)
+        template = JointState(name=list(names), position=[0.0] * count, velocity=[0.0] * count)
         self._encoder = FixedShapeEncoder(template, [*_stamp_paths(''), 'position', 'velocity'])
 
-    def encode(self, state: LinkageState, stamp_ns: int, positions: Sequence[float]) -> bytes:
-        """
-        ``positions`` are ``joint_positions`` of ``state``.
-
-        Unwrapped as the caller keeps them.
-        """
-        return self._encoder.encode(
-            (*divmod(stamp_ns, 1_000_000_000), *positions, *joint_velocities(state))
-        )
+    def encode(
+        self, stamp_ns: int, positions: Sequence[float], velocities: Sequence[float]
+    ) -> bytes:
+        return self._encoder.encode((*divmod(stamp_ns, 1_000_000_000), *positions, *velocities))
 
 
 def state_coordinates(

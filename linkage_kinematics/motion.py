@@ -2,9 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The motion.
+The drive_law source: the motion under the drive law, from node-clock time to states.
 
-Pure functions from node-clock time or a step index to the crank angle to solve at.
+Pure functions from node-clock time or a step index to the crank angle to solve at, and
+``DriveLawRun``, which turns the node's timer ticks into the states that are due.
 
 A RunConfiguration fixes one pass of the crank (alpha_start to ``segment_end``); these functions
 say where the crank is in it, how passes follow each other under each end behaviour, and what the
@@ -16,8 +17,8 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 import math
 
-from linkage_kinematics.geometry import TWO_PI
-from linkage_kinematics.kinematics import continued_branch, LinkageState, solve
+from linkage_kinematics.geometry import TWO_PI, UnreachableError
+from linkage_kinematics.kinematics import continued_branch, DeadPointError, LinkageState, solve
 from linkage_kinematics.parameters import RunConfiguration
 
 
@@ -190,3 +191,121 @@ def dead_point_problem(config: RunConfiguration) -> str:
         f'the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° '
         f'before alpha_end = {math.degrees(config.alpha_end):.6f}°: it {outcome}'
     )
+
+
+@dataclass(frozen=True)
+class DueState:
+    """
+    One state the drive law has made due, and what happened on the way to it.
+
+    ``at_ns`` is its node-clock stamp; ``state`` None when the crank angle was refused
+    (``refusal`` says why: at a dead point, which has no state to show); ``met_dead_point``
+    when the crank met the dead point that cuts a pass short just before it.
+    """
+
+    sample: MotionSample
+    at_ns: int
+    state: LinkageState | None
+    refusal: str | None
+    met_dead_point: bool
+
+
+class DriveLawRun:
+    """
+    The drive_law source: which states are due at a node-clock time (ns), in either mode.
+
+    The node's timer calls ``advance`` with the clock's time; the run remembers where the
+    motion started, which fixed step comes next, the ticks and the missed deadlines (in
+    real_time, timer periods that passed without a tick; in fixed_step, steps published only
+    after the next step's time had come; counted over the whole run, across restarts). No ROS.
+    """
+
+    def __init__(self, config: RunConfiguration) -> None:
+        self.config = config
+        self.missed_deadlines = 0
+        self.window_ticks = 0
+        self.restart()
+
+    def restart(self) -> None:
+        """Start the motion again from alpha_start at the next ``advance``."""
+        self.start_ns: int | None = None
+        self._step = 0
+        self._ticks = 0
+        self._pass_index = 0
+        self._missed_before_restart = self.missed_deadlines
+
+    @property
+    def timer_period(self) -> float:
+        """
+        Return the state timer's period (s): 1/rate_hz in real_time mode.
+
+        In fixed_step mode the timer is re-armed for each step's time (``advance``'s second
+        value) and this first period only starts it.
+        """
+        if self.config.mode == 'real_time':
+            return 1.0 / self.config.rate_hz
+        return 1e-3
+
+    def advance(self, now_ns: int) -> tuple[list[DueState], int | None, bool]:
+        """
+        Return the states due by ``now_ns``, the next step's time, and whether it cannot go on.
+
+        The next step's time (ns) only in fixed_step mode; a 'stop' motion cannot go on at a
+        dead point before alpha_end. A time before the motion's start (ROS time jumped back,
+        e.g. a simulation restarted) starts it over.
+        """
+        if self.start_ns is None or now_ns < self.start_ns:
+            self.restart()
+            self.start_ns = now_ns
+        if self.config.mode == 'real_time':
+            return self._advance_in_real_time(now_ns)
+        return self._advance_steps(now_ns)
+
+    def _advance_in_real_time(self, now_ns: int) -> tuple[list[DueState], int | None, bool]:
+        config = self.config
+        elapsed = (now_ns - self.start_ns) * 1e-9
+        # A period that passed without a tick is a missed deadline; rcl timers skip such
+        # periods rather than firing twice, so the shortfall stays visible.
+        self._ticks += 1
+        self.window_ticks += 1
+        due = math.floor(elapsed * config.rate_hz + 1e-6) + 1
+        self.missed_deadlines = max(
+            self.missed_deadlines, self._missed_before_restart + due - self._ticks)
+        sample = sample_at_time(config, elapsed)
+        if sample is None:
+            return [], None, True
+        # The end of a 'stop' pass is stamped at the time the drive law reaches it.
+        at_ns = self._motion_time(sample.motion_time) if sample.final else now_ns
+        return [self._solve(sample, at_ns)], None, False
+
+    def _advance_steps(self, now_ns: int) -> tuple[list[DueState], int | None, bool]:
+        due_states: list[DueState] = []
+        while True:
+            sample = sample_at_step(self.config, self._step)
+            if sample is None:
+                return due_states, None, True
+            at_ns = self._motion_time(sample.motion_time)
+            if at_ns > now_ns:
+                return due_states, at_ns, False
+            if due_states:
+                # The step before this one went out only once this one's time had come.
+                self.missed_deadlines += 1
+            self._step += 1
+            self._ticks += 1
+            self.window_ticks += 1
+            due_states.append(self._solve(sample, at_ns))
+            if sample.final:
+                return due_states, None, False
+
+    def _motion_time(self, seconds: float) -> int:
+        """Return the node-clock time ``seconds`` of drive-law time after the start (ns)."""
+        return self.start_ns + round(seconds * 1e9)
+
+    def _solve(self, sample: MotionSample, at_ns: int) -> DueState:
+        config = self.config
+        met = met_dead_point(config, self._pass_index, sample.pass_index)
+        self._pass_index = sample.pass_index
+        try:
+            return DueState(sample, at_ns, solve_sample(config, sample), None, met)
+        except (DeadPointError, UnreachableError) as error:
+            return DueState(sample, at_ns, None, str(error), met)

@@ -4,39 +4,31 @@
 """
 ``linkage_node``.
 
-Turns the disk under the drive law and publishes the linkage's exact state.
+Publishes the linkage's exact state as the drive law turns the crank, or as a measured joint
+moves it.
 
-A thin shell over two pure modules: ``parameters`` validates the parameter values into a frozen
-RunConfiguration, ``motion`` maps node-clock time or a step index to the crank angle to solve
-at; the state comes from ``kinematics.solve`` and the messages from ``messages``. Topics,
-parameters, diagnostics and exit statuses are documented in README.md.
+A thin shell that wires pure modules to ROS: ``parameters`` validates the parameter values into
+a frozen RunConfiguration; the two sources, ``motion.DriveLawRun`` (the drive law on the node's
+timer) and ``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states``
+message), give the states; ``status`` says what ``/diagnostics`` reports; ``node_outputs``
+publishes and logs. Topics, parameters, diagnostics and exit statuses are documented in
+README.md.
 """
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import signal
 import sys
-import time
 from typing import Any
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import bag_reader, messages
-from linkage_kinematics.bag_writer import package_version
 from linkage_kinematics.bag_writer_process import set_process_affinity
-from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
-from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
-from linkage_kinematics.motion import (
-    blocked_note,
-    dead_point_problem,
-    met_dead_point,
-    MotionSample,
-    sample_at_step,
-    sample_at_time,
-    solve_sample,
-)
+from linkage_kinematics.geometry import GeometryError
+from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.measured import MeasuredFollower, Rejection
+from linkage_kinematics.motion import blocked_note, dead_point_problem, DriveLawRun
+from linkage_kinematics.node_outputs import NodeOutputs
 from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
@@ -48,9 +40,9 @@ from linkage_kinematics.parameters import (
     ParameterSpec,
     REAL_PARAMETERS,
     RunConfiguration,
+    Source,
 )
-from linkage_kinematics.recording import encode_cdr, Recorder
-from linkage_kinematics.urdf import urdf_text
+from linkage_kinematics.status import assess, MeasuredHealth, state_values
 from rcl_interfaces.msg import (
     FloatingPointRange,
     IntegerRange,
@@ -58,32 +50,23 @@ from rcl_interfaces.msg import (
     SetParametersResult,
 )
 import rclpy
-from rclpy.duration import Duration
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile
 from rclpy.signals import SignalHandlerOptions
-from rclpy.time import Time
 from sensor_msgs.msg import JointState
-from std_msgs.msg import String
-from trajectory_msgs.msg import JointTrajectory
-from visualization_msgs.msg import MarkerArray
 
-DIAGNOSTIC_TASK = 'crank motion'
 DIAGNOSTICS_PERIOD = 1.0  # s
 
 EXIT_OK = 0
 EXIT_FAILED = 1  # the crank met a dead point before alpha_end, or the log could not be closed
 EXIT_CONFIGURATION = 2
 
-DATA_QOS = QoSProfile(depth=10)
-# robot_state_publisher's convention: late joiners get the latest description.
-ROBOT_DESCRIPTION_QOS = QoSProfile(
-    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
-)
+# Deep enough that a burst of encoder samples waiting for one slow callback is never lost.
+MEASURED_QOS = QoSProfile(depth=100)
 
 
 def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
@@ -107,53 +90,14 @@ def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> Parame
     return descriptor
 
 
-def assess(
-    config: RunConfiguration, state: LinkageState | None, problem: str | None, activity: str
-) -> tuple[bytes, str]:
-    """
-    Diagnostic level and message.
-
-    ERROR for ``problem`` (the crank cannot go on, or the log failed), WARN near a dead point or at
-    a poor transmission angle, else OK with ``activity``.
-    """
-    if problem is not None:
-        return DiagnosticStatus.ERROR, problem
-    if state is None:
-        return DiagnosticStatus.OK, activity
-    warnings = []
-    deviation = min(state.transmission_angle, math.pi - state.transmission_angle)
-    if deviation < config.min_transmission_angle:
-        warnings.append(
-            f'transmission angle {math.degrees(state.transmission_angle):.2f}° is within '
-            f'{math.degrees(config.min_transmission_angle):.2f}° of a straight line'
-        )
-    reachability = config.linkage.reachability
-    distance = reachability.dead_point_distance(state.alpha)
-    if distance is not None and distance < config.dead_point_warning:
-        warnings.append(f'{math.degrees(distance):.3f}° from a dead point')
-    distance = reachability.change_point_distance(state.alpha)
-    if distance is not None and distance < config.dead_point_warning:
-        warnings.append(
-            f'{math.degrees(distance):.3f}° from a change point (the assemblies meet; the '
-            'motion continues smoothly on its branch)'
-        )
-    note = blocked_note(config)
-    if note is not None:
-        warnings.append(note)
-    if warnings:
-        return DiagnosticStatus.WARN, '; '.join(warnings)
-    return DiagnosticStatus.OK, activity
-
-
 # --- the node ------------------------------------------------------------------------------
 
 
 class LinkageNode(Node):
     """
-    Publishes the linkage's state as the drive law moves the crank.
+    Publishes the linkage's state as its source moves it (README: Topics, Parameters).
 
-    Markers at display_rate_hz, diagnostics at 1 Hz and whenever the motion's activity changes.
-
+    Markers at display_rate_hz, diagnostics at 1 Hz and whenever the activity changes.
     Construction raises ConfigurationError for bad parameters before anything is published or
     written. ``exit_code`` becomes an int when the node has finished (see README).
     """
@@ -162,71 +106,45 @@ class LinkageNode(Node):
         super().__init__(NODE_NAME, **node_options)
         self.exit_code: int | None = None
         specs = self._declare_parameters()
-        self.config = build_configuration(self.parameter_values())
+        self.config = config = build_configuration(self.parameter_values())
         # Ranges go into the descriptors only now, so that a bad start-up value gets
         # build_configuration's message; from here on rclpy enforces them too.
         for spec in specs:
             if spec.floating_range is not None or spec.integer_range is not None:
                 self.set_descriptor(spec.name, parameter_descriptor(spec))
-        if blocked_note(self.config) is not None:
-            self.get_logger().warning(blocked_note(self.config))
+        if blocked_note(config) is not None:
+            self.get_logger().warning(blocked_note(config))
         self._pending: tuple[RunConfiguration, list[str]] | None = None
         self._problem: str | None = None
         self._activity = 'starting'
-        self._recording_error: str | None = None
-        self._described_linkage: FourBar | None = None
-        # frame_id and frame_prefix are read-only: one frame for the node's life.
-        self._frame_id = self.config.frame_prefix + self.config.frame_id
-        # The per-tick messages and the scene are encoded straight from the state; the
-        # encoders of the state and the scene are prepared for each geometry.
-        self._joint_state_encoder = messages.JointStateEncoder()
-        self._joint_positions: tuple[float, float, float] = (0.0, 0.0, 0.0)
-        self._encoded_linkage: FourBar | None = None
-        self._state_encoder: messages.LinkageStateEncoder | None = None
-        self._marker_encoder: messages.MarkerArrayEncoder | None = None
-        self._window_start: Time | None = None
-        self._window_ticks = 0
+        self._state: LinkageState | None = None
+        self._state_ns = 0
+        self._stale = False  # measured: no valid sample within measured.timeout
+        self._window_start_ns: int | None = None
         self._achieved_rate = 0.0
-        self._missed_deadlines = 0
-        self._missed_before_restart = 0
-        self._restart_motion()
-        # Relative names resolve under the node's namespace (as joint_state_publisher's and
-        # robot_state_publisher's do), so mechanisms in different namespaces never mix;
-        # /diagnostics is absolute, diagnostic_updater's convention.
-        publishers = (
-            self.create_publisher(JointState, 'joint_states', DATA_QOS),
-            self.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
-            self.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS),
-            self.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
-            self.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
-        )
-        self._topic_publishers = {publisher.topic_name: publisher for publisher in publishers}
-        (
-            self._joint_states_topic,
-            self._state_topic,
-            self._description_topic,
-            self._markers_topic,
-            self._diagnostics_topic,
-        ) = self._topic_publishers
         self._available_cpus = (
             os.sched_getaffinity(0) if hasattr(os, 'sched_getaffinity') else set()
         )
         self._bag_writer_cpus: set[int] | None = None
-        self._bag_writer_cpus = self._place(self.config.cpu_affinity)
-        self._recorder = self._open_recorder() if self.config.log_enabled else None
-        if self._recorder is not None:
-            self.get_logger().info(f'recording to {self._recorder.bag_path}')
-        self._state_timer = self.create_timer(self._timer_period(), self._tick)
-        self._marker_timer = self.create_timer(
-            1.0 / self.config.display_rate_hz, self._publish_markers
-        )
+        self._bag_writer_cpus = self._place(config.cpu_affinity)
+        self.outputs = NodeOutputs(self, config, self.parameter_values(), self._bag_writer_cpus)
+        if self.outputs.recorder is not None:
+            self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
+        self._marker_timer = self.create_timer(1.0 / config.display_rate_hz,
+                                               self._publish_markers)
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics)
         self.add_pre_set_parameters_callback(self._keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
-        # The motion starts now (its first state, scene first, is published at once), unless
-        # the clock does not run yet (use_sim_time before the first /clock).
-        self._tick()
+        self._run = DriveLawRun(config)
+        self._follower = MeasuredFollower(config)
+        if config.source is Source.MEASURED:
+            self._start_measured()
+        else:
+            self._state_timer = self.create_timer(self._run.timer_period, self._tick)
+            # The motion starts now (its first state, scene first, is published at once),
+            # unless the clock does not run yet (use_sim_time before the first /clock).
+            self._tick()
 
     # parameters
 
@@ -263,11 +181,7 @@ class LinkageNode(Node):
 
     @staticmethod
     def _keep_declared_types(changed: list[Parameter]) -> list[Parameter]:
-        """
-        Whole numbers given for real parameters become those reals.
-
-        So that a parameter never changes type (`ros2 param set /linkage_node rate_hz 50`).
-        """
+        """Turn whole numbers given for real parameters into those reals (types never change)."""
         return [
             Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
             if p.name in REAL_PARAMETERS and p.type_ == Parameter.Type.INTEGER
@@ -276,11 +190,7 @@ class LinkageNode(Node):
         ]
 
     def _validate_change(self, changed: list[Parameter]) -> SetParametersResult:
-        """
-        Validate the whole configuration the change would produce.
-
-        Keep it for the post-set callback, which swaps it in once rclpy has stored the values.
-        """
+        """Validate the whole configuration the change would produce; keep it for the post-set."""
         current = self.parameter_values()
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
@@ -300,27 +210,40 @@ class LinkageNode(Node):
         if not differing:
             return  # e.g. `ros2 param load` of the node's own dump: nothing changes
         old, self.config = self.config, new
+        self.outputs.config = self._run.config = self._follower.config = new
         restarts = new.restarts_motion(old)
         self.get_logger().info(
             'parameters changed: '
             + ', '.join(f'{name}={self.get_parameter(name).value!r}' for name in differing)
             + ('; motion restarts at alpha_start' if restarts else '')
         )
-        note = blocked_note(new)
-        if note is not None:
-            self.get_logger().warning(note)
+        if blocked_note(new) is not None:
+            self.get_logger().warning(blocked_note(new))
         if new.display_rate_hz != old.display_rate_hz:
             self.destroy_timer(self._marker_timer)
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
                                                    self._publish_markers)
         if new.cpu_affinity != old.cpu_affinity:
             self._bag_writer_cpus = self._place(new.cpu_affinity)
-            if self._recorder is not None:
-                self._recorder.run_writer_on(self._bag_writer_cpus or self._available_cpus)
+            if self.outputs.recorder is not None:
+                self.outputs.recorder.run_writer_on(self._bag_writer_cpus or self._available_cpus)
+        if new.measured_timeout != old.measured_timeout and new.source is Source.MEASURED:
+            self.destroy_timer(self._freshness_timer)
+            self._freshness_timer = self.create_timer(0.25 * new.measured_timeout,
+                                                      self._check_freshness)
+        if new.joints != old.joints:
+            # The lab's names and mapping: a measured driver is read anew, the URDF follows.
+            self._follower = MeasuredFollower(new)
+            self.outputs.publish_description(self._state_ns if self._state else self._now_ns())
         if restarts:
-            self._restart_motion()
+            self._state = None
+            if new.source is Source.MEASURED:
+                self._follower.restart()
+                self.outputs.publish_description(self._now_ns())
+                return
+            self._run.restart()
             self.destroy_timer(self._state_timer)
-            self._state_timer = self.create_timer(self._timer_period(), self._tick)
+            self._state_timer = self.create_timer(self._run.timer_period, self._tick)
             self._tick()
 
     # placement
@@ -340,15 +263,12 @@ class LinkageNode(Node):
 
     def _place(self, cpu: int) -> set[int] | None:
         """
-        Pin every thread of this process.
+        Pin every thread of this process to ``cpu`` (or unpin it for -1).
 
-        (Fast DDS's included; threads started later inherit it) to ``cpu``, or give a pinned
-        process back every CPU it could use for -1; return the CPUs for the bag writer process,
-        None when the node is not pinned.
-
-        On one CPU the executor's timer thread and the thread running the callbacks wake each
-        other without crossing CPUs, and the bag writer cannot delay either
-        (docs/benchmarks.md, section 3).
+        Fast DDS's threads included; threads started later inherit it. Return the CPUs for the
+        bag writer process, None when the node is not pinned. On one CPU the executor's timer
+        thread and the thread running the callbacks wake each other without crossing CPUs, and
+        the bag writer cannot delay either (docs/benchmarks.md, section 3).
         """
         self._check_cpu(cpu)
         if cpu == NO_CPU_AFFINITY and self._bag_writer_cpus is None:
@@ -365,316 +285,150 @@ class LinkageNode(Node):
         )
         return bag_writer_cpus
 
-    # recording
+    # the drive_law source
 
-    def _open_recorder(self) -> Recorder:
-        """
-        Return a recorder for every topic, before anything is published.
-
-        ConfigurationError naming log.folder if it cannot be written.
-        """
-        metadata = {
-            'parameters': json.dumps(self.parameter_values(), sort_keys=True),
-            'package_version': package_version(),
-        }
-        try:
-            recorder = Recorder(
-                self.config.log_folder, metadata=metadata, cpus=self._bag_writer_cpus
-            )
-        except OSError as error:
-            raise ConfigurationError('log.folder', str(error)) from None
-        try:
-            for topic, publisher in self._topic_publishers.items():
-                recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
-        except OSError as error:
-            recorder.close()
-            raise ConfigurationError('log.folder', str(error)) from None
-        return recorder
-
-    def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
-        self._send(topic, encode_cdr(message), log_time_ns)
-
-    def _send(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """
-        Publish a message encoded by ``encode_cdr``.
-
-        (or an encoder equal to it) and log it: subscribers get the very bytes that are logged.
-        """
-        self._topic_publishers[topic].publish(data)
-        if self._recorder is None or self._recording_error is not None:
-            return
-        try:
-            self._recorder.record(topic, data, log_time_ns)
-        except OSError as error:
-            # The data keep flowing; diagnostics report the lost log.
-            self._recording_error = f'recording stopped: {error}'
-            self.get_logger().error(self._recording_error)
-
-    def flush_publishers(self, timeout: float = 1.0) -> None:
-        """
-        Give subscribers up to ``timeout`` seconds in all to acknowledge what was published.
-
-        The final state of a 'stop' run must not die with the process.
-        """
-        deadline = time.monotonic() + timeout
-        for publisher in self._topic_publishers.values():
-            publisher.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))
-
-    def close_log(self) -> bool:
-        """Finalize the bag (idempotent); False, with an error logged, if that failed."""
-        if self._recorder is None:
-            return True
-        try:
-            self._recorder.close()
-        except OSError as error:
-            self.get_logger().error(f'could not finalize the log: {error}')
-            return False
-        bag = self._recorder.bag_path
-        count = bag_reader.bag_information(bag)['message_count']
-        self.get_logger().info(f'bag finalized: {bag}, {count} messages')
-        return True
-
-    # motion
-
-    def _timer_period(self) -> float:
-        """
-        Return the state timer's period: rate_hz in real_time mode.
-
-        In fixed_step mode the timer is re-armed for each step's time, and this first period only
-        starts it.
-        """
-        if self.config.mode == 'real_time':
-            return 1.0 / self.config.rate_hz
-        return 1e-3
-
-    def _restart_motion(self) -> None:
-        self._motion_start: Time | None = None
-        self._state: LinkageState | None = None
-        self._state_time: Time | None = None
-        self._step = 0
-        self._ticks = 0
-        self._pass_index = 0
-        # Missed deadlines count over the whole run, across restarts.
-        self._missed_before_restart = self._missed_deadlines
+    def _now_ns(self) -> int:
+        return self.get_clock().now().nanoseconds
 
     def _tick(self) -> None:
-        if self.exit_code is not None:
-            return
-        now = self.get_clock().now()
-        if now.nanoseconds == 0:
-            return  # use_sim_time and no /clock yet: the motion has no time to start at
-        if self._motion_start is None or now < self._motion_start:
-            # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
-            self._restart_motion()
-            self._motion_start = now
-        if self.config.mode == 'real_time':
-            self._advance_in_real_time(now)
-        else:
-            self._advance_steps(now)
-
-    def _advance_in_real_time(self, now: Time) -> None:
-        elapsed = (now - self._motion_start).nanoseconds * 1e-9
-        self._count_tick(elapsed)
-        sample = sample_at_time(self.config, elapsed)
-        if sample is None:
+        now_ns = self._now_ns()
+        if self.exit_code is not None or now_ns == 0:
+            return  # finished, or use_sim_time and no /clock yet: no time to start at
+        if self._run.start_ns is None or now_ns < self._run.start_ns:
+            self._state = None  # the motion starts (again): its scene and status come first
+        due_states, next_ns, blocked = self._run.advance(now_ns)
+        for due in due_states:
+            if due.met_dead_point:
+                self._publish_diagnostics(dead_point_problem(self.config), due.at_ns)
+            if due.state is None:
+                if self.config.end_behavior == 'stop':
+                    self._cannot_go_on(due.refusal)
+                    return
+                continue  # loop and bounce turn round at the dead point, which has no state
+            self._publish_state(due.state, due.at_ns, due.sample.motion_time)
+            if due.sample.final:
+                self._activity = (
+                    f'reached alpha_end = {math.degrees(self.config.alpha_end):.6f}°; stopped')
+                self.get_logger().info(self._activity)
+                self._publish_markers()
+                self._publish_diagnostics()
+                self.exit_code = EXIT_OK
+                return
+        if blocked:
             self._cannot_go_on(None)
-            return
-        # The end of a 'stop' pass is published at the time the drive law reaches it.
-        at = self._motion_time(sample.motion_time) if sample.final else now
-        self._publish_sample(sample, at)
-
-    def _advance_steps(self, now: Time) -> None:
-        """
-        Publish every step whose drive-law time has come, each stamped with that time.
-
-        Then re-arm the timer for the next step's time.
-        """
-        published = 0
-        while self.exit_code is None:
-            sample = sample_at_step(self.config, self._step)
-            if sample is None:
-                self._cannot_go_on(None)
-                return
-            due = self._motion_time(sample.motion_time)
-            if due > now:
-                self._state_timer.timer_period_ns = (due - now).nanoseconds
-                self._state_timer.reset()
-                return
-            if published:
-                # The step before this one went out only once this one's time had come.
-                self._missed_deadlines += 1
-            published += 1
-            self._step += 1
-            self._ticks += 1
-            self._window_ticks += 1
-            self._publish_sample(sample, due)
-
-    def _motion_time(self, seconds: float) -> Time:
-        """Return the node-clock time ``seconds`` of drive-law time after the motion started."""
-        return self._motion_start + Duration(nanoseconds=round(seconds * 1e9))
-
-    def _publish_sample(self, sample: MotionSample, at: Time) -> None:
-        config = self.config
-        if met_dead_point(config, self._pass_index, sample.pass_index):
-            self._publish_diagnostics(dead_point_problem(config), at)
-        self._pass_index = sample.pass_index
-        try:
-            state = solve_sample(config, sample)
-        except (DeadPointError, UnreachableError) as error:
-            if config.end_behavior == 'stop':
-                self._cannot_go_on(str(error))
-            # loop and bounce turn round at the dead point itself, which has no state to show.
-            return
-        self._publish_state(state, sample.motion_time, at)
-        if sample.final:
-            self._finish_at_end()
-
-    def _count_tick(self, elapsed: float) -> None:
-        # A period that passed without a tick is a missed deadline; rcl timers skip such periods
-        # rather than firing twice, so the shortfall stays visible.
-        self._ticks += 1
-        due = math.floor(elapsed * self.config.rate_hz + 1e-6) + 1
-        self._missed_deadlines = max(
-            self._missed_deadlines, self._missed_before_restart + due - self._ticks
-        )
-        self._window_ticks += 1
-
-    def _publish_state(self, state: LinkageState, motion_time: float, at: Time) -> None:
-        """
-        Publish a state stamped ``at``.
-
-        The first of a motion comes after its scene (so a viewer knows the frame before anything
-        refers to it), the URDF if the geometry is new, and the status that says the crank moves.
-        """
-        first = self._state is None
-        self._state = state
-        self._state_time = at
-        if first:
-            if self._encoded_linkage != self.config.linkage:
-                self._prepare_encoders()
-            self._publish_markers()
-            if self._described_linkage != self.config.linkage:
-                self._publish_robot_description(at)
-            self._activity = 'moving'
-            self._publish_diagnostics()
-        nanoseconds = at.nanoseconds
-        self._joint_positions = messages.joint_positions(state, self._joint_positions)
-        self._send(
-            self._joint_states_topic,
-            self._joint_state_encoder.encode(state, nanoseconds, self._joint_positions),
-            nanoseconds,
-        )
-        self._send(
-            self._state_topic,
-            self._state_encoder.encode(state, nanoseconds, motion_time),
-            nanoseconds,
-        )
-
-    def _prepare_encoders(self) -> None:
-        linkage = self.config.linkage
-        self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
-        self._marker_encoder = messages.MarkerArrayEncoder(linkage, self._frame_id)
-        self._encoded_linkage = linkage
-
-    def _finish_at_end(self) -> None:
-        self._activity = (
-            f'reached alpha_end = {math.degrees(self.config.alpha_end):.6f}°; stopped'
-        )
-        self.get_logger().info(self._activity)
-        self._publish_markers()
-        self._publish_diagnostics()
-        self.exit_code = EXIT_OK
+        elif next_ns is not None:
+            self._state_timer.timer_period_ns = next_ns - now_ns
+            self._state_timer.reset()
 
     def _cannot_go_on(self, detail: str | None) -> None:
-        config = self.config
-        if config.blocked_at is not None:
-            problem = dead_point_problem(config)
+        if self.config.blocked_at is not None:
+            self._problem = dead_point_problem(self.config)
         else:
-            problem = f'the crank cannot go on: {detail}'
-        self._problem = problem
-        self.get_logger().error(problem)
+            self._problem = f'the crank cannot go on: {detail}'
+        self.get_logger().error(self._problem)
         self._publish_diagnostics()
         self.exit_code = EXIT_FAILED
 
-    # display and diagnostics
+    # the measured source
 
-    def _publish_robot_description(self, at: Time) -> None:
-        self._described_linkage = self.config.linkage
-        message = String(data=urdf_text(self.config.linkage, self.config.frame_id))
-        self._publish(self._description_topic, message, at.nanoseconds)
+    def _start_measured(self) -> None:
+        config = self.config
+        self._driver_name = config.joints[config.driver].name
+        self._health = MeasuredHealth(self._now_ns())
+        self._activity = f'waiting for {self._driver_name} on measured_joint_states'
+        self._measured = self.create_subscription(
+            JointState, 'measured_joint_states', self._on_measured, MEASURED_QOS)
+        self._freshness_timer = self.create_timer(0.25 * config.measured_timeout,
+                                                  self._check_freshness)
+        # The lab's robot_state_publisher gets the URDF before the first sample.
+        self.outputs.publish_description(self._now_ns())
+        self._publish_diagnostics()
+
+    def _on_measured(self, message: JointState) -> None:
+        stamp = message.header.stamp
+        followed = self._follower.follow(stamp.sec * 1_000_000_000 + stamp.nanosec,
+                                         message.name, message.position, message.velocity)
+        if followed is None:
+            return  # this node's own joint states, heard back
+        if isinstance(followed, Rejection):
+            self._health.drop(followed)
+            return
+        self._health.accept(self._now_ns(), followed.velocity)
+        self._run.window_ticks += 1
+        if self._stale:
+            self._stale = False
+            self._state = None  # publish the scene and the status with the next state
+        self._activity = f'following {self._driver_name}'
+        self._publish_state(followed.state, followed.stamp_ns, followed.motion_time)
+
+    def _check_freshness(self) -> None:
+        """Report at once when the measured data goes stale, or the drops of the last period."""
+        stale = self._health.is_stale(self._now_ns(), self.config.measured_timeout)
+        if stale and not self._stale:
+            self._stale = True
+            self._follower.restart()  # a long gap: the next valid sample starts afresh
+            self._publish_diagnostics()
+
+    # publishing
+
+    def _publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+        """
+        Publish a state stamped ``stamp_ns``.
+
+        The first of a motion comes after its scene (so a viewer knows the frame before anything
+        refers to it), the URDF if the geometry is new, and the status that says it moves.
+        """
+        first = self._state is None
+        self._state = state
+        self._state_ns = stamp_ns
+        self.outputs.publish_state(state, stamp_ns, motion_time)
+        if first:
+            self._publish_markers()
+            self.outputs.publish_description(stamp_ns)
+            if self.config.source is Source.DRIVE_LAW:
+                self._activity = 'moving'
+            self._publish_diagnostics()
 
     def _publish_markers(self) -> None:
-        """Return the scene of the latest state, stamped with that state's time."""
-        if self._state is None:
-            return
-        nanoseconds = self._state_time.nanoseconds
-        self._send(
-            self._markers_topic, self._marker_encoder.encode(self._state, nanoseconds),
-            nanoseconds,
-        )
+        """Publish the scene of the latest state, stamped with that state's time."""
+        if self._state is not None:
+            self.outputs.publish_markers(self._state, self._state_ns)
 
-    def _publish_diagnostics(self, event: str | None = None, at: Time | None = None) -> None:
+    def _publish_diagnostics(self, event: str | None = None, at_ns: int | None = None) -> None:
         """
-        Publish the status.
+        Publish the status, stamped ``at_ns``.
 
-        Stamped ``at`` (by default the latest state's time, so that log times never fall behind the
-        states'); ``event``, a problem of this moment only, makes it ERROR.
+        By default the latest state's time, so that log times never fall behind the states',
+        or now before the first state and while measured data is stale; ``event``, a problem
+        of this moment only, makes it ERROR.
         """
-        now = self.get_clock().now()
-        if at is None:
-            at = self._state_time if self._state_time is not None else now
-        if self._window_start is not None:
-            window = (now - self._window_start).nanoseconds * 1e-9
-            if window > 0.0:
-                self._achieved_rate = self._window_ticks / window
-        self._window_start = now
-        self._window_ticks = 0
-        problem = event or self._problem or self._recording_error
-        level, text = assess(self.config, self._state, problem, self._activity)
-        message = messages.diagnostic_array(
-            at.to_msg(),
-            f'{self.get_name()}: {DIAGNOSTIC_TASK}',
-            f"four-bar linkage ({self.config.preset or 'explicit geometry'})",
-            level,
-            text,
-            self._diagnostic_values(),
-        )
-        self._publish(self._diagnostics_topic, message, at.nanoseconds)
-
-    def _diagnostic_values(self) -> dict[str, str]:
         config = self.config
-        values = {
-            'end behavior': config.end_behavior,
-            'mode': config.mode,
-            'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
-            'rate_hz': f'{config.rate_hz:g}',
-            'missed deadlines': str(self._missed_deadlines),
-        }
-        state = self._state
-        if state is not None:
-            reachability = config.linkage.reachability
-            distance = reachability.dead_point_distance(state.alpha)
-            change_distance = reachability.change_point_distance(state.alpha)
-            residual = float(loop_closure_residual(config.linkage, state))
-            values.update({
-                'alpha (rad)': repr(state.alpha),
-                'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
-                'dead point distance (deg)': (
-                    'none (full rotation)' if distance is None
-                    else f'{math.degrees(distance):.6f}'
-                ),
-                'change point distance (deg)': (
-                    'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
-                ),
-                'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
-                'loop closure residual': f'{residual:.3g}',
-            })
-        if self._recorder is None:
-            values['log file'] = 'disabled'
+        now_ns = self._now_ns()
+        if at_ns is None:
+            at_ns = self._state_ns if self._state is not None and not self._stale else now_ns
+        if self._window_start_ns is not None and now_ns > self._window_start_ns:
+            window = (now_ns - self._window_start_ns) * 1e-9
+            self._achieved_rate = self._run.window_ticks / window
+        self._window_start_ns = now_ns
+        self._run.window_ticks = 0
+        values = {'achieved rate (Hz)': f'{self._achieved_rate:.1f}'}
+        warnings: tuple[str, ...] = ()
+        problem = event or self._problem or self.outputs.recording_error
+        if config.source is Source.MEASURED:
+            values.update(self._health.values(now_ns, config))
+            warnings = self._health.take_warnings()
+            problem = problem or self._health.problem(
+                now_ns, config.measured_timeout, self._driver_name)
         else:
-            values['log file'] = str(self._recorder.bag_path)
-            values['log size (bytes)'] = str(self._recorder.size_bytes)
-        return values
+            values.update({
+                'end behavior': config.end_behavior,
+                'mode': config.mode,
+                'rate_hz': f'{config.rate_hz:g}',
+                'missed deadlines': str(self._run.missed_deadlines),
+            })
+        values.update(state_values(config, self._state))
+        level, text = assess(config, self._state, problem, self._activity, warnings)
+        self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 
 # --- process ------------------------------------------------------------------------------
@@ -725,8 +479,8 @@ def main(args: list[str] | None = None) -> int:
             while node.exit_code is None and not received:
                 executor.spin_once(timeout_sec=0.1)
         finally:
-            node.flush_publishers()
-            log_closed = node.close_log()
+            node.outputs.flush()
+            log_closed = node.outputs.close_log()
             executor.remove_node(node)
             node.destroy_node()
         exit_code = EXIT_OK if received else node.exit_code

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from enum import Enum
 import math
 from pathlib import Path
 from typing import Any
@@ -25,11 +26,22 @@ from linkage_kinematics.geometry import (
     TWO_PI,
     UnreachableError,
 )
+from linkage_kinematics.inversion import seen_from_rocker
+from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, JointMap, JointMapping, Link
 from linkage_kinematics.kinematics import continued_branch, DeadPointError, solve
 from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 import yaml
 
 NODE_NAME = 'linkage_node'
+
+
+class Source(str, Enum):
+    """Where the driver's motion comes from."""
+
+    DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
+    MEASURED = 'measured'  # the driver joint of each measured_joint_states message
+
+
 END_BEHAVIORS = ('stop', 'loop', 'bounce')
 MODES = ('real_time', 'fixed_step')
 GEOMETRY_PARAMETERS = ('crank_length', 'coupler_length', 'rocker_length', 'ground_x', 'ground_y')
@@ -43,6 +55,8 @@ MAX_OMEGA0 = 1e4  # rad/s
 MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
 # s; shorter passes would fall between clock ticks, and elapsed / pass duration could overflow.
 MIN_PASS_DURATION = 1e-6
+MAX_TIMEOUT = 3600.0  # s
+MAX_TIME_CONSTANT = 10.0  # s
 
 # A step count within this fraction of a step of a whole number ends exactly on the segment
 # end, so 90° in 0.5° steps is 180 steps and not 180 plus a rounding-sized 181st.
@@ -68,7 +82,9 @@ class RunConfiguration:
     ``segment_end`` is where one pass of the motion ends: alpha_end, or ``blocked_at``, the
     first dead point the crank meets on its way there (change points do not stop it).
     ``segment_duration`` is the drive-law time of that pass (s), ``direction`` the sign of the
-    crank's travel and ``step_count`` the number of fixed steps strictly before ``segment_end``.
+    crank's travel and ``step_count`` the number of fixed steps strictly before ``segment_end``;
+    with ``source`` measured there is no pass, and these five are those of a motion that never
+    starts (no dead point, duration 0).
     """
 
     preset: str
@@ -89,6 +105,15 @@ class RunConfiguration:
     log_enabled: bool
     log_folder: Path
     cpu_affinity: int
+    source: Source
+    driver: Driver
+    # The linkage as its driver turns it: ``linkage``, or seen from C for the rocker.
+    driven_linkage: FourBar
+    joints: JointMap
+    publish_robot_description: bool
+    measured_timeout: float
+    max_jump: float
+    acceleration_time_constant: float
     direction: int
     segment_end: float
     blocked_at: float | None
@@ -113,6 +138,10 @@ class RunConfiguration:
             dead_point_warning=self.dead_point_warning,
             display_rate_hz=self.display_rate_hz,
             cpu_affinity=self.cpu_affinity,
+            measured_timeout=self.measured_timeout,
+            max_jump=self.max_jump,
+            acceleration_time_constant=self.acceleration_time_constant,
+            joints=self.joints,
         )
         return same_motion != self
 
@@ -145,6 +174,20 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
             ('rocker_length', 'rocker length BC, greater than 0', (0.0, MAX_LENGTH)),
             ('ground_x', 'x of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
             ('ground_y', 'y of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
+        )
+    )
+    joint_specs = tuple(
+        spec
+        for link in Link
+        for spec in (
+            ParameterSpec(f'joints.{link.value}.name', DEFAULT_JOINT_NAMES[link],
+                          f'name of the {link.value} joint in joint_states and the URDF'),
+            ParameterSpec(f'joints.{link.value}.direction', 1,
+                          f'+1 or -1: lab value of the {link.value} joint = direction · node '
+                          'value + offset', integer_range=(-1, 1, 2)),
+            ParameterSpec(f'joints.{link.value}.offset', 0.0,
+                          f'offset of the {link.value} joint (rad): lab value = direction · '
+                          'node value + offset', floating_range=(-MAX_ANGLE, MAX_ANGLE)),
         )
     )
     return (
@@ -207,6 +250,29 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                       "process on the others (as ros2_control's cpu_affinity); -1 leaves "
                       'both to the operating system',
                       integer_range=(NO_CPU_AFFINITY, MAX_CPU, 1)),
+        ParameterSpec('source', Source.DRIVE_LAW.value,
+                      'drive_law: a timer turns the crank under the drive law; measured: the '
+                      'driver joint of each message on measured_joint_states',
+                      read_only=True),
+        ParameterSpec('driver', Driver.CRANK.value,
+                      'joint that moves the linkage: crank (at O) or rocker (at C, '
+                      'source measured only)',
+                      read_only=True),
+        *joint_specs,
+        ParameterSpec('publish_robot_description', True,
+                      "publish the node's URDF on robot_description (false where the lab's "
+                      'robot_state_publisher has its own)', read_only=True),
+        ParameterSpec('measured.timeout', 1.0,
+                      'diagnostics ERROR after this long without a valid measured sample (s), '
+                      'greater than 0', floating_range=(0.0, MAX_TIMEOUT)),
+        ParameterSpec('measured.max_jump', math.pi / 2.0,
+                      'a measured driver angle further than this from the last one used is '
+                      'dropped (rad, greater than 0; π drops none)',
+                      floating_range=(0.0, math.pi)),
+        ParameterSpec('measured.acceleration_time_constant', 0.02,
+                      "time constant of the low-pass filter on the driver's angular "
+                      'acceleration estimate (s); 0 for the raw difference of velocities',
+                      floating_range=(0.0, MAX_TIME_CONSTANT)),
     )
 
 
@@ -313,6 +379,28 @@ def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
     return preset_name, linkage
 
 
+def _joints(values: Mapping[str, Any]) -> JointMap:
+    mappings = {}
+    for link in Link:
+        prefix = f'joints.{link.value}.'
+        direction = values.get(prefix + 'direction')
+        if isinstance(direction, bool) or direction not in (1, -1):
+            raise ConfigurationError(
+                prefix + 'direction',
+                f'must be the integer 1 or -1, got {describe_value(direction)}')
+        mappings[link.value] = JointMapping(
+            _text(values, prefix + 'name'), int(direction),
+            _within(values, prefix + 'offset', -MAX_ANGLE, MAX_ANGLE),
+        )
+    joints = JointMap(**mappings)
+    names = joints.names(tuple(Link))
+    if len(set(names)) < len(names):
+        raise ConfigurationError(
+            'joints.crank.name, joints.coupler.name, joints.rocker.name',
+            f"the three joint names must differ, got {', '.join(names)}")
+    return joints
+
+
 def _branch(values: Mapping[str, Any]) -> int:
     branch = values.get('branch')
     if isinstance(branch, bool) or not isinstance(branch, int) or branch not in (1, -1):
@@ -388,13 +476,28 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     log_enabled = _flag(values, 'log.enabled')
     log_folder = Path(_text(values, 'log.folder'))
     cpu_affinity = _cpu(values)
-    blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
-    segment_end = alpha_end if blocked_at is None else blocked_at
-    travel = abs(segment_end - alpha_start)
-    steps = travel / alpha_step
-    if not math.isfinite(steps):
-        raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
-    step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
+    source = Source(_text(values, 'source', tuple(item.value for item in Source)))
+    driver = Driver(_text(values, 'driver', tuple(item.value for item in Driver)))
+    joints = _joints(values)
+    publish_robot_description = _flag(values, 'publish_robot_description')
+    measured_timeout = _positive(values, 'measured.timeout', 's', MAX_TIMEOUT)
+    max_jump = _positive(values, 'measured.max_jump', 'rad', math.pi)
+    acceleration_time_constant = _within(
+        values, 'measured.acceleration_time_constant', 0.0, MAX_TIME_CONSTANT, 's')
+    if source is Source.MEASURED:
+        # No pass: the drive-law parameters are not used, so not checked against the geometry.
+        blocked_at, segment_duration, segment_end, step_count = None, 0.0, alpha_end, 1
+    else:
+        if driver is not Driver.CRANK:
+            raise ConfigurationError(
+                'driver', 'the drive law turns the crank: driver rocker needs source measured')
+        blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
+        segment_end = alpha_end if blocked_at is None else blocked_at
+        travel = abs(segment_end - alpha_start)
+        steps = travel / alpha_step
+        if not math.isfinite(steps):
+            raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
+        step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     return RunConfiguration(
         preset=preset_name,
         linkage=linkage,
@@ -414,6 +517,14 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         log_enabled=log_enabled,
         log_folder=log_folder,
         cpu_affinity=cpu_affinity,
+        source=source,
+        driver=driver,
+        driven_linkage=linkage if driver is Driver.CRANK else seen_from_rocker(linkage),
+        joints=joints,
+        publish_robot_description=publish_robot_description,
+        measured_timeout=measured_timeout,
+        max_jump=max_jump,
+        acceleration_time_constant=acceleration_time_constant,
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,
         blocked_at=blocked_at,

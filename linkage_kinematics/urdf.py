@@ -2,17 +2,24 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-URDF of a four-bar linkage.
+URDF of a four-bar linkage: an open chain rooted at the driver's ground pivot.
 
-The open chain base → disk → coupler → rocker whose end lands on C.
+For the ``crank`` driver the closed loop is cut at the fixed pivot C: base → disk → coupler →
+rocker, whose end lands on C. With the node's joint positions (α, γ − α, −β − γ, see
+``joints``) the frames turn by α, γ and −β in the plane, so
 
-The closed loop is cut at the fixed pivot C. With the /joint_states positions
-(α, γ − α, −β − γ) the frames turn by α, γ and −β in the plane, so
-
-* ``crank_joint`` at O turns the ``disk``; pin A is at (0, −OA, 0) in the disk frame;
-* ``coupler_joint`` at A: the ``coupler`` frame's x axis points from A to B;
-* ``rocker_joint`` at B, (AB, 0, 0) in the coupler frame: the ``rocker`` frame's x axis points
+* the crank joint at O turns the ``disk``; pin A is at (0, −OA, 0) in the disk frame;
+* the coupler joint at A: the ``coupler`` frame's x axis points from A to B;
+* the rocker joint at B, (AB, 0, 0) in the coupler frame: the ``rocker`` frame's x axis points
   from B to C, which is therefore at (BC, 0, 0) in the rocker frame.
+
+For the ``rocker`` driver it is cut at O: base → rocker (joint at C, x axis from C to B) →
+coupler (joint at B, x axis from B to A) → disk (joint at A, x axis from A to O, which lands at
+(OA, 0, 0)), with the node's positions (θ_BC, γ + β, α − γ − π/2).
+
+Each joint carries the lab's name, and its lab value q = direction · node value + offset turns
+it: the joint's axis is direction·z and its origin is turned by −direction·offset about z, so
+that the child frame turns by direction·(q − offset), the node's value, as above.
 
 The root link (``frame_id``, by default ``linkage_base``) shows both ground pivots.
 Regenerate the installed file with ``python -m linkage_kinematics.urdf > urdf/linkage.urdf``.
@@ -23,6 +30,7 @@ from __future__ import annotations
 import math
 
 from linkage_kinematics.geometry import FourBar, preset
+from linkage_kinematics.joints import Driver, JointMap, JointMapping
 
 DEFAULT_FRAME_ID = 'linkage_base'
 _BAR_WIDTH = 0.02  # m
@@ -63,13 +71,14 @@ def _sphere(radius: float) -> str:
     return f'<sphere radius="{_number(radius)}"/>'
 
 
-def _joint(name: str, parent: str, child: str, xyz: str) -> str:
+def _joint(joint: JointMapping, parent: str, child: str, xyz: str) -> str:
+    yaw = _number(-joint.direction * joint.offset) if joint.offset else '0'
     return (
-        f'  <joint name="{name}" type="continuous">\n'
+        f'  <joint name="{joint.name}" type="continuous">\n'
         f'    <parent link="{parent}"/>\n'
         f'    <child link="{child}"/>\n'
-        f'    <origin xyz="{xyz}" rpy="0 0 0"/>\n'
-        '    <axis xyz="0 0 1"/>\n'
+        f'    <origin xyz="{xyz}" rpy="0 0 {yaw}"/>\n'
+        f'    <axis xyz="0 0 {joint.direction}"/>\n'
         '  </joint>\n'
     )
 
@@ -84,10 +93,16 @@ _MATERIALS = (
 )
 
 
-def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
+def urdf_text(
+    linkage: FourBar,
+    frame_id: str = DEFAULT_FRAME_ID,
+    joints: JointMap = JointMap(),
+    driver: Driver = Driver.CRANK,
+) -> str:
     """
     Return the URDF (XML text) of ``linkage`` with root link ``frame_id``.
 
+    The tree of ``driver``, its joints named and oriented as ``joints`` (module docstring).
     Primitive shapes only.
     """
     crank = linkage.crank_length
@@ -113,12 +128,6 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
         )
         + '  </link>\n'
     )
-    disk = (
-        '  <link name="disk">\n'
-        + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(0.0, 0.0, -_DISK_THICKNESS), 'disk')
-        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, -crank, 0.0), 'pin')
-        + '  </link>\n'
-    )
     coupler_link = (
         '  <link name="coupler">\n'
         + _visual(_box(coupler, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * coupler, 0.0, 0.0),
@@ -128,9 +137,38 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
     rocker_link = (
         '  <link name="rocker">\n'
         + _visual(_box(rocker, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * rocker, 0.0, 0.0), 'rocker')
-        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, 0.0, 0.0), 'pin')
+        + _visual(_sphere(_PIN_RADIUS), _xyz(0.0 if driver is Driver.CRANK else rocker, 0.0,
+                                             0.0), 'pin')
         + '  </link>\n'
     )
+    if driver is Driver.CRANK:
+        disk = (
+            '  <link name="disk">\n'
+            + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(0.0, 0.0, -_DISK_THICKNESS),
+                      'disk')
+            + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, -crank, 0.0), 'pin')
+            + '  </link>\n'
+        )
+        chain = (
+            _joint(joints.crank, frame_id, 'disk', _xyz(0.0, 0.0, 0.0))
+            + _joint(joints.coupler, 'disk', 'coupler', _xyz(0.0, -crank, 0.0))
+            + _joint(joints.rocker, 'coupler', 'rocker', _xyz(coupler, 0.0, 0.0))
+        )
+    else:
+        # The disk's frame has its x axis from A to O, so O is at (OA, 0, 0) in it.
+        disk = (
+            '  <link name="disk">\n'
+            + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(crank, 0.0, -_DISK_THICKNESS),
+                      'disk')
+            + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, 0.0, 0.0), 'pin')
+            + '  </link>\n'
+        )
+        chain = (
+            _joint(joints.rocker, frame_id, 'rocker',
+                   _xyz(linkage.ground_x, linkage.ground_y, 0.0))
+            + _joint(joints.coupler, 'rocker', 'coupler', _xyz(rocker, 0.0, 0.0))
+            + _joint(joints.crank, 'coupler', 'disk', _xyz(coupler, 0.0, 0.0))
+        )
     return (
         '<?xml version="1.0"?>\n'
         '<robot name="linkage">\n'
@@ -139,9 +177,7 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
         + disk
         + coupler_link
         + rocker_link
-        + _joint('crank_joint', frame_id, 'disk', _xyz(0.0, 0.0, 0.0))
-        + _joint('coupler_joint', 'disk', 'coupler', _xyz(0.0, -crank, 0.0))
-        + _joint('rocker_joint', 'coupler', 'rocker', _xyz(coupler, 0.0, 0.0))
+        + chain
         + '</robot>\n'
     )
 

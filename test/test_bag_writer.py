@@ -41,6 +41,7 @@ from linkage_kinematics.bag_writer import (
 )
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
+from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values, unwrap_positions
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.recording import (
     encode_cdr,
@@ -151,7 +152,9 @@ def sample_messages() -> list[Any]:
     state = solve(paper.geometry, 0.3, DriveLaw(2.0, 0.0))
     stamp = messages.time_msg(1_234_567_890_123)
     return [
-        messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
+        # empty effort: the case rclpy pads
+        messages.joint_state(['crank_joint', 'coupler_joint'], *tree_values(state, Driver.CRANK),
+                             stamp),
         messages.linkage_state(paper.geometry, state, stamp, 0.1, 'linkage_base'),
         messages.marker_array(paper.geometry, state, stamp, 'linkage_base'),
         messages.diagnostic_array(
@@ -347,9 +350,11 @@ def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_message
     except ValueError:  # an unreachable or dead-point angle has no state to encode
         return
     stamp_msg = messages.time_msg(stamp)
-    positions = messages.joint_positions(state, previous)
-    assert messages.JointStateEncoder().encode(state, stamp, positions) == encode_cdr(
-        messages.joint_state(state, stamp_msg, previous))
+    positions, velocities = tree_values(state, Driver.CRANK)
+    positions = unwrap_positions(positions, previous)
+    names = list(DEFAULT_JOINT_NAMES.values())
+    assert messages.JointStateEncoder(names).encode(stamp, positions, velocities) == encode_cdr(
+        messages.joint_state(names, positions, velocities, stamp_msg))
     assert messages.LinkageStateEncoder(linkage, frame_id).encode(
         state, stamp, motion_time) == encode_cdr(
         messages.linkage_state(linkage, state, stamp_msg, motion_time, frame_id))

@@ -21,6 +21,7 @@ from linkage_kinematics import messages
 from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset, TWO_PI
+from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_sample
 from linkage_kinematics.parameters import build_configuration
@@ -132,7 +133,7 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
     assert joint_states, 'no /joint_states received'
     previous = None
     for message in joint_states:
-        assert list(message.name) == list(messages.JOINT_NAMES)
+        assert list(message.name) == list(DEFAULT_JOINT_NAMES.values())
         assert message.header.frame_id == ''
         alpha, coupler, rocker = message.position
         state = solve(PAPER, alpha, drive)
@@ -448,7 +449,7 @@ def _point_in(frame: tuple[float, float, float], x: float) -> tuple[float, float
 @pytest.mark.parametrize('alpha', [-0.03, 0.0, 0.7, math.pi / 2.0, 2.5, 3.17])
 def test_urdf_forward_kinematics_lands_on_the_library_pins(alpha):
     state = solve(PAPER, alpha, DriveLaw(2.0))
-    positions = dict(zip(messages.JOINT_NAMES, messages.joint_positions(state)))
+    positions = dict(zip(DEFAULT_JOINT_NAMES.values(), tree_values(state, Driver.CRANK)[0]))
     urdf = urdf_text(PAPER)
     frames = _planar_chain(urdf, positions)
     assert set(frames) == {'linkage_base', 'disk', 'coupler', 'rocker'}

@@ -93,6 +93,17 @@ ACCEPTED = {
     'log.enabled': set(),
     'log.folder': set(),
     'cpu_affinity': {'zero', 'negative'},    # CPU 0; −1 is no pinning; at most 1023
+    'source': set(),
+    'driver': set(),
+    **{f'joints.{link}.{field}': accepted
+       for link in ('crank', 'coupler', 'rocker')
+       for field, accepted in (('name', set()),
+                               ('direction', {'negative'}),  # −1 reverses the axis; only ±1
+                               ('offset', {'zero', 'negative'}))},  # rad, at most 1e6
+    'publish_robot_description': set(),
+    'measured.timeout': set(),               # in (0, 3600] s
+    'measured.max_jump': set(),              # in (0, π] rad
+    'measured.acceleration_time_constant': {'zero'},  # 0 is the raw difference
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
 ACCEPTED_IN_CONTEXT = [{'ground_x': 0.0, 'ground_y': -1.3}, {'ground_x': 0, 'ground_y': -1.3}]
@@ -108,6 +119,10 @@ CONFIGURED = {
     'diagnostics.min_transmission_angle': lambda config: config.min_transmission_angle,
     'diagnostics.dead_point_warning': lambda config: config.dead_point_warning,
     'cpu_affinity': lambda config: config.cpu_affinity,
+    **{f'joints.{link}.{field}': (
+        lambda config, link=link, field=field: getattr(getattr(config.joints, link), field))
+       for link in ('crank', 'coupler', 'rocker') for field in ('direction', 'offset')},
+    'measured.acceleration_time_constant': lambda config: config.acceleration_time_constant,
 }
 
 

@@ -1,0 +1,209 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The measured source: one measured driver joint in, the exact state of the linkage out.
+
+``MeasuredFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
+positions, velocities), picks the driver joint by its lab name, maps it to the node's
+convention (``joints.JointMapping.from_lab``), unwraps it across turns and solves the linkage
+at it: the crank directly, the rocker through the mechanism seen from C (``inversion``).
+
+What is measured, exact or estimated:
+
+* the driver's angle is measured; every position (β, γ, α or θ_BC, the pins, the passive
+  joints) is an exact function of it;
+* the driver's angular velocity is measured when the message carries one for it; otherwise it
+  is estimated by the backward difference (θ_k − θ_{k−1})/(t_k − t_{k−1}) of the unwrapped
+  angles over the header stamps (the mean over the last interval: it lags by half a sample
+  period), and 0 for a first sample; the other velocities are exact functions of angle and ω;
+* the driver's angular acceleration is never in a JointState: it is estimated from the
+  driver's velocities (measured or estimated) by a first-order low-pass filter of their
+  backward differences, ω̇_k = a·ω̇_{k−1} + (1 − a)·(ω_k − ω_{k−1})/(t_k − t_{k−1}) with
+  a = exp(−(t_k − t_{k−1})/τ), τ = ``measured.acceleration_time_constant`` (τ = 0: the raw
+  difference; a step in ω̇ is followed with time constant τ, so the estimate lags by about τ),
+  and 0 for a first sample; every other acceleration is then an estimate too.
+
+A sample that cannot be used is dropped and its ``Rejection`` returned; nothing of it is kept.
+No ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from enum import Enum
+import math
+
+from linkage_kinematics.geometry import TWO_PI, UnreachableError
+from linkage_kinematics.inversion import solve_from_rocker
+from linkage_kinematics.joints import Driver, Link, TREE_ORDER
+from linkage_kinematics.kinematics import (
+    continued_branch,
+    CrankRates,
+    DeadPointError,
+    LinkageState,
+    solve,
+    unwrap_near,
+)
+from linkage_kinematics.parameters import RunConfiguration
+
+
+class Rejection(str, Enum):
+    """Why a measured sample was dropped (the text names it in diagnostics)."""
+
+    NO_DRIVER = 'without the driver joint'
+    NON_FINITE = 'with a NaN or infinite position or velocity'
+    STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
+    UNREACHABLE = 'at a driver angle the loop cannot reach (or at a dead point)'
+    JUMP = 'jumping further than measured.max_jump'
+
+
+class Estimate(str, Enum):
+    """How the driver's angular velocity of a sample was obtained."""
+
+    MEASURED = 'measured'
+    BACKWARD_DIFFERENCE = 'estimated (backward difference of angles)'
+    FIRST_SAMPLE = 'estimated (0: first sample without velocity)'
+
+
+@dataclass(frozen=True)
+class FollowedSample:
+    """
+    The exact state at one measured sample, and how its driver rates were obtained.
+
+    ``state.alpha`` is the unwrapped crank angle; ``driver_angle`` the unwrapped driver angle in
+    the node's convention (α, or θ_BC = π − β for the rocker); ``motion_time`` the stamp's time
+    since the first sample followed (s).
+    """
+
+    stamp_ns: int
+    state: LinkageState
+    driver_angle: float
+    velocity: Estimate
+    motion_time: float
+
+
+@dataclass(frozen=True)
+class _Anchor:
+    """Where the followed motion is known: a driver angle, its assembly and its stamp."""
+
+    stamp_ns: int
+    angle: float  # unwrapped, node convention
+    encoder_angle: float  # as measured, node convention
+    turns: int  # whole turns from encoder_angle to angle
+    crank_angle: float  # α, unwrapped
+    omega: float
+    omega_dot: float
+
+
+class MeasuredFollower:
+    """Follows the measured driver joint; one per run, ``restart`` forgets the motion."""
+
+    def __init__(self, config: RunConfiguration) -> None:
+        self.config = config
+        self._mapping = config.joints[Link(config.driver.value)]
+        # Messages that hold only the joints this node publishes are its own output coming
+        # back (it may listen on the topic it publishes to): ignored, not counted.
+        self._own_names = frozenset(config.joints.names(TREE_ORDER[config.driver][1:]))
+        self.restart()
+
+    def restart(self) -> None:
+        """Forget the motion: the next valid sample starts it again on ``branch``."""
+        self._first: _Anchor | None = None
+        self._last: _Anchor | None = None
+
+    def reconfigure(self, config: RunConfiguration) -> None:
+        """Take new thresholds (timeout, jump, filter) while following the same motion."""
+        self.config = config
+
+    def follow(
+        self,
+        stamp_ns: int,
+        names: Sequence[str],
+        positions: Sequence[float],
+        velocities: Sequence[float],
+    ) -> FollowedSample | Rejection | None:
+        """
+        Return the state at one message's driver sample, or why it was dropped.
+
+        None for a message that is this node's own output (see ``__init__``).
+        """
+        try:
+            index = list(names).index(self._mapping.name)
+            measured_angle = positions[index]
+        except (ValueError, IndexError):
+            if names and self._own_names.issuperset(names):
+                return None
+            return Rejection.NO_DRIVER
+        measured_velocity = velocities[index] if index < len(velocities) else None
+        if not math.isfinite(measured_angle) or (
+                measured_velocity is not None and not math.isfinite(measured_velocity)):
+            return Rejection.NON_FINITE
+        last = self._last
+        if last is not None and stamp_ns <= last.stamp_ns:
+            return Rejection.STAMP_NOT_NEWER
+        encoder_angle = self._mapping.from_lab(measured_angle)
+        # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are counted.
+        turns = 0 if last is None else round((last.angle - encoder_angle) / TWO_PI)
+        angle = encoder_angle + turns * TWO_PI
+        if last is not None and abs(angle - last.angle) > self.config.max_jump:
+            return Rejection.JUMP
+        omega, omega_dot, estimate = self._rates(stamp_ns, angle, measured_velocity)
+        try:
+            state = self._solve(encoder_angle, turns, omega, omega_dot)
+        except (DeadPointError, UnreachableError):
+            return Rejection.UNREACHABLE
+        anchor = _Anchor(stamp_ns, angle, encoder_angle, turns, state.alpha, omega, omega_dot)
+        if self._first is None:
+            self._first = anchor
+        self._last = anchor
+        return FollowedSample(
+            stamp_ns, state, angle, estimate, (stamp_ns - self._first.stamp_ns) * 1e-9)
+
+    def _rates(
+        self, stamp_ns: int, angle: float, measured_velocity: float | None
+    ) -> tuple[float, float, Estimate]:
+        """Return the driver's ω and ω̇ (node convention) and how ω was obtained."""
+        last = self._last
+        if measured_velocity is not None:
+            omega = self._mapping.direction * measured_velocity
+            estimate = Estimate.MEASURED
+        elif last is None:
+            omega, estimate = 0.0, Estimate.FIRST_SAMPLE
+        else:
+            omega = (angle - last.angle) / ((stamp_ns - last.stamp_ns) * 1e-9)
+            estimate = Estimate.BACKWARD_DIFFERENCE
+        if last is None:
+            return omega, 0.0, estimate
+        interval = (stamp_ns - last.stamp_ns) * 1e-9
+        raw = (omega - last.omega) / interval
+        time_constant = self.config.acceleration_time_constant
+        keep = math.exp(-interval / time_constant) if time_constant > 0.0 else 0.0
+        return omega, keep * last.omega_dot + (1.0 - keep) * raw, estimate
+
+    def _solve(self, encoder_angle: float, turns: int, omega: float,
+               omega_dot: float) -> LinkageState:
+        """
+        Return the state at the measured driver angle ``encoder_angle`` + 2π·``turns``.
+
+        Solved at the angle as measured (its precision kept), on the assembly the motion has
+        reached from its first sample through any change points, with α unwrapped.
+        """
+        config = self.config
+        driven = config.driven_linkage
+        first = self._first
+        if first is None:
+            branch = config.branch
+        else:
+            branch = continued_branch(driven, first.encoder_angle, config.branch,
+                                      encoder_angle, turns=turns)
+        rates = CrankRates(omega, omega_dot)
+        if config.driver is Driver.CRANK:
+            state = solve(driven, encoder_angle, rates, branch)
+            return replace(state, alpha=state.alpha + turns * TWO_PI) if turns else state
+        state = solve_from_rocker(config.linkage, driven, encoder_angle, rates, branch)
+        if self._last is None:
+            return state
+        # The crank driven by the rocker may turn fully (a double crank): α stays continuous.
+        return replace(state, alpha=unwrap_near(state.alpha, self._last.crank_angle))

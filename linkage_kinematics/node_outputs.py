@@ -1,0 +1,185 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The node's outputs: its publishers and its log, one place that publishes and records.
+
+Every message is encoded once (``encode_cdr``, or for the per-state messages and the scene an
+encoder that writes the same bytes straight from the state), published, and the very same bytes
+logged at the message's stamp, so subscribers receive exactly what the bag holds.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+from diagnostic_msgs.msg import DiagnosticArray
+from linkage_kinematics import bag_reader, messages
+from linkage_kinematics.bag_writer import package_version
+from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.joints import JointMap, JointStream
+from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.parameters import ConfigurationError, RunConfiguration, Source
+from linkage_kinematics.recording import encode_cdr, Recorder
+from linkage_kinematics.status import Level
+from linkage_kinematics.urdf import urdf_text
+from rclpy.duration import Duration
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from trajectory_msgs.msg import JointTrajectory
+from visualization_msgs.msg import MarkerArray
+
+DATA_QOS = QoSProfile(depth=10)
+# robot_state_publisher's convention: late joiners get the latest description.
+ROBOT_DESCRIPTION_QOS = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
+
+
+class NodeOutputs:
+    """
+    The node's publishers, the encoders of its per-state messages, and its recorder.
+
+    Relative names resolve under the node's namespace (as joint_state_publisher's and
+    robot_state_publisher's do), so mechanisms in different namespaces never mix;
+    /diagnostics is absolute, diagnostic_updater's convention. Construction raises
+    ConfigurationError naming log.folder if the log cannot be written.
+    """
+
+    def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
+                 bag_writer_cpus: set[int] | None) -> None:
+        self._node = node
+        self.config = config
+        publishers = [
+            node.create_publisher(JointState, 'joint_states', DATA_QOS),
+            node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
+            node.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
+            node.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
+        ]
+        if config.publish_robot_description:
+            publishers.append(
+                node.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS))
+        self._publishers = {publisher.topic_name: publisher for publisher in publishers}
+        self._joint_states_topic, self._state_topic, self._markers_topic, \
+            self._diagnostics_topic = (publisher.topic_name for publisher in publishers[:4])
+        self._description_topic = publishers[4].topic_name if len(publishers) > 4 else None
+        self.recording_error: str | None = None
+        self._described: tuple[FourBar, JointMap] | None = None
+        self._encoded: FourBar | None = None
+        self._streamed: JointMap | None = None
+        # frame_id and frame_prefix are read-only: one frame for the node's life.
+        self._frame_id = config.frame_prefix + config.frame_id
+        self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
+                         if config.log_enabled else None)
+
+    def _open_recorder(self, parameter_values: dict[str, Any],
+                       cpus: set[int] | None) -> Recorder:
+        """Return a recorder for every topic, before anything is published."""
+        metadata = {
+            'parameters': json.dumps(parameter_values, sort_keys=True),
+            'package_version': package_version(),
+        }
+        try:
+            recorder = Recorder(self.config.log_folder, metadata=metadata, cpus=cpus)
+        except OSError as error:
+            raise ConfigurationError('log.folder', str(error)) from None
+        try:
+            for topic, publisher in self._publishers.items():
+                recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
+        except OSError as error:
+            recorder.close()
+            raise ConfigurationError('log.folder', str(error)) from None
+        return recorder
+
+    def send(self, topic: str, data: bytes, log_time_ns: int) -> None:
+        """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""
+        self._publishers[topic].publish(data)
+        if self.recorder is None or self.recording_error is not None:
+            return
+        try:
+            self.recorder.record(topic, data, log_time_ns)
+        except OSError as error:
+            # The data keep flowing; diagnostics report the lost log.
+            self.recording_error = f'recording stopped: {error}'
+            self._node.get_logger().error(self.recording_error)
+
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+        """Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``."""
+        if self._encoded != self.config.linkage:
+            linkage = self.config.linkage
+            self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
+            self._marker_encoder = messages.MarkerArrayEncoder(linkage, self._frame_id)
+            self._encoded = linkage
+        if self._streamed != self.config.joints:
+            # A measured driver stays with its own source: only the passive joints go out.
+            self._joints = JointStream(self.config.joints, self.config.driver,
+                                       include_driver=self.config.source is Source.DRIVE_LAW)
+            self._joint_state_encoder = messages.JointStateEncoder(self._joints.names)
+            self._streamed = self.config.joints
+        positions, velocities = self._joints.values(state)
+        self.send(self._joint_states_topic,
+                  self._joint_state_encoder.encode(stamp_ns, positions, velocities), stamp_ns)
+        self.send(self._state_topic, self._state_encoder.encode(state, stamp_ns, motion_time),
+                  stamp_ns)
+
+    def publish_markers(self, state: LinkageState, stamp_ns: int) -> None:
+        """Publish the scene of ``state`` (after ``publish_state`` prepared its encoder)."""
+        self.send(self._markers_topic, self._marker_encoder.encode(state, stamp_ns), stamp_ns)
+
+    def publish_description(self, stamp_ns: int) -> None:
+        """Publish the URDF if it is published and the geometry or the joints are new."""
+        config = self.config
+        described = (config.linkage, config.joints)
+        if self._description_topic is None or self._described == described:
+            return
+        self._described = described
+        text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
+        self.send(self._description_topic, encode_cdr(String(data=text)), stamp_ns)
+
+    def publish_diagnostics(self, stamp_ns: int, level: Level, text: str,
+                            values: dict[str, str]) -> None:
+        """Publish one status in diagnostic_updater's layout, stamped ``stamp_ns``."""
+        config = self.config
+        if self.recorder is None:
+            values['log file'] = 'disabled'
+        else:
+            values['log file'] = str(self.recorder.bag_path)
+            values['log size (bytes)'] = str(self.recorder.size_bytes)
+        message = messages.diagnostic_array(
+            messages.time_msg(stamp_ns),
+            f'{self._node.get_name()}: crank motion',
+            f"four-bar linkage ({config.preset or 'explicit geometry'})",
+            bytes([level]),
+            text,
+            values,
+        )
+        self.send(self._diagnostics_topic, encode_cdr(message), stamp_ns)
+
+    def flush(self, timeout: float = 1.0) -> None:
+        """
+        Give subscribers up to ``timeout`` seconds in all to acknowledge what was published.
+
+        The final state of a 'stop' run must not die with the process.
+        """
+        deadline = time.monotonic() + timeout
+        for publisher in self._publishers.values():
+            publisher.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))
+
+    def close_log(self) -> bool:
+        """Finalize the bag (idempotent); False, with an error logged, if that failed."""
+        if self.recorder is None:
+            return True
+        logger = self._node.get_logger()
+        try:
+            self.recorder.close()
+        except OSError as error:
+            logger.error(f'could not finalize the log: {error}')
+            return False
+        bag = self.recorder.bag_path
+        count = bag_reader.bag_information(bag)['message_count']
+        logger.info(f'bag finalized: {bag}, {count} messages')
+        return True
