@@ -41,7 +41,7 @@ from typing import Callable
 
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.kinematics import CrankRates, LinkageState
 from mpmath import mp, mpf
 
 # Enough digits that the reference's own error stays far below anything float64 can show, even
@@ -89,16 +89,23 @@ def _derivatives(function: Callable[[mpf], mpf], alpha: mpf) -> tuple[mpf, mpf, 
     return centre + value, first, second
 
 
+def _crank_rates(drive: DriveLaw | CrankRates, alpha: mpf) -> tuple[mpf, mpf]:
+    """ω and ω̇ at ``alpha``: from the drive law, or as given."""
+    if isinstance(drive, CrankRates):
+        return mpf(drive.omega), mpf(drive.omega_dot)
+    omega = mpf(drive.omega0) + mpf(drive.k) * alpha
+    return omega, mpf(drive.k) * omega
+
+
 def reference_state(
-    linkage: FourBar, alpha: float, drive: DriveLaw, branch: int = 1
+    linkage: FourBar, alpha: float, drive: DriveLaw | CrankRates, branch: int = 1
 ) -> dict[str, mpf]:
     """Every ``LinkageState`` quantity at ``alpha``, as mpf values keyed by field name."""
     with mp.workdps(DIGITS):
         a = mpf(alpha)
         beta, beta_1, beta_2 = _derivatives(lambda t: _angles(linkage, t, branch)[0], a)
         gamma, gamma_1, gamma_2 = _derivatives(lambda t: _angles(linkage, t, branch)[1], a)
-        omega = mpf(drive.omega0) + mpf(drive.k) * a
-        omega_dot = mpf(drive.k) * omega
+        omega, omega_dot = _crank_rates(drive, a)
         beta_rate = beta_1 * omega
         beta_acceleration = beta_2 * omega * omega + beta_1 * omega_dot
         r = mpf(linkage.crank_length)
@@ -141,6 +148,67 @@ def reference_state(
             'acceleration_b_x': acceleration_b[0],
             'acceleration_b_y': acceleration_b[1],
             'transmission_angle': mp.acos(max(-1, min(1, cosine))),
+        }
+
+
+def _crank_side(linkage: FourBar, theta: mpf, side: int) -> tuple[mpf, mpf]:
+    """
+    (α, γ) at rocker angle θ_BC = ``theta``, with A on ``side`` of the directed line B→O.
+
+    With B = C + BC·(cos θ, sin θ) and A = OA·(sin α, −cos α), |B − A|² = AB² reads
+    B_x·sin α − B_y·cos α = K, K = (|B|² + OA² − AB²)/(2·OA), i.e. |B|·sin(α − ψ) = K with
+    ψ = atan2(B_y, B_x): α = ψ + asin(K/|B|) or ψ + π − asin(K/|B|); the side is the sign of
+    (O − B) × (A − B).
+    """
+    r = mpf(linkage.crank_length)
+    b = mpf(linkage.coupler_length)
+    c = mpf(linkage.rocker_length)
+    pin_b_x = mpf(linkage.ground_x) + c * mp.cos(theta)
+    pin_b_y = mpf(linkage.ground_y) + c * mp.sin(theta)
+    reach = mp.sqrt(pin_b_x**2 + pin_b_y**2)
+    ratio = (pin_b_x**2 + pin_b_y**2 + r * r - b * b) / (2 * r * reach)
+    if abs(ratio) > 1:
+        raise ValueError(f'reference: the loop does not close at θ = {theta}')
+    heading = mp.atan2(pin_b_y, pin_b_x)
+    for alpha in (heading + mp.asin(ratio), heading + mp.pi - mp.asin(ratio)):
+        pin_a_x, pin_a_y = r * mp.sin(alpha), -r * mp.cos(alpha)
+        cross = (-pin_b_x) * (pin_a_y - pin_b_y) - (-pin_b_y) * (pin_a_x - pin_b_x)
+        if mp.sign(cross) == side:
+            return _wrap(alpha), mp.atan2(pin_b_y - pin_a_y, pin_b_x - pin_a_x)
+    raise ValueError(f'reference: no assembly on side {side} at θ = {theta}')
+
+
+def reference_rocker_driven(
+    linkage: FourBar, theta: float, rates: CrankRates, side: int = 1
+) -> dict[str, mpf]:
+    """
+    Return the quantities of a rocker-driven state at rocker angle ``theta`` (θ_BC = π − β).
+
+    ``rates`` are the rocker's ω_BC and ω̇_BC; ``side`` that of A relative to B→O. Independent
+    of the library's inversion: the crank side is solved directly (``_crank_side``, an asin
+    form) and differentiated numerically in θ, then the chain rule with ω_BC, ω̇_BC.
+    """
+    with mp.workdps(DIGITS):
+        t = mpf(theta)
+        alpha, alpha_1, alpha_2 = _derivatives(lambda u: _crank_side(linkage, u, side)[0], t)
+        gamma, gamma_1, gamma_2 = _derivatives(lambda u: _crank_side(linkage, u, side)[1], t)
+        omega_bc, omega_dot_bc = mpf(rates.omega), mpf(rates.omega_dot)
+        r = mpf(linkage.crank_length)
+        c = mpf(linkage.rocker_length)
+        return {
+            'alpha': alpha,
+            'beta': _wrap(mp.pi - t),
+            'gamma': gamma,
+            'omega': alpha_1 * omega_bc,
+            'omega_dot': alpha_2 * omega_bc**2 + alpha_1 * omega_dot_bc,
+            'omega_ab': gamma_1 * omega_bc,
+            'omega_dot_ab': gamma_2 * omega_bc**2 + gamma_1 * omega_dot_bc,
+            'omega_bc': omega_bc,
+            'omega_dot_bc': omega_dot_bc,
+            'pin_a_x': r * mp.sin(alpha),
+            'pin_a_y': -r * mp.cos(alpha),
+            'pin_b_x': mpf(linkage.ground_x) + c * mp.cos(t),
+            'pin_b_y': mpf(linkage.ground_y) + c * mp.sin(t),
         }
 
 
