@@ -18,37 +18,32 @@ README.md.
 from __future__ import annotations
 
 import math
-import os
 import signal
 import sys
 from typing import Any
 
-from linkage_kinematics.bag_writer_process import set_process_affinity
-from linkage_kinematics.geometry import GeometryError
+from linkage_kinematics.joints import Link
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.measured import MeasuredFollower, Rejection
 from linkage_kinematics.motion import blocked_note, dead_point_problem, DriveLawRun
 from linkage_kinematics.node_outputs import NodeOutputs
+from linkage_kinematics.node_parameters import (
+    add_ranges,
+    declare_parameters,
+    keep_declared_types,
+    parameter_values,
+)
 from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
-    describe_value,
-    NO_CPU_AFFINITY,
     NODE_NAME,
     PARAMETER_NAMES,
-    parameter_specs,
-    ParameterSpec,
-    REAL_PARAMETERS,
     RunConfiguration,
     Source,
 )
-from linkage_kinematics.status import assess, MeasuredHealth, state_values
-from rcl_interfaces.msg import (
-    FloatingPointRange,
-    IntegerRange,
-    ParameterDescriptor,
-    SetParametersResult,
-)
+from linkage_kinematics.placement import CpuPlacement
+from linkage_kinematics.status import MeasuredHealth, report
+from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
@@ -69,27 +64,6 @@ EXIT_CONFIGURATION = 2
 MEASURED_QOS = QoSProfile(depth=100)
 
 
-def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
-    """Return the ROS descriptor of a parameter (its range only ``with_range``)."""
-    # dynamic_typing lets a wrongly typed value reach build_configuration, whose message
-    # names the parameter; rclpy's own type check does not.
-    descriptor = ParameterDescriptor(
-        name=spec.name,
-        description=spec.description,
-        read_only=spec.read_only,
-        dynamic_typing=True,
-    )
-    if with_range and spec.floating_range is not None:
-        low, high = spec.floating_range
-        descriptor.floating_point_range = [FloatingPointRange(from_value=low, to_value=high)]
-    if with_range and spec.integer_range is not None:
-        low_integer, high_integer, step = spec.integer_range
-        descriptor.integer_range = [
-            IntegerRange(from_value=low_integer, to_value=high_integer, step=step)
-        ]
-    return descriptor
-
-
 # --- the node ------------------------------------------------------------------------------
 
 
@@ -105,13 +79,9 @@ class LinkageNode(Node):
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
         self.exit_code: int | None = None
-        specs = self._declare_parameters()
+        specs = declare_parameters(self)
         self.config = config = build_configuration(self.parameter_values())
-        # Ranges go into the descriptors only now, so that a bad start-up value gets
-        # build_configuration's message; from here on rclpy enforces them too.
-        for spec in specs:
-            if spec.floating_range is not None or spec.integer_range is not None:
-                self.set_descriptor(spec.name, parameter_descriptor(spec))
+        add_ranges(self, specs)
         if blocked_note(config) is not None:
             self.get_logger().warning(blocked_note(config))
         self._pending: tuple[RunConfiguration, list[str]] | None = None
@@ -122,18 +92,16 @@ class LinkageNode(Node):
         self._stale = False  # measured: no valid sample within measured.timeout
         self._window_start_ns: int | None = None
         self._achieved_rate = 0.0
-        self._available_cpus = (
-            os.sched_getaffinity(0) if hasattr(os, 'sched_getaffinity') else set()
-        )
-        self._bag_writer_cpus: set[int] | None = None
-        self._bag_writer_cpus = self._place(config.cpu_affinity)
-        self.outputs = NodeOutputs(self, config, self.parameter_values(), self._bag_writer_cpus)
+        self._placement = CpuPlacement()
+        self._place(config.cpu_affinity)
+        self.outputs = NodeOutputs(self, config, self.parameter_values(),
+                                   self._placement.bag_writer_cpus)
         if self.outputs.recorder is not None:
             self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
         self._marker_timer = self.create_timer(1.0 / config.display_rate_hz,
                                                self._publish_markers)
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics)
-        self.add_pre_set_parameters_callback(self._keep_declared_types)
+        self.add_pre_set_parameters_callback(keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
         self._run = DriveLawRun(config)
@@ -148,54 +116,13 @@ class LinkageNode(Node):
 
     # parameters
 
-    def _declare_parameters(self) -> tuple[ParameterSpec, ...]:
-        """Declare every parameter up front (without ranges); return their specs."""
-        preset_spec = parameter_specs('paper')[0]
-        self.declare_parameter(preset_spec.name, preset_spec.default,
-                               parameter_descriptor(preset_spec, with_range=False))
-        preset_name = self.get_parameter('preset').value
-        if not isinstance(preset_name, str):
-            raise ConfigurationError(
-                'preset', f'must be a string, got {describe_value(preset_name)}'
-            )
-        try:
-            specs = parameter_specs(preset_name)
-        except GeometryError as error:
-            raise ConfigurationError('preset', str(error)) from None
-        for spec in specs[1:]:
-            self.declare_parameter(
-                spec.name, spec.default, parameter_descriptor(spec, with_range=False)
-            )
-        # A whole number given for a real parameter (`-p rate_hz:=50`) is stored as that real.
-        whole_numbers = [
-            self.get_parameter(name) for name in REAL_PARAMETERS
-            if self.get_parameter(name).type_ == Parameter.Type.INTEGER
-        ]
-        if whole_numbers:
-            self.set_parameters(self._keep_declared_types(whole_numbers))
-        return specs
-
-    def parameter_values(self) -> dict[str, Any]:
-        """Return the current values of the node's own parameters (name → value)."""
-        return {name: self.get_parameter(name).value for name in PARAMETER_NAMES}
-
-    @staticmethod
-    def _keep_declared_types(changed: list[Parameter]) -> list[Parameter]:
-        """Turn whole numbers given for real parameters into those reals (types never change)."""
-        return [
-            Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
-            if p.name in REAL_PARAMETERS and p.type_ == Parameter.Type.INTEGER
-            else p
-            for p in changed
-        ]
-
     def _validate_change(self, changed: list[Parameter]) -> SetParametersResult:
         """Validate the whole configuration the change would produce; keep it for the post-set."""
         current = self.parameter_values()
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
             config = build_configuration({**current, **updates})
-            self._check_cpu(config.cpu_affinity)
+            self._placement.check(config.cpu_affinity)
         except ConfigurationError as error:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
@@ -224,9 +151,10 @@ class LinkageNode(Node):
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
                                                    self._publish_markers)
         if new.cpu_affinity != old.cpu_affinity:
-            self._bag_writer_cpus = self._place(new.cpu_affinity)
+            self._place(new.cpu_affinity)
             if self.outputs.recorder is not None:
-                self.outputs.recorder.run_writer_on(self._bag_writer_cpus or self._available_cpus)
+                self.outputs.recorder.run_writer_on(
+                    self._placement.bag_writer_cpus or self._placement.available)
         if new.measured_timeout != old.measured_timeout and new.source is Source.MEASURED:
             self.destroy_timer(self._freshness_timer)
             self._freshness_timer = self.create_timer(0.25 * new.measured_timeout,
@@ -246,44 +174,14 @@ class LinkageNode(Node):
             self._state_timer = self.create_timer(self._run.timer_period, self._tick)
             self._tick()
 
-    # placement
+    def parameter_values(self) -> dict[str, Any]:
+        """Return the current values of the node's own parameters (name → value)."""
+        return parameter_values(self)
 
-    def _check_cpu(self, cpu: int) -> None:
-        """Raise ConfigurationError naming cpu_affinity unless this process may use ``cpu``."""
-        if cpu == NO_CPU_AFFINITY:
-            return
-        if not hasattr(os, 'sched_setaffinity'):
-            raise ConfigurationError('cpu_affinity', 'CPU affinity is not supported here')
-        if cpu not in self._available_cpus:
-            raise ConfigurationError(
-                'cpu_affinity',
-                f'CPU {cpu} is not one this process may run on (it may run on '
-                f"{', '.join(map(str, sorted(self._available_cpus)))})",
-            )
-
-    def _place(self, cpu: int) -> set[int] | None:
-        """
-        Pin every thread of this process to ``cpu`` (or unpin it for -1).
-
-        Fast DDS's threads included; threads started later inherit it. Return the CPUs for the
-        bag writer process, None when the node is not pinned. On one CPU the executor's timer
-        thread and the thread running the callbacks wake each other without crossing CPUs, and
-        the bag writer cannot delay either (docs/benchmarks.md, section 3).
-        """
-        self._check_cpu(cpu)
-        if cpu == NO_CPU_AFFINITY and self._bag_writer_cpus is None:
-            return None  # never pinned: the process stays as it was started
-        node_cpus = self._available_cpus if cpu == NO_CPU_AFFINITY else {cpu}
-        set_process_affinity(os.getpid(), node_cpus)
-        if cpu == NO_CPU_AFFINITY:
-            self.get_logger().info('no longer pinned to a CPU')
-            return None
-        bag_writer_cpus = (self._available_cpus - node_cpus) or node_cpus
-        self.get_logger().info(
-            f'running on CPU {cpu}; the bag writer on CPU '
-            f"{', '.join(map(str, sorted(bag_writer_cpus)))}"
-        )
-        return bag_writer_cpus
+    def _place(self, cpu: int) -> None:
+        change = self._placement.place(cpu)
+        if change is not None:
+            self.get_logger().info(change)
 
     # the drive_law source
 
@@ -333,7 +231,7 @@ class LinkageNode(Node):
 
     def _start_measured(self) -> None:
         config = self.config
-        self._driver_name = config.joints[config.driver].name
+        self._driver_name = config.joints[Link(config.driver.value)].name
         self._health = MeasuredHealth(self._now_ns())
         self._activity = f'waiting for {self._driver_name} on measured_joint_states'
         self._measured = self.create_subscription(
@@ -381,13 +279,13 @@ class LinkageNode(Node):
         first = self._state is None
         self._state = state
         self._state_ns = stamp_ns
-        self.outputs.publish_state(state, stamp_ns, motion_time)
         if first:
             self._publish_markers()
             self.outputs.publish_description(stamp_ns)
             if self.config.source is Source.DRIVE_LAW:
                 self._activity = 'moving'
             self._publish_diagnostics()
+        self.outputs.publish_state(state, stamp_ns, motion_time)
 
     def _publish_markers(self) -> None:
         """Publish the scene of the latest state, stamped with that state's time."""
@@ -411,23 +309,10 @@ class LinkageNode(Node):
             self._achieved_rate = self._run.window_ticks / window
         self._window_start_ns = now_ns
         self._run.window_ticks = 0
-        values = {'achieved rate (Hz)': f'{self._achieved_rate:.1f}'}
-        warnings: tuple[str, ...] = ()
-        problem = event or self._problem or self.outputs.recording_error
-        if config.source is Source.MEASURED:
-            values.update(self._health.values(now_ns, config))
-            warnings = self._health.take_warnings()
-            problem = problem or self._health.problem(
-                now_ns, config.measured_timeout, self._driver_name)
-        else:
-            values.update({
-                'end behavior': config.end_behavior,
-                'mode': config.mode,
-                'rate_hz': f'{config.rate_hz:g}',
-                'missed deadlines': str(self._run.missed_deadlines),
-            })
-        values.update(state_values(config, self._state))
-        level, text = assess(config, self._state, problem, self._activity, warnings)
+        health = self._health if config.source is Source.MEASURED else None
+        level, text, values = report(
+            config, self._state, event or self._problem or self.outputs.recording_error,
+            self._activity, health, now_ns, self._achieved_rate, self._run.missed_deadlines)
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

@@ -107,8 +107,8 @@ class NodeOutputs:
             self.recording_error = f'recording stopped: {error}'
             self._node.get_logger().error(self.recording_error)
 
-    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
-        """Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``."""
+    def _prepare(self) -> None:
+        """Prepare the encoders of the per-state messages for the geometry and joints."""
         if self._encoded != self.config.linkage:
             linkage = self.config.linkage
             self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
@@ -120,6 +120,10 @@ class NodeOutputs:
                                        include_driver=self.config.source is Source.DRIVE_LAW)
             self._joint_state_encoder = messages.JointStateEncoder(self._joints.names)
             self._streamed = self.config.joints
+
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+        """Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``."""
+        self._prepare()
         positions, velocities = self._joints.values(state)
         self.send(self._joint_states_topic,
                   self._joint_state_encoder.encode(stamp_ns, positions, velocities), stamp_ns)
@@ -127,7 +131,8 @@ class NodeOutputs:
                   stamp_ns)
 
     def publish_markers(self, state: LinkageState, stamp_ns: int) -> None:
-        """Publish the scene of ``state`` (after ``publish_state`` prepared its encoder)."""
+        """Publish the scene of ``state``."""
+        self._prepare()
         self.send(self._markers_topic, self._marker_encoder.encode(state, stamp_ns), stamp_ns)
 
     def publish_description(self, stamp_ns: int) -> None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 from enum import IntEnum
 import math
 
-from linkage_kinematics.joints import Driver
+from linkage_kinematics.joints import Driver, Link
 from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
 from linkage_kinematics.measured import Estimate, Rejection
 from linkage_kinematics.motion import blocked_note
@@ -77,6 +77,41 @@ def assess(
     if warnings:
         return Level.WARN, '; '.join(warnings)
     return Level.OK, activity
+
+
+def report(
+    config: RunConfiguration,
+    state: LinkageState | None,
+    problem: str | None,
+    activity: str,
+    health: MeasuredHealth | None,
+    now_ns: int,
+    achieved_rate: float,
+    missed_deadlines: int,
+) -> tuple[Level, str, dict[str, str]]:
+    """
+    Return the level, message and key values of one status (README, Diagnostics).
+
+    ``health`` is the measured source's (None under the drive law); its drops since the last
+    status make it WARN and its staleness ERROR. ``achieved_rate`` counts states per second.
+    """
+    values = {'achieved rate (Hz)': f'{achieved_rate:.1f}'}
+    warnings: tuple[str, ...] = ()
+    if health is not None:
+        values.update(health.values(now_ns, config))
+        warnings = health.take_warnings()
+        driver_name = config.joints[Link(config.driver.value)].name
+        problem = problem or health.problem(now_ns, config.measured_timeout, driver_name)
+    else:
+        values.update({
+            'end behavior': config.end_behavior,
+            'mode': config.mode,
+            'rate_hz': f'{config.rate_hz:g}',
+            'missed deadlines': str(missed_deadlines),
+        })
+    values.update(state_values(config, state))
+    level, text = assess(config, state, problem, activity, warnings)
+    return level, text, values
 
 
 def state_values(config: RunConfiguration, state: LinkageState | None) -> dict[str, str]:

@@ -1,0 +1,103 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The node's parameters on the ROS side: declared with descriptors, whole numbers kept real.
+
+``parameters`` owns what each parameter is and how values are validated; this module only
+declares them on a node so that ``ros2 param describe`` shows their meaning, unit and range.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from linkage_kinematics.geometry import GeometryError
+from linkage_kinematics.parameters import (
+    ConfigurationError,
+    describe_value,
+    PARAMETER_NAMES,
+    parameter_specs,
+    ParameterSpec,
+    REAL_PARAMETERS,
+)
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+
+def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
+    """Return the ROS descriptor of a parameter (its range only ``with_range``)."""
+    # dynamic_typing lets a wrongly typed value reach build_configuration, whose message
+    # names the parameter; rclpy's own type check does not.
+    descriptor = ParameterDescriptor(
+        name=spec.name,
+        description=spec.description,
+        read_only=spec.read_only,
+        dynamic_typing=True,
+    )
+    if with_range and spec.floating_range is not None:
+        low, high = spec.floating_range
+        descriptor.floating_point_range = [FloatingPointRange(from_value=low, to_value=high)]
+    if with_range and spec.integer_range is not None:
+        low_integer, high_integer, step = spec.integer_range
+        descriptor.integer_range = [
+            IntegerRange(from_value=low_integer, to_value=high_integer, step=step)
+        ]
+    return descriptor
+
+
+def keep_declared_types(changed: list[Parameter]) -> list[Parameter]:
+    """
+    Turn whole numbers given for real parameters into those reals.
+
+    So that a parameter never changes type (`ros2 param set /linkage_node rate_hz 50`).
+    """
+    return [
+        Parameter(p.name, Parameter.Type.DOUBLE, float(p.value))
+        if p.name in REAL_PARAMETERS and p.type_ == Parameter.Type.INTEGER
+        else p
+        for p in changed
+    ]
+
+
+def declare_parameters(node: Node) -> tuple[ParameterSpec, ...]:
+    """Declare every parameter on ``node`` (without ranges, see ``add_ranges``)."""
+    preset_spec = parameter_specs('paper')[0]
+    node.declare_parameter(preset_spec.name, preset_spec.default,
+                           parameter_descriptor(preset_spec, with_range=False))
+    preset_name = node.get_parameter('preset').value
+    if not isinstance(preset_name, str):
+        raise ConfigurationError('preset', f'must be a string, got {describe_value(preset_name)}')
+    try:
+        specs = parameter_specs(preset_name)
+    except GeometryError as error:
+        raise ConfigurationError('preset', str(error)) from None
+    for spec in specs[1:]:
+        node.declare_parameter(spec.name, spec.default,
+                               parameter_descriptor(spec, with_range=False))
+    # A whole number given for a real parameter (`-p rate_hz:=50`) is stored as that real.
+    whole_numbers = [
+        node.get_parameter(name) for name in REAL_PARAMETERS
+        if node.get_parameter(name).type_ == Parameter.Type.INTEGER
+    ]
+    if whole_numbers:
+        node.set_parameters(keep_declared_types(whole_numbers))
+    return specs
+
+
+def add_ranges(node: Node, specs: tuple[ParameterSpec, ...]) -> None:
+    """
+    Put the ranges into the descriptors, once the start-up values are validated.
+
+    So that a bad start-up value gets build_configuration's message; from here on rclpy enforces
+    them too.
+    """
+    for spec in specs:
+        if spec.floating_range is not None or spec.integer_range is not None:
+            node.set_descriptor(spec.name, parameter_descriptor(spec))
+
+
+def parameter_values(node: Node) -> dict[str, Any]:
+    """Return the current values of the node's own parameters (name → value)."""
+    return {name: node.get_parameter(name).value for name in PARAMETER_NAMES}
