@@ -275,16 +275,24 @@ def methods(linkage: FourBar, quick: bool) -> list[Method]:
         continued(competitors.fsolve_states),
         lambda: len(competitors.fsolve_states(linkage, iterative_alphas, variable,
                                               start)['beta'])))
-    for step in (1e-2, 1e-4, 1e-6, 1e-8):
-        result.append(Method(
+    result.extend(_finite_difference_methods(linkage, sweep[: vector_count // 4], variable))
+    result.extend(_pylinkage_methods(linkage, iterative_count))
+    return result
+
+
+def _finite_difference_methods(linkage: FourBar, alphas: np.ndarray, law: DriveLaw
+                               ) -> list[Method]:
+    """Central differences of exact positions at several steps, timed on ``alphas``."""
+    return [
+        Method(
             f'finite differences of exact positions, h = {step:g} rad', 'finite differences',
             lambda angle_set, drive, step=step: competitors.finite_difference_states(
                 angle_set.linkage, np.array(angle_set.alphas), drive, step, angle_set.start,
                 angle_set.branch),
             lambda step=step: (competitors.finite_difference_states(
-                linkage, sweep[: vector_count // 4], variable, step), vector_count // 4)[1]))
-    result.extend(_pylinkage_methods(linkage, iterative_count))
-    return result
+                linkage, alphas, law, step), alphas.size)[1])
+        for step in (1e-2, 1e-4, 1e-6, 1e-8)
+    ]
 
 
 def _library_branches(angle_set: AngleSet) -> list[int]:
