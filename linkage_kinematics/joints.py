@@ -23,20 +23,20 @@ the same way. No ROS.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from enum import Enum
+from enum import StrEnum
 import math
 
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
 
 
-class Driver(str, Enum):
+class Driver(StrEnum):
     """The joint that moves the linkage: the crank at O, or the rocker at C."""
 
     CRANK = 'crank'
     ROCKER = 'rocker'
 
 
-class Link(str, Enum):
+class Link(StrEnum):
     """The moving links; each URDF joint is named after the link it moves."""
 
     CRANK = 'crank'

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from enum import Enum
+from enum import StrEnum
 import math
 
 from linkage_kinematics.geometry import TWO_PI, UnreachableError
@@ -49,7 +49,7 @@ from linkage_kinematics.kinematics import (
 from linkage_kinematics.parameters import RunConfiguration
 
 
-class Rejection(str, Enum):
+class Rejection(StrEnum):
     """Why a measured sample was dropped (the text names it in diagnostics)."""
 
     NO_DRIVER = 'without the driver joint'
@@ -59,7 +59,7 @@ class Rejection(str, Enum):
     JUMP = 'jumping further than measured.max_jump'
 
 
-class Estimate(str, Enum):
+class Estimate(StrEnum):
     """How the driver's angular velocity of a sample was obtained."""
 
     MEASURED = 'measured'

@@ -36,6 +36,7 @@ from linkage_kinematics.node_parameters import (
 from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
+    EndBehavior,
     NODE_NAME,
     PARAMETER_NAMES,
     RunConfiguration,
@@ -199,7 +200,7 @@ class LinkageNode(Node):
             if due.met_dead_point:
                 self._publish_diagnostics(dead_point_problem(self.config), due.at_ns)
             if due.state is None:
-                if self.config.end_behavior == 'stop':
+                if self.config.end_behavior is EndBehavior.STOP:
                     self._cannot_go_on(due.refusal)
                     return
                 continue  # loop and bounce turn round at the dead point, which has no state

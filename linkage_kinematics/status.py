@@ -104,8 +104,8 @@ def report(
         problem = problem or health.problem(now_ns, config.measured_timeout, driver_name)
     else:
         values.update({
-            'end behavior': config.end_behavior,
-            'mode': config.mode,
+            'end behavior': config.end_behavior.value,
+            'mode': config.mode.value,
             'rate_hz': f'{config.rate_hz:g}',
             'missed deadlines': str(missed_deadlines),
         })
