@@ -49,8 +49,8 @@ import numpy as np
 
 __all__ = [
     'continued_branch', 'CrankRates', 'DeadPointError', 'LinkagePose', 'LinkageState',
-    'loop_closure_residual', 'PIVOT_PASSAGE', 'RATE_ACCURACY', 'reachable_mask', 'solve', 'solve_many', 'solve_pose',
-    'unwrap_near',
+    'loop_closure_residual', 'PIVOT_PASSAGE', 'RATE_ACCURACY', 'reachable_mask', 'solve',
+    'solve_many', 'solve_pose', 'unwrap_near',
 ]
 
 # Arrays longer than this are solved in pieces of this many angles, so that the closed form's
