@@ -26,7 +26,6 @@ from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.metadata import (
     BagMetadata,
     offered_qos_profiles_for,
-    qos_profiles_yaml,
 )
 from linkage_kinematics.bag.reader import bag_files, iter_messages
 from linkage_kinematics.bag.recovery import recover_bag
@@ -101,7 +100,7 @@ def string_topic(writer: BagWriter, topic: str, latched: bool) -> int:
                      else DurabilityPolicy.VOLATILE)
     type_name = 'std_msgs/msg/String'
     return writer.add_topic(topic, type_name, message_definition(type_name),
-                            qos_profiles_yaml(offered_qos_profiles_for(qos)),
+                            offered_qos_profiles_for(qos),
                             repeat_latest=latched)
 
 

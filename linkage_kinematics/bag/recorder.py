@@ -25,7 +25,6 @@ from linkage_kinematics.bag.cdr import ros_type_name
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.metadata import (
     offered_qos_profiles_for,
-    qos_profiles_yaml,
     TRANSIENT_LOCAL,
 )
 from linkage_kinematics.bag.writer import NO_SPLIT
@@ -86,7 +85,7 @@ class Recorder:
             repeat_latest = qos.durability.name.lower() == TRANSIENT_LOCAL
         self._channels[topic] = self._writer.add_topic(
             topic, type_name, message_definition(type_name),
-            qos_profiles_yaml(offered_qos_profiles_for(qos)), repeat_latest,
+            offered_qos_profiles_for(qos), repeat_latest,
         )
 
     def run_writer_on(self, cpus: Set[int]) -> None:

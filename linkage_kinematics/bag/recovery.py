@@ -25,7 +25,6 @@ from linkage_kinematics.bag.metadata import (
     BagMetadata,
     FileInfo,
     METADATA_FILE,
-    qos_profiles_yaml,
     TopicInfo,
 )
 from linkage_kinematics.bag.writer import BagWriter
@@ -99,7 +98,7 @@ def _rewrite(bag: Path, source: Path, topics: dict[str, TopicInfo],
                 )
             channel_ids[message.topic] = writer.add_topic(
                 message.topic, topic.type_name, message_definition(topic.type_name),
-                qos_profiles_yaml(topic.offered_qos_profiles),
+                topic.offered_qos_profiles,
             )
         writer.write(channel_ids[message.topic], message.data, message.log_time_ns,
                      message.publish_time_ns)

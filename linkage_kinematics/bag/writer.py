@@ -35,7 +35,7 @@ from collections.abc import Mapping
 import os
 from pathlib import Path
 import time
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 from linkage_kinematics.bag.definitions import SCHEMA_ENCODING, type_description_hash
 from linkage_kinematics.bag.errors import BagError, BagExistsError
@@ -46,10 +46,10 @@ from linkage_kinematics.bag.metadata import (
     METADATA_FILE,
     PACKAGE_NAME,
     package_version,
+    qos_profiles_yaml,
     TopicInfo,
 )
 from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, Writer
-import yaml
 
 METADATA_RECORD_NAME = PACKAGE_NAME
 ROSBAG2_METADATA_RECORD_NAME = 'rosbag2'
@@ -146,7 +146,7 @@ class _McapFile:
             self._schema_ids[info.type_name] = schema_id
         return self.writer.register_channel(
             info.name, MESSAGE_ENCODING, schema_id,
-            {'offered_qos_profiles': yaml.safe_dump(info.offered_qos_profiles, sort_keys=False),
+            {'offered_qos_profiles': qos_profiles_yaml(info.offered_qos_profiles),
              'topic_type_hash': info.type_hash},
         )
 
@@ -264,20 +264,21 @@ class BagWriter:
         return self._finished_size + self._file.stream.tell()
 
     def add_topic(
-        self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str,
-        repeat_latest: bool = False,
+        self, topic: str, type_name: str, message_definition: str,
+        offered_qos_profiles: list[dict[str, Any]], repeat_latest: bool = False,
     ) -> int:
         """
         Register a topic (``type_name`` like ``std_msgs/msg/String``); return its channel id.
 
-        ``offered_qos_profiles`` is rosbag2's YAML text of the publisher's QoS list. With
+        ``offered_qos_profiles`` is the publisher's QoS as rosbag2 lists it
+        (``metadata.offered_qos_profiles_for``). With
         ``repeat_latest``, each further file of a split bag starts with the topic's latest
         message.
         """
         self._check_writable()
         if any(existing.name == topic for existing in self._topics.values()):
             raise ValueError(f'topic {topic} is already in bag {self.bag_path}')
-        info = TopicInfo(topic, type_name, yaml.safe_load(offered_qos_profiles) or [],
+        info = TopicInfo(topic, type_name, list(offered_qos_profiles),
                          type_description_hash(type_name))
         self._definitions.setdefault(type_name, message_definition)
         try:

@@ -114,8 +114,8 @@ class BagWriterProcess:
         self.size_bytes = reply['size']
 
     def add_topic(
-        self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str,
-        repeat_latest: bool = False,
+        self, topic: str, type_name: str, message_definition: str,
+        offered_qos_profiles: list[dict[str, Any]], repeat_latest: bool = False,
     ) -> int:
         """``BagWriter.add_topic`` in the child; its channel id."""
         reply = self._request(TOPIC, {
