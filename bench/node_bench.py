@@ -172,6 +172,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     from linkage_kinematics.node import LinkageNode
     import rclpy
     from rclpy.parameter import Parameter
+    from rclpy.serialization import deserialize_message
     from sensor_msgs.msg import JointState
 
     count = 300 if quick else 1500
@@ -202,12 +203,13 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             stamp = clock.now()
             names = list(DEFAULT_JOINT_NAMES.values())
             positions, velocities = tree_values(state, Driver.CRANK)
-            bare_message = messages.joint_state(names, positions, velocities, stamp.to_msg())
             joint_state_encoder = messages.JointStateEncoder(names)
             state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
             joint_state_data = joint_state_encoder.encode(stamp.nanoseconds, positions,
                                                           velocities)
             trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
+            # the node's own JointState, as a subscriber's rclpy decodes it
+            bare_message = deserialize_message(joint_state_data, JointState)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 
             def compute() -> int:

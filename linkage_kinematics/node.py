@@ -26,7 +26,7 @@ from linkage_kinematics.joints import Link
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.measured import MeasuredFollower, Rejection
 from linkage_kinematics.motion import blocked_note, dead_point_problem, DriveLawRun
-from linkage_kinematics.node_outputs import NodeOutputs
+from linkage_kinematics.node_outputs import NodeOutputs, StartupError
 from linkage_kinematics.node_parameters import (
     add_ranges,
     declare_parameters,
@@ -320,14 +320,14 @@ class LinkageNode(Node):
 # --- process ------------------------------------------------------------------------------
 
 
-def _report_configuration_error(error: ConfigurationError) -> None:
+def _report_start_up_failure(text: str) -> None:
     """
-    Return the one line saying which parameter is bad and why.
+    Report the one line saying why the node cannot start.
 
     To the node's logger (console, /rosout, log file) and plainly to stderr.
     """
-    get_logger(NODE_NAME).fatal(f'invalid parameter {error}')
-    print(f'{NODE_NAME}: invalid parameter {error}', file=sys.stderr, flush=True)
+    get_logger(NODE_NAME).fatal(text)
+    print(f'{NODE_NAME}: {text}', file=sys.stderr, flush=True)
 
 
 def main(args: list[str] | None = None) -> int:
@@ -346,7 +346,10 @@ def main(args: list[str] | None = None) -> int:
         try:
             node = LinkageNode()
         except ConfigurationError as error:
-            _report_configuration_error(error)
+            _report_start_up_failure(f'invalid parameter {error}')
+            return EXIT_CONFIGURATION
+        except StartupError as error:
+            _report_start_up_failure(str(error))
             return EXIT_CONFIGURATION
         # The events executor dispatches timers and services from C++ instead of rebuilding a
         # wait set in Python for every callback: at 1 kHz it halves the process's CPU

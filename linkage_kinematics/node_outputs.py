@@ -15,14 +15,17 @@ import json
 import time
 from typing import Any
 
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics import bag_reader, messages
-from linkage_kinematics.bag_writer import package_version
+from linkage_kinematics import messages
+from linkage_kinematics.bag.cdr import encode_cdr
+from linkage_kinematics.bag.errors import MessageDefinitionError
+from linkage_kinematics.bag.metadata import BagMetadata, package_version
+from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.joints import JointMap, JointStream
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.parameters import ConfigurationError, RunConfiguration, Source
-from linkage_kinematics.recording import encode_cdr, Recorder
 from linkage_kinematics.status import Level
 from linkage_kinematics.urdf import urdf_text
 from rclpy.duration import Duration
@@ -40,6 +43,10 @@ ROBOT_DESCRIPTION_QOS = QoSProfile(
 )
 
 
+class StartupError(Exception):
+    """The node cannot start for a reason other than a parameter; the message names it."""
+
+
 class NodeOutputs:
     """
     The node's publishers, the encoders of its per-state messages, and its recorder.
@@ -47,7 +54,8 @@ class NodeOutputs:
     Relative names resolve under the node's namespace (as joint_state_publisher's and
     robot_state_publisher's do), so mechanisms in different namespaces never mix;
     /diagnostics is absolute, diagnostic_updater's convention. Construction raises
-    ConfigurationError naming log.folder if the log cannot be written.
+    ConfigurationError naming log.folder if the log cannot be written, StartupError if a message
+    definition cannot be found (before any folder is made).
     """
 
     def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
@@ -83,17 +91,22 @@ class NodeOutputs:
             'parameters': json.dumps(parameter_values, sort_keys=True),
             'package_version': package_version(),
         }
+        # The latest status starts every file of a split bag, as the latched URDF does.
+        topics = [
+            (topic, publisher.msg_type, publisher.qos_profile,
+             True if topic == self._diagnostics_topic else None)
+            for topic, publisher in self._publishers.items()
+        ]
         try:
-            recorder = Recorder(self.config.log_folder, metadata=metadata, cpus=cpus)
+            return Recorder(
+                self.config.log_folder, topics=topics, metadata=metadata, cpus=cpus,
+                max_bag_size=self.config.log_max_bag_size,
+                max_bag_duration=self.config.log_max_bag_duration,
+            )
+        except MessageDefinitionError as error:
+            raise StartupError(f'cannot record: {error}') from None
         except OSError as error:
             raise ConfigurationError('log.folder', str(error)) from None
-        try:
-            for topic, publisher in self._publishers.items():
-                recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
-        except OSError as error:
-            recorder.close()
-            raise ConfigurationError('log.folder', str(error)) from None
-        return recorder
 
     def send(self, topic: str, data: bytes, log_time_ns: int) -> None:
         """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""
@@ -155,7 +168,7 @@ class NodeOutputs:
             values['log file'] = str(self.recorder.bag_path)
             values['log size (bytes)'] = str(self.recorder.size_bytes)
         message = messages.diagnostic_array(
-            messages.time_msg(stamp_ns),
+            Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000),
             f'{self._node.get_name()}: crank motion',
             f"four-bar linkage ({config.preset or 'explicit geometry'})",
             bytes([level]),
@@ -185,6 +198,6 @@ class NodeOutputs:
             logger.error(f'could not finalize the log: {error}')
             return False
         bag = self.recorder.bag_path
-        count = bag_reader.bag_information(bag)['message_count']
+        count = BagMetadata.read(bag).message_count
         logger.info(f'bag finalized: {bag}, {count} messages')
         return True

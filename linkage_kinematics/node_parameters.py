@@ -27,13 +27,14 @@ from rclpy.parameter import Parameter
 
 
 def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
-    """Return the ROS descriptor of a parameter (its range only ``with_range``)."""
+    """Return a parameter's ROS descriptor (range and read-only flag only ``with_range``)."""
     # dynamic_typing lets a wrongly typed value reach build_configuration, whose message
     # names the parameter; rclpy's own type check does not.
     descriptor = ParameterDescriptor(
         name=spec.name,
         description=spec.description,
-        read_only=spec.read_only,
+        # rclpy refuses a later descriptor, with its range, for a read-only parameter
+        read_only=spec.read_only and with_range,
         dynamic_typing=True,
     )
     if with_range and spec.floating_range is not None:
@@ -94,7 +95,8 @@ def add_ranges(node: Node, specs: tuple[ParameterSpec, ...]) -> None:
     them too.
     """
     for spec in specs:
-        if spec.floating_range is not None or spec.integer_range is not None:
+        if (spec.floating_range is not None or spec.integer_range is not None
+                or spec.read_only):
             node.set_descriptor(spec.name, parameter_descriptor(spec))
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import os
 
-from linkage_kinematics.bag_writer_process import set_process_affinity
+from linkage_kinematics.bag.writer_process import set_process_affinity
 from linkage_kinematics.parameters import ConfigurationError, NO_CPU_AFFINITY
 
 
