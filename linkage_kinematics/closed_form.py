@@ -279,9 +279,9 @@ def _smooth_rate_terms(
     if closure.folded.is_change and closure.stretched.is_change:
         # m = sin(½φ)·sin(½(φ − π)), q = 2·OC·m, R = 2·OA·OC/d
         vanishing = -sin_half * cos_half
-        # at m = 0, the sign just counterclockwise is the other factor's
-        other = (np.where(sin_half == 0.0, -cos_half, sin_half) if isinstance(sin_half, np.ndarray)
-                 else -cos_half if sin_half == 0.0 else sin_half)
+        # m = −½·sin φ: at m = 0 its sign just counterclockwise is that of −cos φ (whichever
+        # factor vanishes, and on every turn of φ, which the half-angle factors tell apart)
+        other = (sin_half - cos_half) * (cos_half + sin_half)
         numerator = 2.0 * ground
         numerator_rate = 0.0
         radius = 2.0 * half_scale / distance

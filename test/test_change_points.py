@@ -218,3 +218,21 @@ def test_pin_passing_through_the_pivot_is_refused() -> None:
         state = solve(folding, alpha, CONSTANT)
         errors = state_errors(state, reference_state(folding, alpha, CONSTANT))
         assert max(errors.values()) <= 1e-12, errors
+
+
+@pytest.mark.parametrize('branch', [1, -1])
+def test_a_change_point_on_a_float_names_the_side_just_counterclockwise_on_any_turn(branch):
+    """
+    C straight above O puts a change point of the parallelogram on the float 0 (held as 2π).
+
+    At α = 0.0 itself a branch names the side just counterclockwise of it, as everywhere: the
+    state there is the limit of that side's states from α > 0. (Seen from C, the parallelogram
+    with C level with O is this linkage, so a measured rocker at θ = 0 lands here.)
+    """
+    linkage = FourBar(0.3, 1.0, 0.3, 0.0, 1.0)
+    assert linkage.reachability.change_points[1] == 0.0
+    at = solve(linkage, 0.0, CONSTANT, branch)
+    after = solve(linkage, 1e-9, CONSTANT, branch)
+    assert (at.omega_ab, at.omega_bc) == pytest.approx((after.omega_ab, after.omega_bc), abs=1e-8)
+    assert (at.omega_dot_ab, at.omega_dot_bc) == pytest.approx(
+        (after.omega_dot_ab, after.omega_dot_bc), abs=1e-7)
