@@ -27,8 +27,10 @@ import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.geometry import FourBar, preset, TWO_PI
+from linkage_kinematics.joints import Driver
 from linkage_kinematics.kinematics import CrankRates
-from linkage_kinematics.measured import Rejection
+from linkage_kinematics.measured import MeasuredFollower, Rejection
+from linkage_kinematics.parameters import build_configuration, parameter_specs, Source
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,
@@ -47,6 +49,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
+import yaml
 
 DOMAIN_ID = 80
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
@@ -452,3 +455,20 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, t
     for messages in recorded.values():
         for message in messages:
             assert_no_nan(message)
+
+
+def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configuration():
+    entries = yaml.safe_load((REPOSITORY / 'config' / 'measured_lab.yaml').read_text())
+    values = entries['/**/linkage_node']['ros__parameters']
+    assert {name: values[name] for name in LAB_JOINTS} == LAB_JOINTS
+    defaults = {spec.name: spec.default for spec in parameter_specs(values['preset'])}
+    config = build_configuration({**defaults, **values})
+    assert (config.source, config.driver, config.publish_robot_description) == (
+        Source.MEASURED, Driver.CRANK, False)
+    # The README's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
+    state = MeasuredFollower(config).follow(1, ['knee_motor'], [-0.1], [1.0]).state
+    assert state.alpha == pytest.approx(0.5, abs=1e-15)
+    assert math.remainder(state.gamma - state.alpha - 0.2, TWO_PI) == pytest.approx(
+        0.2090, abs=1e-4)
+    assert math.remainder(-state.beta - state.gamma + 1.1, TWO_PI) == pytest.approx(
+        -1.0141, abs=1e-4)
