@@ -26,7 +26,7 @@ sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'node', 'cost', 'memory')
+SECTIONS = ('kinematics', 'drive', 'node', 'cost', 'measured', 'memory')
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -80,6 +80,11 @@ def main(argv: list[str] | None = None) -> int:
 
         print('\n## Node against a minimal hand-written publisher\n')
         print(cost_bench.run(arguments.quick, arguments.ros_domain))
+    if 'measured' in sections:
+        import measured_bench
+
+        print('\n## Measured source against a minimal hand-written relay\n')
+        print(measured_bench.run(arguments.quick, arguments.ros_domain))
     if 'memory' in sections:
         import node_bench
 
