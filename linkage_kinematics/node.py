@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 import signal
 import sys
 import time
@@ -25,7 +26,7 @@ from typing import Any
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics import messages
 from linkage_kinematics.bag.cdr import encode_cdr
-from linkage_kinematics.bag.errors import MessageDefinitionError
+from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.bag.writer_process import set_process_affinity
@@ -379,8 +380,8 @@ class LinkageNode(Node):
         """
         Return a recorder for every topic, before anything is published.
 
-        ConfigurationError naming log.folder if it cannot be written; StartupError if a
-        message definition cannot be found (before any folder is made).
+        ConfigurationError naming log.folder if it cannot be written; StartupError for any other
+        reason, such as a message definition that cannot be found (before any folder is made).
         """
         metadata = {
             'parameters': json.dumps(self.parameter_values(), sort_keys=True),
@@ -398,10 +399,10 @@ class LinkageNode(Node):
                 cpus=self._bag_writer_cpus, max_bag_size=self.config.log_max_bag_size,
                 max_bag_duration=self.config.log_max_bag_duration,
             )
-        except MessageDefinitionError as error:
-            raise StartupError(f'cannot record: {error}') from None
-        except OSError as error:
+        except LogFolderError as error:
             raise ConfigurationError('log.folder', str(error)) from None
+        except OSError as error:  # every BagError
+            raise StartupError(f'cannot record: {error}') from None
 
     def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
         self._send(topic, encode_cdr(message), log_time_ns)
@@ -706,7 +707,13 @@ def main(args: list[str] | None = None) -> int:
     """Run the node until it finishes, or until SIGINT or SIGTERM; return the exit status."""
     # rclpy's own SIGINT handler would shut the context down under our feet; ours lets the
     # loop below finalize the log first.
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except RuntimeError as error:  # rclpy's RCLError: ROS arguments rcl cannot use
+        # rcl's text, without the source locations it appends ('…, at /src/rcl/x.c:352')
+        _report_start_up_failure(
+            'cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
+        return EXIT_CONFIGURATION
     received: list[int] = []
 
     def request_stop(signal_number: int, _frame: object) -> None:
