@@ -170,6 +170,8 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: 
     bag = only_bag(folder)
     files = assert_metadata_lists_every_file(bag)
     assert len(files) in (3, 4), [len(logged) for logged in files]  # 0.785 s in files of > 0.2 s
+    with Reader(bag) as reader:  # rosbags reads the bag as a whole, too
+        assert reader.message_count == sum(1 for _ in reader.messages()) == sum(map(len, files))
     (description,) = [raw for topic, _, raw in files[0] if topic == '/robot_description']
     for logged in files:
         log_times = [log_time for _, log_time, _ in logged]
