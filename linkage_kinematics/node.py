@@ -45,6 +45,8 @@ from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
     describe_value,
+    EndBehavior,
+    MotionMode,
     NO_CPU_AFFINITY,
     NODE_NAME,
     PARAMETER_NAMES,
@@ -456,7 +458,7 @@ class LinkageNode(Node):
         In fixed_step mode the timer is re-armed for each step's time, and this first period only
         starts it.
         """
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             return 1.0 / self.config.rate_hz
         return 1e-3
 
@@ -480,7 +482,7 @@ class LinkageNode(Node):
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
             self._motion_start = now
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             self._advance_in_real_time(now)
         else:
             self._advance_steps(now)
@@ -534,7 +536,7 @@ class LinkageNode(Node):
         try:
             state = solve_sample(config, sample)
         except (DeadPointError, UnreachableError) as error:
-            if config.end_behavior == 'stop':
+            if config.end_behavior == EndBehavior.STOP:
                 self._cannot_go_on(str(error))
             # loop and bounce turn round at the dead point itself, which has no state to show.
             return
@@ -657,8 +659,8 @@ class LinkageNode(Node):
     def _diagnostic_values(self) -> dict[str, str]:
         config = self.config
         values = {
-            'end behavior': config.end_behavior,
-            'mode': config.mode,
+            'end behavior': config.end_behavior.value,
+            'mode': config.mode.value,
             'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
             'rate_hz': f'{config.rate_hz:g}',
             'missed deadlines': str(self._missed_deadlines),
