@@ -18,6 +18,7 @@ README.md.
 from __future__ import annotations
 
 import math
+import re
 import signal
 import sys
 from typing import Any
@@ -334,7 +335,13 @@ def main(args: list[str] | None = None) -> int:
     """Run the node until it finishes, or until SIGINT or SIGTERM; return the exit status."""
     # rclpy's own SIGINT handler would shut the context down under our feet; ours lets the
     # loop below finalize the log first.
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except RuntimeError as error:  # rclpy's RCLError: ROS arguments rcl cannot use
+        # rcl's text, without the source locations it appends ('…, at /src/rcl/x.c:352')
+        _report_start_up_failure(
+            'cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
+        return EXIT_CONFIGURATION
     received: list[int] = []
 
     def request_stop(signal_number: int, _frame: object) -> None:

@@ -19,7 +19,7 @@ from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics import messages
 from linkage_kinematics.bag.cdr import encode_cdr
-from linkage_kinematics.bag.errors import MessageDefinitionError
+from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.geometry import FourBar
@@ -54,8 +54,8 @@ class NodeOutputs:
     Relative names resolve under the node's namespace (as joint_state_publisher's and
     robot_state_publisher's do), so mechanisms in different namespaces never mix;
     /diagnostics is absolute, diagnostic_updater's convention. Construction raises
-    ConfigurationError naming log.folder if the log cannot be written, StartupError if a message
-    definition cannot be found (before any folder is made).
+    ConfigurationError naming log.folder if the log cannot be written, StartupError for any
+    other reason, such as a message definition that cannot be found (before any folder is made).
     """
 
     def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
@@ -103,10 +103,10 @@ class NodeOutputs:
                 max_bag_size=self.config.log_max_bag_size,
                 max_bag_duration=self.config.log_max_bag_duration,
             )
-        except MessageDefinitionError as error:
-            raise StartupError(f'cannot record: {error}') from None
-        except OSError as error:
+        except LogFolderError as error:
             raise ConfigurationError('log.folder', str(error)) from None
+        except OSError as error:  # every BagError
+            raise StartupError(f'cannot record: {error}') from None
 
     def send(self, topic: str, data: bytes, log_time_ns: int) -> None:
         """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""

@@ -42,8 +42,9 @@ class Recorder:
     Written by a BagWriter in a process of its own (``writer_process``) and split as it is
     told (``max_bag_size`` bytes, ``max_bag_duration`` s; ``NO_SPLIT``: never). ``topics`` are
     added first, their definitions found before anything is created (MessageDefinitionError
-    otherwise); ``metadata`` (the run's parameters, strings) goes into the bag's custom data,
-    ``cpus`` are the CPUs the writer process may run on.
+    otherwise; LogFolderError if ``folder`` cannot be written); ``metadata`` (the run's
+    parameters, strings) goes into the bag's custom data, ``cpus`` are the CPUs the writer
+    process may run on.
     """
 
     def __init__(

@@ -38,7 +38,7 @@ import sys
 import time
 from typing import Any, BinaryIO
 
-from linkage_kinematics.bag.errors import BagError, BagExistsError
+from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
 from linkage_kinematics.bag.writer import BagWriter, NO_SPLIT, WRITE_BATCH
 
 _FRAME = struct.Struct('<cI')
@@ -101,11 +101,12 @@ class BagWriterProcess:
         self._closed = False
         self.size_bytes = 0
         try:
+            # The child's one answer to START that is an error is about the folder.
             reply = self._request(START, {
                 'folder': str(folder), 'metadata': dict(metadata),
                 'split': {'max_bag_size': max_bag_size,
                           'max_bag_duration_ns': max_bag_duration_ns},
-            })
+            }, LogFolderError)
         except BagError:
             self._process.stdin.close()
             self._process.wait(timeout=CLOSE_TIMEOUT)
@@ -197,8 +198,10 @@ class BagWriterProcess:
                              f'ended unexpectedly (status {self._process.wait()})')
             raise BagError(self._failure) from None
 
-    def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
-        """Send a frame and waits for the child's answer to it."""
+    def _request(
+        self, kind: bytes, payload: dict[str, Any], error_kind: type[BagError] = BagError
+    ) -> dict[str, Any]:
+        """Send a frame and wait for the child's answer to it (an error as ``error_kind``)."""
         self._send(kind, json.dumps(payload).encode('utf-8'))
         os.set_blocking(self._process.stdout.fileno(), True)
         line = self._process.stdout.readline()
@@ -209,7 +212,7 @@ class BagWriterProcess:
             )
         reply = json.loads(line)
         if 'error' in reply:
-            raise BagError(reply['error'])
+            raise error_kind(reply['error'])
         return reply
 
     def _read_replies(self) -> None:
