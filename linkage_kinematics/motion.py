@@ -225,7 +225,6 @@ class DriveLawRun:
     def __init__(self, config: RunConfiguration) -> None:
         self.config = config
         self.missed_deadlines = 0
-        self.window_ticks = 0
         self.restart()
 
     def restart(self) -> None:
@@ -269,7 +268,6 @@ class DriveLawRun:
         # A period that passed without a tick is a missed deadline; rcl timers skip such
         # periods rather than firing twice, so the shortfall stays visible.
         self._ticks += 1
-        self.window_ticks += 1
         due = math.floor(elapsed * config.rate_hz + 1e-6) + 1
         self.missed_deadlines = max(
             self.missed_deadlines, self._missed_before_restart + due - self._ticks)
@@ -294,7 +292,6 @@ class DriveLawRun:
                 self.missed_deadlines += 1
             self._step += 1
             self._ticks += 1
-            self.window_ticks += 1
             due_states.append(self._solve(sample, at_ns))
             if sample.final:
                 return due_states, None, False

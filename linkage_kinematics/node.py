@@ -17,16 +17,13 @@ README.md.
 
 from __future__ import annotations
 
-import math
 import re
 import signal
 import sys
 from typing import Any
 
-from linkage_kinematics.joints import Link
 from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.measured import MeasuredFollower, Rejection
-from linkage_kinematics.motion import blocked_note, dead_point_problem, DriveLawRun
+from linkage_kinematics.motion import blocked_note
 from linkage_kinematics.node_outputs import NodeOutputs, StartupError
 from linkage_kinematics.node_parameters import (
     add_ranges,
@@ -34,17 +31,22 @@ from linkage_kinematics.node_parameters import (
     keep_declared_types,
     parameter_values,
 )
+from linkage_kinematics.node_sources import (
+    DriveLawTimer,
+    EXIT_FAILED,
+    EXIT_OK,
+    MeasuredSubscription,
+)
 from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
-    EndBehavior,
     NODE_NAME,
     PARAMETER_NAMES,
     RunConfiguration,
     Source,
 )
 from linkage_kinematics.placement import CpuPlacement
-from linkage_kinematics.status import MeasuredHealth, report
+from linkage_kinematics.status import report
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -52,18 +54,11 @@ from rclpy.experimental import EventsExecutor
 from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile
 from rclpy.signals import SignalHandlerOptions
-from sensor_msgs.msg import JointState
 
 DIAGNOSTICS_PERIOD = 1.0  # s
 
-EXIT_OK = 0
-EXIT_FAILED = 1  # the crank met a dead point before alpha_end, or the log could not be closed
 EXIT_CONFIGURATION = 2
-
-# Deep enough that a burst of encoder samples waiting for one slow callback is never lost.
-MEASURED_QOS = QoSProfile(depth=100)
 
 
 # --- the node ------------------------------------------------------------------------------
@@ -87,12 +82,12 @@ class LinkageNode(Node):
         if blocked_note(config) is not None:
             self.get_logger().warning(blocked_note(config))
         self._pending: tuple[RunConfiguration, list[str]] | None = None
-        self._problem: str | None = None
-        self._activity = 'starting'
+        self.problem: str | None = None
+        self.activity = 'starting'
         self._state: LinkageState | None = None
         self._state_ns = 0
-        self._stale = False  # measured: no valid sample within measured.timeout
         self._window_start_ns: int | None = None
+        self._window_states = 0
         self._achieved_rate = 0.0
         self._placement = CpuPlacement()
         self._place(config.cpu_affinity)
@@ -101,22 +96,21 @@ class LinkageNode(Node):
         if self.outputs.recorder is not None:
             self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
         self._marker_timer = self.create_timer(1.0 / config.display_rate_hz,
-                                               self._publish_markers)
-        self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self._publish_diagnostics)
+                                               self.publish_markers)
+        self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         self.add_pre_set_parameters_callback(keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
-        self._run = DriveLawRun(config)
-        self._follower = MeasuredFollower(config)
-        if config.source is Source.MEASURED:
-            self._start_measured()
-        else:
-            self._state_timer = self.create_timer(self._run.timer_period, self._tick)
-            # The motion starts now (its first state, scene first, is published at once),
-            # unless the clock does not run yet (use_sim_time before the first /clock).
-            self._tick()
+        self._source: DriveLawTimer | MeasuredSubscription = (
+            MeasuredSubscription(self) if config.source is Source.MEASURED
+            else DriveLawTimer(self))
+        self._source.start()
 
     # parameters
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Return the current values of the node's own parameters (name → value)."""
+        return parameter_values(self)
 
     def _validate_change(self, changed: list[Parameter]) -> SetParametersResult:
         """Validate the whole configuration the change would produce; keep it for the post-set."""
@@ -139,7 +133,8 @@ class LinkageNode(Node):
         if not differing:
             return  # e.g. `ros2 param load` of the node's own dump: nothing changes
         old, self.config = self.config, new
-        self.outputs.config = self._run.config = self._follower.config = new
+        self.outputs.config = new
+        self._source.reconfigure(old, new)
         restarts = new.restarts_motion(old)
         self.get_logger().info(
             'parameters changed: '
@@ -151,127 +146,34 @@ class LinkageNode(Node):
         if new.display_rate_hz != old.display_rate_hz:
             self.destroy_timer(self._marker_timer)
             self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
-                                                   self._publish_markers)
+                                                   self.publish_markers)
         if new.cpu_affinity != old.cpu_affinity:
             self._place(new.cpu_affinity)
             if self.outputs.recorder is not None:
                 self.outputs.recorder.run_writer_on(
                     self._placement.bag_writer_cpus or self._placement.available)
-        if new.measured_timeout != old.measured_timeout and new.source is Source.MEASURED:
-            self.destroy_timer(self._freshness_timer)
-            self._freshness_timer = self.create_timer(0.25 * new.measured_timeout,
-                                                      self._check_freshness)
         if new.joints != old.joints:
-            # The lab's names and mapping: a measured driver is read anew, the URDF follows.
-            self._follower = MeasuredFollower(new)
-            self.outputs.publish_description(self._state_ns if self._state else self._now_ns())
+            self.publish_description()  # the lab's names, axes and offsets
         if restarts:
-            self._state = None
-            if new.source is Source.MEASURED:
-                self._follower.restart()
-                self.outputs.publish_description(self._now_ns())
-                return
-            self._run.restart()
-            self.destroy_timer(self._state_timer)
-            self._state_timer = self.create_timer(self._run.timer_period, self._tick)
-            self._tick()
-
-    def parameter_values(self) -> dict[str, Any]:
-        """Return the current values of the node's own parameters (name → value)."""
-        return parameter_values(self)
+            self.forget_state()
+            self._source.restart()
 
     def _place(self, cpu: int) -> None:
         change = self._placement.place(cpu)
         if change is not None:
             self.get_logger().info(change)
 
-    # the drive_law source
+    # publishing, for the sources (node_sources)
 
-    def _now_ns(self) -> int:
+    def now_ns(self) -> int:
+        """Return the node clock's time (ns)."""
         return self.get_clock().now().nanoseconds
 
-    def _tick(self) -> None:
-        now_ns = self._now_ns()
-        if self.exit_code is not None or now_ns == 0:
-            return  # finished, or use_sim_time and no /clock yet: no time to start at
-        if self._run.start_ns is None or now_ns < self._run.start_ns:
-            self._state = None  # the motion starts (again): its scene and status come first
-        due_states, next_ns, blocked = self._run.advance(now_ns)
-        for due in due_states:
-            if due.met_dead_point:
-                self._publish_diagnostics(dead_point_problem(self.config), due.at_ns)
-            if due.state is None:
-                if self.config.end_behavior is EndBehavior.STOP:
-                    self._cannot_go_on(due.refusal)
-                    return
-                continue  # loop and bounce turn round at the dead point, which has no state
-            self._publish_state(due.state, due.at_ns, due.sample.motion_time)
-            if due.sample.final:
-                self._activity = (
-                    f'reached alpha_end = {math.degrees(self.config.alpha_end):.6f}°; stopped')
-                self.get_logger().info(self._activity)
-                self._publish_markers()
-                self._publish_diagnostics()
-                self.exit_code = EXIT_OK
-                return
-        if blocked:
-            self._cannot_go_on(None)
-        elif next_ns is not None:
-            self._state_timer.timer_period_ns = next_ns - now_ns
-            self._state_timer.reset()
+    def forget_state(self) -> None:
+        """Make the next state a motion's first: its scene and status go out before it."""
+        self._state = None
 
-    def _cannot_go_on(self, detail: str | None) -> None:
-        if self.config.blocked_at is not None:
-            self._problem = dead_point_problem(self.config)
-        else:
-            self._problem = f'the crank cannot go on: {detail}'
-        self.get_logger().error(self._problem)
-        self._publish_diagnostics()
-        self.exit_code = EXIT_FAILED
-
-    # the measured source
-
-    def _start_measured(self) -> None:
-        config = self.config
-        self._driver_name = config.joints[Link(config.driver.value)].name
-        self._health = MeasuredHealth(self._now_ns())
-        self._activity = f'waiting for {self._driver_name} on measured_joint_states'
-        self._measured = self.create_subscription(
-            JointState, 'measured_joint_states', self._on_measured, MEASURED_QOS)
-        self._freshness_timer = self.create_timer(0.25 * config.measured_timeout,
-                                                  self._check_freshness)
-        # The lab's robot_state_publisher gets the URDF before the first sample.
-        self.outputs.publish_description(self._now_ns())
-        self._publish_diagnostics()
-
-    def _on_measured(self, message: JointState) -> None:
-        stamp = message.header.stamp
-        followed = self._follower.follow(stamp.sec * 1_000_000_000 + stamp.nanosec,
-                                         message.name, message.position, message.velocity)
-        if followed is None:
-            return  # this node's own joint states, heard back
-        if isinstance(followed, Rejection):
-            self._health.drop(followed)
-            return
-        self._health.accept(self._now_ns(), followed.velocity)
-        self._run.window_ticks += 1
-        if self._stale:
-            self._stale = False
-            self._state = None  # publish the scene and the status with the next state
-        self._activity = f'following {self._driver_name}'
-        self._publish_state(followed.state, followed.stamp_ns, followed.motion_time)
-
-    def _check_freshness(self) -> None:
-        """Report at once when the measured data goes stale, or the drops of the last period."""
-        stale = self._health.is_stale(self._now_ns(), self.config.measured_timeout)
-        if stale and not self._stale:
-            self._stale = True
-            self._follower.restart()  # a long gap: the next valid sample starts afresh
-            self._publish_diagnostics()
-
-    # publishing
-
-    def _publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
         """
         Publish a state stamped ``stamp_ns``.
 
@@ -281,20 +183,26 @@ class LinkageNode(Node):
         first = self._state is None
         self._state = state
         self._state_ns = stamp_ns
+        self._window_states += 1
         if first:
-            self._publish_markers()
+            self.publish_markers()
             self.outputs.publish_description(stamp_ns)
             if self.config.source is Source.DRIVE_LAW:
-                self._activity = 'moving'
-            self._publish_diagnostics()
+                self.activity = 'moving'
+            self.publish_diagnostics()
         self.outputs.publish_state(state, stamp_ns, motion_time)
 
-    def _publish_markers(self) -> None:
+    def publish_markers(self) -> None:
         """Publish the scene of the latest state, stamped with that state's time."""
         if self._state is not None:
             self.outputs.publish_markers(self._state, self._state_ns)
 
-    def _publish_diagnostics(self, event: str | None = None, at_ns: int | None = None) -> None:
+    def publish_description(self) -> None:
+        """Publish the URDF if it is new, at the latest state's time (or now before one)."""
+        self.outputs.publish_description(
+            self._state_ns if self._state is not None else self.now_ns())
+
+    def publish_diagnostics(self, event: str | None = None, at_ns: int | None = None) -> None:
         """
         Publish the status, stamped ``at_ns``.
 
@@ -302,19 +210,19 @@ class LinkageNode(Node):
         or now before the first state and while measured data is stale; ``event``, a problem
         of this moment only, makes it ERROR.
         """
-        config = self.config
-        now_ns = self._now_ns()
+        now_ns = self.now_ns()
         if at_ns is None:
-            at_ns = self._state_ns if self._state is not None and not self._stale else now_ns
+            fresh = self._state is not None and not self._source.stale
+            at_ns = self._state_ns if fresh else now_ns
         if self._window_start_ns is not None and now_ns > self._window_start_ns:
             window = (now_ns - self._window_start_ns) * 1e-9
-            self._achieved_rate = self._run.window_ticks / window
+            self._achieved_rate = self._window_states / window
         self._window_start_ns = now_ns
-        self._run.window_ticks = 0
-        health = self._health if config.source is Source.MEASURED else None
+        self._window_states = 0
         level, text, values = report(
-            config, self._state, event or self._problem or self.outputs.recording_error,
-            self._activity, health, now_ns, self._achieved_rate, self._run.missed_deadlines)
+            self.config, self._state, event or self.problem or self.outputs.recording_error,
+            self.activity, self._source.health, now_ns, self._achieved_rate,
+            self._source.missed_deadlines)
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 
