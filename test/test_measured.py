@@ -27,10 +27,11 @@ import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.geometry import FourBar, preset, TWO_PI
-from linkage_kinematics.joints import Driver
+from linkage_kinematics.joints import Driver, JointStream, Link, TREE_ORDER
 from linkage_kinematics.kinematics import CrankRates
 from linkage_kinematics.measured import MeasuredFollower, Rejection
 from linkage_kinematics.parameters import build_configuration, parameter_specs, Source
+from linkage_kinematics.urdf import urdf_text
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,
@@ -472,3 +473,40 @@ def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configur
         0.2090, abs=1e-4)
     assert math.remainder(-state.beta - state.gamma + 1.1, TWO_PI) == pytest.approx(
         -1.0141, abs=1e-4)
+
+
+@pytest.mark.parametrize('driver', list(Driver))
+def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(driver):
+    """
+    The node's URDF, with the lab's names, reversed axes and offsets, for each driver's tree.
+
+    Forward kinematics at the driver's lab value and the passive joints a JointStream gives
+    lands the chain's end on the cut pivot (C for the crank, O for the rocker) within 1e-12 m,
+    over two turns of the driver; the URDF's joints are exactly the published ones.
+    """
+    mapping = {**LAB_JOINTS, 'joints.rocker.direction': -1}
+    defaults = {spec.name: spec.default for spec in parameter_specs('grashof_crank_rocker')}
+    config = build_configuration({**defaults, **mapping, 'source': 'measured',
+                                  'driver': driver.value})
+    linkage = config.linkage
+    urdf = urdf_text(linkage, config.frame_id, config.joints, driver)
+    order = TREE_ORDER[driver]
+    names = config.joints.names(order)
+    assert {joint.get('name') for joint in ElementTree.fromstring(urdf).iter('joint')} == set(
+        names)
+    stream = JointStream(config.joints, driver, include_driver=False)
+    assert stream.names == names[1:]
+    driver_mapping = config.joints[Link(driver.value)]
+    follower = MeasuredFollower(config)
+    interval = config.driven_linkage.reachability.intervals[0]
+    low, high = interval
+    span = high - low if high - low < TWO_PI else TWO_PI
+    end = (linkage.rocker_length, (linkage.ground_x, linkage.ground_y)) if (
+        driver is Driver.CRANK) else (linkage.crank_length, (0.0, 0.0))
+    for index in range(1, 200):
+        node_angle = low + span * (0.5 - 0.49 * math.cos(math.pi * index / 50.0))
+        lab_angle = driver_mapping.to_lab(node_angle)
+        followed = follower.follow(index, [names[0]], [lab_angle], [1.0])
+        positions, _ = stream.values(followed.state)
+        values = {names[0]: lab_angle, **dict(zip(stream.names, positions))}
+        assert chain_end(urdf, values, end[0]) == pytest.approx(end[1], abs=TOLERANCE)
