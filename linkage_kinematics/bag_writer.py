@@ -79,10 +79,20 @@ class MessageDefinitionError(LookupError):
 
 
 def _interface_file(package: str, name: str, suffix: str) -> Path | None:
+    """
+    Return the installed ``<package>/msg/<name><suffix>``.
+
+    From the package in the ament index, or where that package is not installed, from the copies
+    this package ships of the types it logs without publishing them (tf2_msgs, which has no
+    package on PyPI; see interfaces/README.md).
+    """
     try:
         share = Path(get_package_share_directory(package))
     except PackageNotFoundError:
-        return None
+        try:
+            share = Path(get_package_share_directory(PACKAGE_NAME)) / 'interfaces' / package
+        except PackageNotFoundError:
+            return None
     candidate = share / 'msg' / f'{name}{suffix}'
     return candidate if candidate.is_file() else None
 

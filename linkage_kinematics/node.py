@@ -80,6 +80,14 @@ EXIT_FAILED = 1  # the crank met a dead point before alpha_end, or the log could
 EXIT_CONFIGURATION = 2
 
 DATA_QOS = QoSProfile(depth=10)
+# TF is logged, never published (see docs/logging.md), with tf2_ros's broadcaster QoS: the
+# static one keeps the last message for late subscribers, as robot_state_publisher's does.
+TF_TOPIC = '/tf'
+TF_STATIC_TOPIC = '/tf_static'
+TF_QOS = QoSProfile(depth=100)
+TF_STATIC_QOS = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
 # robot_state_publisher's convention: late joiners get the latest description.
 ROBOT_DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
@@ -175,6 +183,7 @@ class LinkageNode(Node):
         self._activity = 'starting'
         self._recording_error: str | None = None
         self._described_linkage: FourBar | None = None
+        self._robot_transforms: messages.RobotStateTransforms | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = self.config.frame_prefix + self.config.frame_id
         # The per-tick messages and the scene are encoded straight from the state; the
@@ -386,6 +395,8 @@ class LinkageNode(Node):
         try:
             for topic, publisher in self._topic_publishers.items():
                 recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
+            recorder.add_topic(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS)
+            recorder.add_topic(TF_TOPIC, messages.TFMessage, TF_QOS)
         except OSError as error:
             recorder.close()
             raise ConfigurationError('log.folder', str(error)) from None
@@ -401,6 +412,9 @@ class LinkageNode(Node):
         (or an encoder equal to it) and log it: subscribers get the very bytes that are logged.
         """
         self._topic_publishers[topic].publish(data)
+        self._record(topic, data, log_time_ns)
+
+    def _record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         if self._recorder is None or self._recording_error is not None:
             return
         try:
@@ -564,6 +578,13 @@ class LinkageNode(Node):
             self._joint_state_encoder.encode(state, nanoseconds, self._joint_positions),
             nanoseconds,
         )
+        if self._robot_transforms is not None:
+            self._record(
+                TF_TOPIC,
+                self._robot_transforms.message(
+                    dict(zip(messages.JOINT_NAMES, self._joint_positions)), nanoseconds),
+                nanoseconds,
+            )
         self._send(
             self._state_topic,
             self._state_encoder.encode(state, nanoseconds, motion_time),
@@ -602,6 +623,12 @@ class LinkageNode(Node):
         self._described_linkage = self.config.linkage
         message = String(data=urdf_text(self.config.linkage, self.config.frame_id))
         self._publish(self._description_topic, message, at.nanoseconds)
+        if self._recorder is not None:
+            # What robot_state_publisher publishes for this description, for the bag only.
+            self._robot_transforms = messages.RobotStateTransforms(
+                message.data, self.config.frame_prefix)
+            self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(at.nanoseconds),
+                         at.nanoseconds)
 
     def _publish_markers(self) -> None:
         """Return the scene of the latest state, stamped with that state's time."""
