@@ -6,13 +6,16 @@
 
 Republish a logged run for labs without rosbag2, or recover a killed one.
 
-    linkage-replay BAG [--rate FACTOR] [--loop] [--topics TOPIC ...] [--delay SECONDS]
+    linkage-replay BAG [--rate FACTOR] [--loop] [--topics TOPIC ...]
+                       [--exclude-topics TOPIC ...] [--delay SECONDS]
     linkage-replay --recover BAG
 
 Replaying publishes each message's logged CDR bytes unchanged on its logged topic, with its
 logged type and QoS (from the bag's metadata.yaml; without one, reliable depth 10, and transient
 local for ``/robot_description`` as the node offers it), at the logged log-time spacing divided
 by ``--rate``. Topics whose message type is not installed here are skipped with a warning.
+``--exclude-topics /tf /tf_static`` leaves out the bag's TF where a robot_state_publisher
+publishes it from the replayed joint states (as ``ros2 bag play --exclude-topics``).
 ``--recover`` rewrites a bag whose recorder was killed into a complete one (see
 docs/logging.md).
 """
@@ -70,6 +73,11 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument('--loop', action='store_true', help='start over at the end, until Ctrl-C')
     parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='replay only these topics')
     parser.add_argument(
+        '--exclude-topics', nargs='+', metavar='TOPIC', default=[],
+        help='do not replay these topics, e.g. /tf /tf_static where a robot_state_publisher '
+        'publishes TF from the replayed joint states',
+    )
+    parser.add_argument(
         '--delay',
         type=_non_negative_seconds,
         default=1.0,
@@ -119,7 +127,7 @@ def _logged_topics(bag: Path) -> dict[str, tuple[str, dict[str, Any] | None]]:
     return found
 
 
-def _plan(bag: Path, wanted: Sequence[str] | None) -> list[TopicPlan]:
+def _plan(bag: Path, wanted: Sequence[str] | None, excluded: Sequence[str]) -> list[TopicPlan]:
     logged = _logged_topics(bag)
     if wanted:
         missing = sorted(set(wanted) - set(logged))
@@ -128,6 +136,10 @@ def _plan(bag: Path, wanted: Sequence[str] | None) -> list[TopicPlan]:
                 f"{bag} has no topic {', '.join(missing)}; it has {', '.join(sorted(logged))}"
             )
         logged = {topic: logged[topic] for topic in wanted}
+    # Like rosbag2, an excluded topic the bag does not hold is no error (an older bag has no TF).
+    logged = {topic: entry for topic, entry in logged.items() if topic not in excluded}
+    if not logged:
+        raise ReplayError(f'nothing to replay in {bag}: every topic is excluded')
     plans = []
     for topic, (type_name, offered_qos) in logged.items():
         msg_type = _import_message_type(type_name)
@@ -235,7 +247,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 f"{', '.join(cut)} ends without its summary (the recorder was killed); "
                 f'run `linkage-replay --recover {bag}` first'
             )
-        plans = _plan(bag, arguments.topics)
+        plans = _plan(bag, arguments.topics, arguments.exclude_topics)
         return _replay(bag, plans, arguments.rate, arguments.loop, arguments.delay)
     except (ReplayError, bag_reader.BagError, BagWriteError) as error:
         print(f'linkage-replay: {error}', file=sys.stderr)

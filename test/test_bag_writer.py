@@ -83,6 +83,8 @@ NODE_TOPICS = {
     '/linkage/markers': MarkerArray,
     '/diagnostics': DiagnosticArray,
 }
+# The node logs TF too, as robot_state_publisher would publish it, without publishing it.
+LOGGED_TOPICS = {**NODE_TOPICS, '/tf_static': messages.TFMessage, '/tf': messages.TFMessage}
 DATA_TOPICS = ('/joint_states', '/linkage/state', '/linkage/markers', '/diagnostics')
 RATE_HZ = 200.0
 # 90° at this constant ω takes 0.3 s: a short run.
@@ -512,10 +514,10 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_published_topic_is_logged_with_its_type(node_run: dict[str, Any]) -> None:
     logged = read_with_rosbags(node_run['bag'])
-    assert set(logged) == set(NODE_TOPICS)
+    assert set(logged) == set(LOGGED_TOPICS)
     with Reader(node_run['bag']) as reader:
         types = {connection.topic: connection.msgtype for connection in reader.connections}
-    assert types == {topic: ros_type_name(msg_type) for topic, msg_type in NODE_TOPICS.items()}
+    assert types == {topic: ros_type_name(msg_type) for topic, msg_type in LOGGED_TOPICS.items()}
     assert len(logged['/linkage/state']) == len(logged['/joint_states']) >= 2
     assert len(logged['/robot_description']) == 1
 
@@ -582,7 +584,7 @@ def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(
     log_times = [message.log_time_ns for message in bag_reader.iter_messages(bag)]
     assert log_times == sorted(log_times)
     for topic, entries in read_with_rosbags(bag).items():
-        type_name = ros_type_name(NODE_TOPICS[topic])
+        type_name = ros_type_name(LOGGED_TOPICS[topic])
         for _, decoded, raw in entries:
             assert len(raw) == len(TYPESTORE.serialize_cdr(decoded, type_name)), topic
 
@@ -595,7 +597,7 @@ def test_mcap_ros2_decodes_every_message_with_the_logged_schemas(node_run: dict[
         counts[decoded.channel.topic] += 1
         assert decoded.schema.encoding == 'ros2msg'
         assert decoded.channel.message_encoding == 'cdr'
-        assert decoded.schema.name == ros_type_name(NODE_TOPICS[decoded.channel.topic])
+        assert decoded.schema.name == ros_type_name(LOGGED_TOPICS[decoded.channel.topic])
         assert 'offered_qos_profiles' in decoded.channel.metadata
     assert dict(counts) == topic_counts(bag_information(bag))
 
@@ -642,7 +644,8 @@ def test_metadata_yaml_is_rosbag2_jazzy_format(node_run: dict[str, Any]) -> None
             'liveliness', 'liveliness_lease_duration', 'avoid_ros_namespace_conventions',
         }
         expected_durability = (
-            'transient_local' if topic['name'] == '/robot_description' else 'volatile'
+            'transient_local' if topic['name'] in ('/robot_description', '/tf_static')
+            else 'volatile'
         )
         assert (profile['reliability'], profile['durability']) == ('reliable', expected_durability)
         assert entry['message_count'] == len(logged[topic['name']])
@@ -752,6 +755,9 @@ def test_replay_rejects_bad_input_with_a_clear_message(
 
     assert replay_main([str(node_run['bag']), '--topics', '/nope']) == 1
     assert '/nope' in capsys.readouterr().err
+    every_topic = list(LOGGED_TOPICS)
+    assert replay_main([str(node_run['bag']), '--exclude-topics', *every_topic]) == 1
+    assert 'every topic is excluded' in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_info:
         replay_main([str(node_run['bag']), '--rate', '-2'])
     assert exit_info.value.code == 2
