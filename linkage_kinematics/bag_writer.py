@@ -34,7 +34,21 @@ from typing import Any
 
 from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
 from linkage_kinematics import bag_reader
-from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, Writer
+from mcap.data_stream import RecordBuilder
+from mcap.opcode import Opcode
+from mcap.records import (
+    Channel,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    McapRecord,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
+from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, MCAP0_MAGIC, Writer
 import yaml
 
 PACKAGE_NAME = 'linkage_kinematics'
@@ -57,6 +71,13 @@ _PRIMITIVE_TYPES = frozenset(
     'bool byte char float32 float64 int8 uint8 int16 uint16 int32 uint32 int64 uint64 '
     'string wstring'.split()
 )
+
+
+def _record_size(record: McapRecord) -> int:
+    """Return the bytes mcap writes for ``record``."""
+    builder = RecordBuilder()
+    record.write(builder)
+    return builder.count
 
 
 def package_version() -> str:
@@ -236,6 +257,11 @@ class BagWriter:
         self._pending_end_ns = 0
         self._last_flush = time.monotonic()
         self._durable_size = 0
+        self._compression = compression
+        # Bytes of the schema and channel records, which the summary repeats, and the chunks
+        # written so far (each gets a chunk index in the summary).
+        self._registered_size = 0
+        self._chunk_count = 0
         self._failure: BagWriteError | None = None
         self._closed = False
         try:
@@ -287,16 +313,18 @@ class BagWriter:
         try:
             schema_id = self._schema_ids.get(type_name)
             if schema_id is None:
-                schema_id = self._writer.register_schema(
-                    type_name, SCHEMA_ENCODING, message_definition.encode('utf-8')
-                )
+                data = message_definition.encode('utf-8')
+                schema_id = self._writer.register_schema(type_name, SCHEMA_ENCODING, data)
                 self._schema_ids[type_name] = schema_id
+                self._registered_size += _record_size(
+                    Schema(id=schema_id, data=data, encoding=SCHEMA_ENCODING, name=type_name))
+            channel_metadata = {'offered_qos_profiles': offered_qos_profiles,
+                                'topic_type_hash': type_hash}
             channel_id = self._writer.register_channel(
-                topic,
-                MESSAGE_ENCODING,
-                schema_id,
-                {'offered_qos_profiles': offered_qos_profiles, 'topic_type_hash': type_hash},
-            )
+                topic, MESSAGE_ENCODING, schema_id, channel_metadata)
+            self._registered_size += _record_size(Channel(
+                id=channel_id, topic=topic, message_encoding=MESSAGE_ENCODING,
+                metadata=channel_metadata, schema_id=schema_id))
         except OSError as error:
             raise self._fail(error) from None
         self._topics[channel_id] = _Topic(topic, type_name, offered_qos_profiles, type_hash)
@@ -350,8 +378,46 @@ class BagWriter:
         except OSError as error:
             raise self._fail(error) from None
         self._last_flush = time.monotonic()
+        if self._file.tell() > self._durable_size:
+            self._chunk_count += 1
         self._durable_size = self._file.tell()
         self._commit_pending()
+
+    def finished_size(self) -> int:
+        """
+        Return the size the MCAP file would have if it were finished now.
+
+        What is written out (``flush`` first, to count the open chunk) and what ``close`` adds to
+        it: the rosbag2 metadata record, the data end, and the summary, which repeats the schema
+        and channel records and holds the statistics, a chunk index per chunk, the metadata
+        indexes, the group offsets and the footer; each measured as mcap writes it (a chunk index
+        as if every channel had messages in its chunk, so at most 10 bytes per channel and chunk
+        too many).
+        """
+        if self._failure is not None or self._closed:
+            return self._durable_size
+        information = yaml.safe_dump(self._bag_information(), sort_keys=False)
+        channel_counts = {channel_id: 0 for channel_id in self._topics}
+        tail = [
+            Metadata(name=ROSBAG2_METADATA_RECORD_NAME,
+                     metadata={'serialized_metadata': information}),
+            DataEnd(data_section_crc=0),
+            Statistics(attachment_count=0, channel_count=len(self._topics),
+                       channel_message_counts=channel_counts, chunk_count=0, message_count=0,
+                       message_end_time=0, message_start_time=0, metadata_count=0,
+                       schema_count=0),
+            *[ChunkIndex(chunk_length=0, chunk_start_offset=0, compression=self._compression,
+                         compressed_size=0, message_end_time=0, message_index_length=0,
+                         message_index_offsets=channel_counts, message_start_time=0,
+                         uncompressed_size=0)] * self._chunk_count,
+            *[MetadataIndex(offset=0, length=0, name=name)
+              for name in (METADATA_RECORD_NAME, ROSBAG2_METADATA_RECORD_NAME)],
+            # schemas, channels, statistics, chunk, attachment and metadata indexes
+            *[SummaryOffset(group_opcode=Opcode.SCHEMA, group_start=0, group_length=0)] * 6,
+            Footer(summary_start=0, summary_offset_start=0, summary_crc=0),
+        ]
+        return (self._file.tell() + self._registered_size + sum(map(_record_size, tail))
+                + len(MCAP0_MAGIC))
 
     def close(self) -> None:
         """

@@ -23,11 +23,11 @@ import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import bag_reader, messages
+from linkage_kinematics import bag_reader, diagnostics, messages
 from linkage_kinematics.bag_writer import package_version
 from linkage_kinematics.bag_writer_process import set_process_affinity
 from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
-from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
+from linkage_kinematics.kinematics import DeadPointError, LinkageState
 from linkage_kinematics.motion import (
     blocked_note,
     dead_point_problem,
@@ -193,9 +193,8 @@ class LinkageNode(Node):
         self._encoded_linkage: FourBar | None = None
         self._state_encoder: messages.LinkageStateEncoder | None = None
         self._marker_encoder: messages.MarkerArrayEncoder | None = None
-        self._window_start: Time | None = None
-        self._window_ticks = 0
-        self._achieved_rate = 0.0
+        self._rate_meter = diagnostics.RateMeter()
+        self._status_schedule = diagnostics.StatusSchedule()
         self._missed_deadlines = 0
         self._missed_before_restart = 0
         self._restart_motion()
@@ -520,7 +519,7 @@ class LinkageNode(Node):
             published += 1
             self._step += 1
             self._ticks += 1
-            self._window_ticks += 1
+            self._rate_meter.tick()
             self._publish_sample(sample, due)
 
     def _motion_time(self, seconds: float) -> Time:
@@ -551,7 +550,7 @@ class LinkageNode(Node):
         self._missed_deadlines = max(
             self._missed_deadlines, self._missed_before_restart + due - self._ticks
         )
-        self._window_ticks += 1
+        self._rate_meter.tick()
 
     def _publish_state(self, state: LinkageState, motion_time: float, at: Time) -> None:
         """
@@ -590,6 +589,8 @@ class LinkageNode(Node):
             self._state_encoder.encode(state, nanoseconds, motion_time),
             nanoseconds,
         )
+        if self._status_schedule.due(nanoseconds):
+            self._publish_diagnostics()
 
     def _prepare_encoders(self) -> None:
         linkage = self.config.linkage
@@ -603,6 +604,7 @@ class LinkageNode(Node):
         )
         self.get_logger().info(self._activity)
         self._publish_markers()
+        self._flush_log()
         self._publish_diagnostics()
         self.exit_code = EXIT_OK
 
@@ -614,6 +616,7 @@ class LinkageNode(Node):
             problem = f'the crank cannot go on: {detail}'
         self._problem = problem
         self.get_logger().error(problem)
+        self._flush_log()
         self._publish_diagnostics()
         self.exit_code = EXIT_FAILED
 
@@ -650,12 +653,8 @@ class LinkageNode(Node):
         now = self.get_clock().now()
         if at is None:
             at = self._state_time if self._state_time is not None else now
-        if self._window_start is not None:
-            window = (now - self._window_start).nanoseconds * 1e-9
-            if window > 0.0:
-                self._achieved_rate = self._window_ticks / window
-        self._window_start = now
-        self._window_ticks = 0
+        self._rate_meter.update(now.nanoseconds)
+        self._status_schedule.sent(at.nanoseconds)
         problem = event or self._problem or self._recording_error
         level, text = assess(self.config, self._state, problem, self._activity)
         message = messages.diagnostic_array(
@@ -669,39 +668,26 @@ class LinkageNode(Node):
         self._publish(self._diagnostics_topic, message, at.nanoseconds)
 
     def _diagnostic_values(self) -> dict[str, str]:
-        config = self.config
-        values = {
-            'end behavior': config.end_behavior,
-            'mode': config.mode,
-            'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
-            'rate_hz': f'{config.rate_hz:g}',
-            'missed deadlines': str(self._missed_deadlines),
-        }
-        state = self._state
-        if state is not None:
-            reachability = config.linkage.reachability
-            distance = reachability.dead_point_distance(state.alpha)
-            change_distance = reachability.change_point_distance(state.alpha)
-            residual = float(loop_closure_residual(config.linkage, state))
-            values.update({
-                'alpha (rad)': repr(state.alpha),
-                'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
-                'dead point distance (deg)': (
-                    'none (full rotation)' if distance is None
-                    else f'{math.degrees(distance):.6f}'
-                ),
-                'change point distance (deg)': (
-                    'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
-                ),
-                'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
-                'loop closure residual': f'{residual:.3g}',
-            })
-        if self._recorder is None:
-            values['log file'] = 'disabled'
-        else:
-            values['log file'] = str(self._recorder.bag_path)
-            values['log size (bytes)'] = str(self._recorder.size_bytes)
-        return values
+        recorder = self._recorder
+        return diagnostics.key_values(
+            self.config, self._state, self._rate_meter.rate, self._missed_deadlines,
+            None if recorder is None else str(recorder.bag_path),
+            None if recorder is None else recorder.size_bytes,
+        )
+
+    def _flush_log(self) -> None:
+        """
+        Have the bag writer write out what it holds before the run's last status.
+
+        So that its log size is the bag's.
+        """
+        if self._recorder is None or self._recording_error is not None:
+            return
+        try:
+            self._recorder.flush()
+        except OSError as error:
+            self._recording_error = f'recording stopped: {error}'
+            self.get_logger().error(self._recording_error)
 
 
 # --- process ------------------------------------------------------------------------------

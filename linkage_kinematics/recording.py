@@ -366,7 +366,11 @@ class Recorder:
 
     @property
     def size_bytes(self) -> int:
-        """Return the MCAP file's size as the writer last reported it (every 0.25 s at most)."""
+        """
+        Return the size the finished MCAP file will have, as the writer last reported it.
+
+        Counting what it has written out: it reports at most every 0.25 s and after ``flush``.
+        """
         return self._writer.size_bytes
 
     def add_topic(self, topic: str, msg_type: type, qos: QoSProfile) -> None:
@@ -386,6 +390,13 @@ class Recorder:
         """Log ``data``, a message of ``topic`` encoded by ``encode_cdr``."""
         try:
             self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
+        except BagWriteError as error:
+            raise RecordingError(str(error)) from None
+
+    def flush(self) -> None:
+        """Wait until the writer has written out everything it was given (``size_bytes`` too)."""
+        try:
+            self._writer.flush()
         except BagWriteError as error:
             raise RecordingError(str(error)) from None
 

@@ -1,0 +1,125 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+What the node's diagnostics say and when, without ROS.
+
+``key_values`` formats the status's key values (README, "Diagnostics") so that a viewer shows
+them as they are: counts as integers, small residuals in scientific notation, and in each mode
+only the rate it uses. ``StatusSchedule`` says which states a status goes out with: one at least
+every ``STATUS_PERIOD`` of mechanism time, so that a replayed bag's diagnostics move with the
+mechanism. ``RateMeter`` measures the achieved state rate over the last ``RATE_WINDOW``, so
+that statuses that close together do not report the jitter of a few ticks.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+
+from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
+from linkage_kinematics.parameters import RunConfiguration
+
+STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
+RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured
+LOG_DISABLED = 'disabled'
+
+
+class StatusSchedule:
+    """
+    Decide which states a status goes out with, so that statuses are at most STATUS_PERIOD apart.
+
+    A state carries one when the next state, as far after it as it came after the one before,
+    would be more than STATUS_PERIOD after the last status; where the states themselves are
+    further apart, every state carries one.
+    """
+
+    def __init__(self) -> None:
+        self._period_ns = round(STATUS_PERIOD * 1e9)
+        self._last_status_ns: int | None = None
+        self._last_state_ns: int | None = None
+
+    def sent(self, stamp_ns: int) -> None:
+        """Note a status stamped ``stamp_ns`` (sent with a state or for any other reason)."""
+        self._last_status_ns = stamp_ns
+
+    def due(self, stamp_ns: int) -> bool:
+        """Whether the state stamped ``stamp_ns`` (the states' stamps in order) carries a status."""
+        previous, self._last_state_ns = self._last_state_ns, stamp_ns
+        if self._last_status_ns is None or previous is None or stamp_ns < previous:
+            return True  # the first state of a motion, or the clock went back
+        spacing = stamp_ns - previous
+        return stamp_ns + spacing - self._last_status_ns > self._period_ns
+
+
+class RateMeter:
+    """Ticks per second over the last RATE_WINDOW, measured at each status."""
+
+    def __init__(self) -> None:
+        self.rate = 0.0
+        self._ticks = 0
+        self._samples: collections.deque[tuple[int, int]] = collections.deque()
+
+    def tick(self) -> None:
+        self._ticks += 1
+
+    def update(self, now_ns: int) -> float:
+        """Return the rate over the samples of the last RATE_WINDOW before ``now_ns``."""
+        samples = self._samples
+        if samples and now_ns < samples[-1][0]:
+            samples.clear()  # the clock went back
+        samples.append((now_ns, self._ticks))
+        while now_ns - samples[0][0] > round(RATE_WINDOW * 1e9):
+            samples.popleft()
+        (first_ns, first_ticks) = samples[0]
+        if now_ns > first_ns:
+            self.rate = (self._ticks - first_ticks) / ((now_ns - first_ns) * 1e-9)
+        return self.rate
+
+
+def key_values(
+    config: RunConfiguration,
+    state: LinkageState | None,
+    achieved_rate: float,
+    missed_deadlines: int,
+    log_file: str | None,
+    log_size: int | None,
+) -> dict[str, str]:
+    """
+    Return the status's key values (README, "Diagnostics") as diagnostic_msgs/KeyValue strings.
+
+    ``log_file`` None means logging is disabled; ``log_size`` is the bag's size in bytes.
+    """
+    values = {
+        'end behavior': config.end_behavior,
+        'mode': config.mode,
+        'achieved rate (Hz)': f'{achieved_rate:.1f}',
+    }
+    # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
+    # the pace, and rate_hz is not used.
+    if config.mode == 'real_time':
+        values['rate_hz'] = f'{config.rate_hz:g}'
+    else:
+        values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'
+    values['missed deadlines'] = str(int(missed_deadlines))
+    if state is not None:
+        reachability = config.linkage.reachability
+        distance = reachability.dead_point_distance(state.alpha)
+        change_distance = reachability.change_point_distance(state.alpha)
+        residual = float(loop_closure_residual(config.linkage, state))
+        values.update({
+            'alpha (rad)': repr(state.alpha),
+            'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
+            'dead point distance (deg)': (
+                'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
+            ),
+            'change point distance (deg)': (
+                'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
+            ),
+            'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
+            'loop closure residual': f'{residual:.2e}',
+        })
+    values['log file'] = LOG_DISABLED if log_file is None else log_file
+    if log_file is not None and log_size is not None:
+        values['log size (bytes)'] = str(int(log_size))
+    return values
