@@ -44,7 +44,7 @@ class StatusSchedule:
         self._last_status_ns = stamp_ns
 
     def due(self, stamp_ns: int) -> bool:
-        """Whether the state stamped ``stamp_ns`` (the states' stamps in order) carries a status."""
+        """Whether the state stamped ``stamp_ns`` (states in the order published) carries one."""
         previous, self._last_state_ns = self._last_state_ns, stamp_ns
         if self._last_status_ns is None or previous is None or stamp_ns < previous:
             return True  # the first state of a motion, or the clock went back

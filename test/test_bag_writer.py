@@ -463,6 +463,28 @@ def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: i
     assert information['duration']['nanoseconds'] == 4_000
 
 
+@pytest.mark.parametrize('flushes', [0, 1, 7])
+def test_finished_size_is_the_size_of_the_bag_closed_then(tmp_path: Path, flushes: int) -> None:
+    writer = BagWriter(tmp_path / 'sized', metadata={'run': 'x'}, flush_interval=3600.0)
+    channels = [
+        writer.add_topic(topic, type_name, message_definition(type_name),
+                         offered_qos_profiles_yaml(QoSProfile(depth=10)))
+        for topic, type_name in (('/a', 'std_msgs/msg/String'),
+                                 ('/tf', 'tf2_msgs/msg/TFMessage'))
+    ]
+    for index in range(700):
+        writer.write(channels[0], encode_cdr(String(data=f'message {index}')), index, index)
+        if flushes and index % (700 // flushes) == 0:
+            writer.flush()
+    writer.flush()
+    projected = writer.finished_size()
+    writer.close()
+    # to a few bytes per chunk: its index counted with an offset for every channel
+    with open(writer.mcap_path, 'rb') as stream:
+        chunks = len(make_reader(stream).get_summary().chunk_indexes)
+    assert 0 <= projected - writer.mcap_path.stat().st_size <= 10 * (chunks + 3)
+
+
 def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
     bag = tmp_path / 'taken'
     bag.mkdir()
