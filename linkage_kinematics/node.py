@@ -23,9 +23,11 @@ import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import bag_reader, diagnostics, messages
-from linkage_kinematics.bag_writer import package_version
-from linkage_kinematics.bag_writer_process import set_process_affinity
+from linkage_kinematics import diagnostics, messages
+from linkage_kinematics.bag.cdr import encode_cdr
+from linkage_kinematics.bag.metadata import BagMetadata, package_version
+from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.bag.writer_process import set_process_affinity
 from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics import DeadPointError, LinkageState
 from linkage_kinematics.motion import (
@@ -49,7 +51,6 @@ from linkage_kinematics.parameters import (
     REAL_PARAMETERS,
     RunConfiguration,
 )
-from linkage_kinematics.recording import encode_cdr, Recorder
 from linkage_kinematics.urdf import urdf_text
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -443,7 +444,7 @@ class LinkageNode(Node):
             self.get_logger().error(f'could not finalize the log: {error}')
             return False
         bag = self._recorder.bag_path
-        count = bag_reader.bag_information(bag)['message_count']
+        count = BagMetadata.read(bag).message_count
         self.get_logger().info(f'bag finalized: {bag}, {count} messages')
         return True
 

@@ -18,8 +18,8 @@ import tempfile
 from typing import Any
 
 from linkage_kinematics import messages
-from linkage_kinematics.bag_writer import message_definition, type_description_hash
-from linkage_kinematics.recording import encode_cdr
+from linkage_kinematics.bag.cdr import encode_cdr
+from linkage_kinematics.bag.definitions import message_definition, type_description_hash
 from linkage_kinematics.robot_transforms import RobotTransforms, Transform, UrdfError
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -209,7 +209,7 @@ def test_tf_message_encoders_write_what_rosbags_serializes() -> None:
     stamp = 1_790_000_000_123_456_789
     data = messages.TFMessageEncoder(
         [(t.parent_frame, t.child_frame) for t in moving]).encode(moving, stamp)
-    assert data == encode_cdr(messages.tf_message(moving, messages.time_msg(stamp)))
+    assert data == encode_cdr(messages.tf_message(moving, stamp))
     decoded = TYPESTORE.deserialize_cdr(data, TF_TYPE)
     assert TYPESTORE.serialize_cdr(decoded, TF_TYPE) == data
     assert [as_transform(stamped) for stamped in decoded.transforms] == moving

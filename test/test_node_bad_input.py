@@ -19,7 +19,7 @@ import math
 import signal
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics.bag_reader import bag_files, iter_messages, read_states
+from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve

@@ -8,7 +8,7 @@ The Python mcap writer stops for 4–15 ms each time it ends a chunk (it writes 
 message index entry by entry); at a 5 kHz timer that is 20–75 ticks. In a thread it would
 still hold the GIL for those milliseconds. Here the node only appends each message to a
 buffer and hands batches to a pipe (``BagWriterProcess``); ``python -m
-linkage_kinematics.bag_writer_process`` runs the ``BagWriter`` on the other end, on whatever
+linkage_kinematics.bag.writer_process`` runs the ``BagWriter`` on the other end, on whatever
 core is free.
 
 The child lives as long as the pipe: when the node closes it, or dies in any way (SIGKILL
@@ -24,7 +24,7 @@ holds. The child answers on stdout with JSON lines: ``bag`` or ``channel`` for S
 ``size`` (the size the finished bag would have, ``BagWriter.finished_size``) now and then and
 with ``flushed`` for F, ``error`` when the bag cannot go on, and ``closed`` when it is done.
 
-Plain Python (no rclpy), as bag_writer.
+Plain Python (no rclpy), as ``writer``.
 """
 from __future__ import annotations
 
@@ -39,12 +39,8 @@ import sys
 import time
 from typing import Any, BinaryIO
 
-from linkage_kinematics.bag_writer import (
-    BagExistsError,
-    BagWriteError,
-    BagWriter,
-    WRITE_BATCH,
-)
+from linkage_kinematics.bag.errors import BagError, BagExistsError
+from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
 
 _FRAME = struct.Struct('<cI')
 _MESSAGE = struct.Struct('<HqqI')
@@ -81,7 +77,7 @@ class BagWriterProcess:
     A new bag folder in ``folder`` named after the local time (``rosbag2_%Y_%m_%d-%H_%M_%S``,
     ``_1``, … if taken).
 
-    Errors of the child's writer come back as BagWriteError from the next ``write`` (or
+    Errors of the child's writer come back as BagError from the next ``write`` (or
     ``close``) after the child reported them. ``cpus``, if given, are the CPUs the child may
     run on (the node's ``cpu_affinity`` keeps it off the node's CPU).
     """
@@ -105,7 +101,7 @@ class BagWriterProcess:
         self.size_bytes = 0
         try:
             reply = self._request(START, {'folder': str(folder), 'metadata': dict(metadata)})
-        except BagWriteError:
+        except BagError:
             self._process.stdin.close()
             self._process.wait(timeout=CLOSE_TIMEOUT)
             raise
@@ -129,7 +125,7 @@ class BagWriterProcess:
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
         """Queues one serialized message; a full or old batch goes to the child."""
         if self._failure is not None or self._closed:
-            raise BagWriteError(self._failure or f'bag {self.bag_path} is closed')
+            raise BagError(self._failure or f'bag {self.bag_path} is closed')
         self._queued += _MESSAGE.pack(channel_id, log_time_ns, publish_time_ns, len(data))
         self._queued += data
         self._queued_count += 1
@@ -144,7 +140,7 @@ class BagWriterProcess:
         ``size_bytes`` is then the size of the finished bag with everything handed over so far.
         """
         if self._failure is not None or self._closed:
-            raise BagWriteError(self._failure or f'bag {self.bag_path} is closed')
+            raise BagError(self._failure or f'bag {self.bag_path} is closed')
         if self._queued:
             self._send_queued()
         self._send(FLUSH, b'')
@@ -159,19 +155,19 @@ class BagWriterProcess:
                     break
                 chunk = os.read(descriptor, 65536)
                 if not chunk:
-                    raise BagWriteError(f'the bag writer ended with status '
-                                        f'{self._process.wait()} before answering')
+                    raise BagError(f'the bag writer ended with status '
+                                   f'{self._process.wait()} before answering')
                 self._replies += chunk
         finally:
             os.set_blocking(descriptor, False)
         if self._failure is not None:
-            raise BagWriteError(self._failure)
+            raise BagError(self._failure)
 
     def close(self) -> None:
         """
         Hand over what is queued, lets the child finish the bag and waits for it.
 
-        Idempotent; raises BagWriteError if the bag could not be finished.
+        Idempotent; raises BagError if the bag could not be finished.
         """
         if self._closed:
             return
@@ -179,7 +175,7 @@ class BagWriterProcess:
         if self._failure is None and self._queued:
             try:
                 self._send_queued()
-            except BagWriteError:
+            except BagError:
                 pass  # reported below with what the child says
         os.set_blocking(self._process.stdout.fileno(), True)
         try:
@@ -188,7 +184,7 @@ class BagWriterProcess:
         except subprocess.TimeoutExpired:
             self._process.kill()
             self._process.wait()
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer of {self.bag_path} did not finish within {CLOSE_TIMEOUT:g} s'
             ) from None
         self._replies += rest
@@ -199,9 +195,9 @@ class BagWriterProcess:
                 closing_error = reply['error']
             closed = closed or 'closed' in reply
         if closing_error is not None:
-            raise BagWriteError(closing_error)
+            raise BagError(closing_error)
         if not closed:
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer of {self.bag_path} ended with status '
                 f'{self._process.returncode} before finishing the bag'
             )
@@ -209,7 +205,7 @@ class BagWriterProcess:
     def _send_queued(self) -> None:
         self._read_replies()
         if self._failure is not None:
-            raise BagWriteError(self._failure)
+            raise BagError(self._failure)
         batch, self._queued = self._queued, bytearray()
         self._queued_count = 0
         self._batch_started = time.monotonic()
@@ -223,7 +219,7 @@ class BagWriterProcess:
         except BrokenPipeError:
             self._failure = (f"the bag writer of {getattr(self, 'bag_path', 'the log')} "
                              f'ended unexpectedly (status {self._process.wait()})')
-            raise BagWriteError(self._failure) from None
+            raise BagError(self._failure) from None
 
     def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
         """Send a frame and waits for the child's answer to it."""
@@ -232,12 +228,12 @@ class BagWriterProcess:
         line = self._process.stdout.readline()
         os.set_blocking(self._process.stdout.fileno(), False)
         if not line:
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer ended with status {self._process.wait()} before answering'
             )
         reply = json.loads(line)
         if 'error' in reply:
-            raise BagWriteError(reply['error'])
+            raise BagError(reply['error'])
         return reply
 
     def _read_replies(self) -> None:
@@ -269,7 +265,7 @@ def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        raise BagWriteError(
+        raise BagError(
             f'cannot create log folder {folder}: {error.strerror or error}'
         ) from None
     base_name = time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
@@ -280,8 +276,8 @@ def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
             return BagWriter(folder / name, metadata=metadata)
         except BagExistsError:
             suffix += 1
-        except BagWriteError as error:
-            raise BagWriteError(f'cannot log into folder {folder}: {error}') from None
+        except BagError as error:
+            raise BagError(f'cannot log into folder {folder}: {error}') from None
 
 
 class _Child:
@@ -325,7 +321,7 @@ class _Child:
     def _start(self, request: dict[str, Any]) -> None:
         try:
             self._writer = _open_bag(Path(request['folder']), request['metadata'])
-        except BagWriteError as error:
+        except BagError as error:
             self._reply(error=str(error))
             return
         self._reply(bag=str(self._writer.bag_path), size=self._writer.size_bytes)
@@ -336,7 +332,7 @@ class _Child:
                 request['topic'], request['type_name'], request['message_definition'],
                 request['offered_qos_profiles'],
             )
-        except (BagWriteError, ValueError) as error:
+        except (BagError, ValueError) as error:
             self._reply(error=str(error))
             return
         self._reply(channel=channel)
@@ -353,7 +349,7 @@ class _Child:
                 offset += _MESSAGE.size
                 write(channel_id, batch[offset:offset + length], log_time_ns, publish_time_ns)
                 offset += length
-        except BagWriteError as error:
+        except BagError as error:
             self._failed = True
             self._reply(error=str(error))
             return
@@ -368,7 +364,7 @@ class _Child:
         if not self._failed:
             try:
                 self._writer.flush()
-            except BagWriteError as error:
+            except BagError as error:
                 self._failed = True
                 self._reply(error=str(error))
         self._reply(size=self._writer.finished_size(), flushed=True)
@@ -378,7 +374,7 @@ class _Child:
             return
         try:
             self._writer.close()
-        except BagWriteError as error:
+        except BagError as error:
             self._reply(error=str(error), in_close=True)
         self._reply(closed=True, size=self._writer.size_bytes)
 

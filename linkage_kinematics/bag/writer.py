@@ -22,18 +22,21 @@ This module is plain Python (no rclpy): bytes in, files out.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
-import functools
-from importlib import metadata as distribution_metadata
-import json
 import os
 from pathlib import Path
-import shutil
 import time
-from typing import Any
 
-from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
-from linkage_kinematics import bag_reader
+from linkage_kinematics.bag.definitions import SCHEMA_ENCODING, type_description_hash
+from linkage_kinematics.bag.errors import BagError, BagExistsError
+from linkage_kinematics.bag.metadata import (
+    BagMetadata,
+    FileInfo,
+    MESSAGE_ENCODING,
+    METADATA_FILE,
+    PACKAGE_NAME,
+    package_version,
+    TopicInfo,
+)
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import (
@@ -51,26 +54,16 @@ from mcap.records import (
 from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, MCAP0_MAGIC, Writer
 import yaml
 
-PACKAGE_NAME = 'linkage_kinematics'
 METADATA_RECORD_NAME = PACKAGE_NAME
 ROSBAG2_METADATA_RECORD_NAME = 'rosbag2'
-ROSBAG2_METADATA_VERSION = 9
-ROS_DISTRO = 'jazzy'
 PROFILE = 'ros2'
-SCHEMA_ENCODING = 'ros2msg'
-MESSAGE_ENCODING = 'cdr'
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 # Messages queued before they go into the MCAP chunk together (see BagWriter._add_queued): at
 # 5 kHz, 16 messages are 8 ticks, and adding them takes well under one tick's period.
 WRITE_BATCH = 16
-DEFINITION_SEPARATOR = '=' * 80
 _COMPRESSION = {
     'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4, 'none': CompressionType.NONE
 }
-_PRIMITIVE_TYPES = frozenset(
-    'bool byte char float32 float64 int8 uint8 int16 uint16 int32 uint32 int64 uint64 '
-    'string wstring'.split()
-)
 
 
 def _record_size(record: McapRecord) -> int:
@@ -78,141 +71,6 @@ def _record_size(record: McapRecord) -> int:
     builder = RecordBuilder()
     record.write(builder)
     return builder.count
-
-
-def package_version() -> str:
-    try:
-        return distribution_metadata.version(PACKAGE_NAME)
-    except distribution_metadata.PackageNotFoundError:
-        return 'unknown'
-
-
-class BagWriteError(OSError):
-    """A bag cannot be created, written or recovered; the message names the file and the cause."""
-
-
-class BagExistsError(BagWriteError, FileExistsError):
-    """The bag folder to create already exists (nothing in it is touched)."""
-
-
-class MessageDefinitionError(LookupError):
-    """A message type's .msg file (or one it depends on) is not installed."""
-
-
-def _interface_file(package: str, name: str, suffix: str) -> Path | None:
-    """
-    Return the installed ``<package>/msg/<name><suffix>``.
-
-    From the package in the ament index, or where that package is not installed, from the copies
-    this package ships of the types it logs without publishing them (tf2_msgs, which has no
-    package on PyPI; see interfaces/README.md).
-    """
-    try:
-        share = Path(get_package_share_directory(package))
-    except PackageNotFoundError:
-        try:
-            share = Path(get_package_share_directory(PACKAGE_NAME)) / 'interfaces' / package
-        except PackageNotFoundError:
-            return None
-    candidate = share / 'msg' / f'{name}{suffix}'
-    return candidate if candidate.is_file() else None
-
-
-def _split_type_name(type_name: str) -> tuple[str, str]:
-    parts = type_name.split('/')
-    if len(parts) == 3 and parts[1] == 'msg':
-        return parts[0], parts[2]
-    if len(parts) == 2:
-        return parts[0], parts[1]
-    raise MessageDefinitionError(
-        f'message type {type_name!r} is not of the form package/msg/Name or package/Name'
-    )
-
-
-def _field_base_type(line: str) -> str | None:
-    """
-    Return the type a field (or constant) line refers to.
-
-    It is ``pkg/Name``, ``Name`` or a primitive.
-    """
-    code = line.split('#', 1)[0].strip()
-    if not code:
-        return None
-    return code.split()[0].split('[', 1)[0].split('<=', 1)[0]
-
-
-@functools.cache
-def message_definition(type_name: str) -> str:
-    """
-    Return the full ros2msg schema text of ``type_name`` (``pkg/msg/Name``) as rosbag2 stores it.
-
-    The root .msg text comes first, then each dependency once, behind an 80-'=' line and a
-    ``MSG: pkg/Name`` line. A dependency is named exactly as the referencing field spells it
-    (``std_msgs/Header``, not ``std_msgs/msg/Header``), with the package of the referencing
-    file added to bare names: Foxglove resolves field types against these names.
-    """
-    package, name = _split_type_name(type_name)
-    root = _read_msg(package, name)
-    sections = [root.rstrip('\n')]
-    seen: set[str] = set()
-    pending = _dependencies(package, root)
-    while pending:
-        dependency = pending.pop(0)
-        if dependency in seen:
-            continue
-        seen.add(dependency)
-        dep_package, dep_name = dependency.split('/')
-        text = _read_msg(dep_package, dep_name)
-        sections.append(f'{DEFINITION_SEPARATOR}\nMSG: {dependency}\n{text.rstrip(chr(10))}')
-        pending += _dependencies(dep_package, text)
-    return '\n'.join(sections) + '\n'
-
-
-def _read_msg(package: str, name: str) -> str:
-    path = _interface_file(package, name, '.msg')
-    if path is None:
-        raise MessageDefinitionError(
-            f'no {package}/msg/{name}.msg in the ament index (AMENT_PREFIX_PATH): '
-            'is the message package installed and the environment sourced?'
-        )
-    return path.read_text(encoding='utf-8')
-
-
-def _dependencies(package: str, text: str) -> list[str]:
-    found = []
-    for line in text.splitlines():
-        base = _field_base_type(line)
-        if base is None or base in _PRIMITIVE_TYPES:
-            continue
-        found.append(base if '/' in base else f'{package}/{base}')
-    return found
-
-
-@functools.cache
-def type_description_hash(type_name: str) -> str:
-    """
-    Return the RIHS01 type hash rosidl generated for ``type_name``.
-
-    '' if it is not installed.
-    """
-    package, name = _split_type_name(type_name)
-    path = _interface_file(package, name, '.json')
-    if path is None:
-        return ''
-    full_name = f'{package}/msg/{name}'
-    for entry in json.loads(path.read_text(encoding='utf-8')).get('type_hashes', []):
-        if entry.get('type_name') == full_name:
-            return str(entry.get('hash_string', ''))
-    return ''
-
-
-@dataclass
-class _Topic:
-    name: str
-    type_name: str
-    offered_qos_profiles: str
-    type_hash: str
-    message_count: int = 0
 
 
 class BagWriter:
@@ -244,10 +102,10 @@ class BagWriter:
             raise ValueError('chunk_size and flush_interval must be positive')
         self.bag_path = Path(bag_path)
         self.mcap_path = self.bag_path / f'{self.bag_path.name}_0.mcap'
-        self.metadata_path = self.bag_path / 'metadata.yaml'
+        self.metadata_path = self.bag_path / METADATA_FILE
         self.custom_data = {'package_version': package_version(), **dict(metadata)}
         self._flush_interval = flush_interval
-        self._topics: dict[int, _Topic] = {}
+        self._topics: dict[int, TopicInfo] = {}
         self._schema_ids: dict[str, int] = {}
         self._pending_counts: dict[int, int] = {}
         self._queued: list[tuple[int, int, bytes, int]] = []
@@ -262,7 +120,7 @@ class BagWriter:
         # written so far (each gets a chunk index in the summary).
         self._registered_size = 0
         self._chunk_count = 0
-        self._failure: BagWriteError | None = None
+        self._failure: BagError | None = None
         self._closed = False
         try:
             self.bag_path.mkdir()
@@ -271,7 +129,7 @@ class BagWriter:
                 f'bag folder {self.bag_path} already exists; refusing to overwrite it'
             ) from None
         except OSError as error:
-            raise BagWriteError(
+            raise BagError(
                 f'cannot create bag folder {self.bag_path}: {error.strerror}'
             ) from None
         try:
@@ -287,7 +145,7 @@ class BagWriter:
             self._durable_size = self._file.tell()
             self._write_metadata_yaml()
         except OSError as error:
-            raise BagWriteError(f'cannot write bag {self.mcap_path}: {error.strerror}') from None
+            raise BagError(f'cannot write bag {self.mcap_path}: {error.strerror}') from None
 
     @property
     def size_bytes(self) -> int:
@@ -327,7 +185,9 @@ class BagWriter:
                 metadata=channel_metadata, schema_id=schema_id))
         except OSError as error:
             raise self._fail(error) from None
-        self._topics[channel_id] = _Topic(topic, type_name, offered_qos_profiles, type_hash)
+        self._topics[channel_id] = TopicInfo(
+            topic, type_name, yaml.safe_load(offered_qos_profiles) or [], type_hash
+        )
         try:
             self._write_metadata_yaml()
         except OSError as error:
@@ -335,7 +195,7 @@ class BagWriter:
         return channel_id
 
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
-        """Append one serialized (CDR) message; raises BagWriteError if the disk refuses it."""
+        """Append one serialized (CDR) message; raises BagError if the disk refuses it."""
         self._check_writable()
         if channel_id not in self._topics:
             raise ValueError(f'unknown channel id {channel_id} in bag {self.bag_path}')
@@ -396,11 +256,10 @@ class BagWriter:
         """
         if self._failure is not None or self._closed:
             return self._durable_size
-        information = yaml.safe_dump(self._bag_information(), sort_keys=False)
         channel_counts = {channel_id: 0 for channel_id in self._topics}
         tail = [
             Metadata(name=ROSBAG2_METADATA_RECORD_NAME,
-                     metadata={'serialized_metadata': information}),
+                     metadata={'serialized_metadata': self._bag_metadata().serialized()}),
             DataEnd(data_section_crc=0),
             Statistics(attachment_count=0, channel_count=len(self._topics),
                        channel_message_counts=channel_counts, chunk_count=0, message_count=0,
@@ -425,7 +284,7 @@ class BagWriter:
 
         After a write failure the file is left as it was after the last successful flush
         (readable without summary, see ``recover_bag``) and metadata.yaml gets those counts;
-        a failure during close itself is raised (as BagWriteError) after that.
+        a failure during close itself is raised (as BagError) after that.
         """
         if self._closed:
             return
@@ -433,21 +292,21 @@ class BagWriter:
         if self._failure is None:
             try:
                 self.flush()
-                serialized = yaml.safe_dump(self._bag_information(), sort_keys=False)
                 self._writer.add_metadata(
-                    ROSBAG2_METADATA_RECORD_NAME, {'serialized_metadata': serialized}
+                    ROSBAG2_METADATA_RECORD_NAME,
+                    {'serialized_metadata': self._bag_metadata().serialized()},
                 )
                 self._writer.finish()
                 self._file.close()
                 self._durable_size = self.mcap_path.stat().st_size
             except OSError as error:
-                failure_in_close = error if isinstance(error, BagWriteError) else self._fail(error)
+                failure_in_close = error if isinstance(error, BagError) else self._fail(error)
         self._closed = True
         try:
             self._write_metadata_yaml()
         except OSError as error:
             if failure_in_close is None and self._failure is None:
-                failure_in_close = BagWriteError(
+                failure_in_close = BagError(
                     f'cannot write {self.metadata_path}: {error.strerror or error}'
                 )
         if failure_in_close is not None:
@@ -455,15 +314,15 @@ class BagWriter:
 
     def _check_writable(self) -> None:
         if self._closed:
-            raise BagWriteError(f'bag {self.bag_path} is closed')
+            raise BagError(f'bag {self.bag_path} is closed')
         if self._failure is not None:
-            raise BagWriteError(
+            raise BagError(
                 f'bag {self.mcap_path} stopped at an earlier error: {self._failure}'
             )
 
-    def _fail(self, error: OSError) -> BagWriteError:
+    def _fail(self, error: OSError) -> BagError:
         """Cuts the file back to its last complete flush so what was written stays readable."""
-        self._failure = BagWriteError(
+        self._failure = BagError(
             f'writing bag {self.mcap_path} failed ({error.strerror or error}); '
             f'the file keeps the {self._durable_size} bytes flushed before'
         )
@@ -489,118 +348,19 @@ class BagWriter:
             self._end_time_ns = max(self._end_time_ns, self._pending_end_ns)
             self._pending_start_ns = None
 
-    def _bag_information(self) -> dict[str, Any]:
+    def _bag_metadata(self) -> BagMetadata:
         start = self._start_time_ns or 0
         duration = max(0, self._end_time_ns - start) if self._start_time_ns is not None else 0
         count = sum(topic.message_count for topic in self._topics.values())
-        return {
-            'version': ROSBAG2_METADATA_VERSION,
-            'storage_identifier': 'mcap',
-            'duration': {'nanoseconds': duration},
-            'starting_time': {'nanoseconds_since_epoch': start},
-            'message_count': count,
-            'topics_with_message_count': [
-                {
-                    'topic_metadata': {
-                        'name': topic.name,
-                        'type': topic.type_name,
-                        'serialization_format': MESSAGE_ENCODING,
-                        # metadata version 9 stores the profiles as a YAML list, not as text
-                        'offered_qos_profiles': yaml.safe_load(topic.offered_qos_profiles) or [],
-                        'type_description_hash': topic.type_hash,
-                    },
-                    'message_count': topic.message_count,
-                }
-                for topic in self._topics.values()
-            ],
-            'compression_format': '',
-            'compression_mode': '',
-            'relative_file_paths': [self.mcap_path.name],
-            'files': [
-                {
-                    'path': self.mcap_path.name,
-                    'starting_time': {'nanoseconds_since_epoch': start},
-                    'duration': {'nanoseconds': duration},
-                    'message_count': count,
-                }
-            ],
-            'custom_data': dict(self.custom_data),
-            'ros_distro': ROS_DISTRO,
-        }
+        return BagMetadata(
+            relative_file_paths=[self.mcap_path.name],
+            topics=list(self._topics.values()),
+            files=[FileInfo(self.mcap_path.name, start, duration, count)],
+            custom_data=dict(self.custom_data),
+            starting_time_ns=start,
+            duration_ns=duration,
+            message_count=count,
+        )
 
     def _write_metadata_yaml(self) -> None:
-        text = yaml.safe_dump(
-            {'rosbag2_bagfile_information': self._bag_information()}, sort_keys=False
-        )
-        temporary = self.metadata_path.with_name(self.metadata_path.name + '.tmp')
-        temporary.write_text(text, encoding='utf-8')
-        os.replace(temporary, self.metadata_path)
-
-
-@dataclass(frozen=True)
-class RecoveryResult:
-    mcap_path: Path
-    message_count: int
-    was_truncated: bool
-
-
-def recover_bag(bag_path: Path | str) -> RecoveryResult:
-    """
-    Rewrites a bag's MCAP file with summary, indexes and true counts (e.g. after SIGKILL).
-
-    Every message of every complete record is kept with its topic and times; a partly written
-    last chunk is dropped. Topics, types, QoS and the run's metadata come from the bag's
-    metadata.yaml (written when the run started), schemas from the installed .msg files.
-    On a complete bag it rewrites the same content.
-    """
-    bag = Path(bag_path)
-    if not (bag / 'metadata.yaml').is_file():
-        raise BagWriteError(f'{bag} is not a bag folder (no metadata.yaml)')
-    files = bag_reader.bag_files(bag)
-    if len(files) != 1:
-        raise BagWriteError(f'bag {bag} has {len(files)} files; only one-file bags are recovered')
-    source = files[0].path
-    information = yaml.safe_load((bag / 'metadata.yaml').read_text(encoding='utf-8'))[
-        'rosbag2_bagfile_information'
-    ]
-    topics = {
-        entry['topic_metadata']['name']: entry['topic_metadata']
-        for entry in information['topics_with_message_count']
-    }
-    work = bag.parent / f'.{bag.name}.recovering'
-    shutil.rmtree(work, ignore_errors=True)  # left over from an interrupted recovery
-    work.mkdir()
-    try:
-        writer = BagWriter(
-            work / source.stem.removesuffix('_0'), metadata=information.get('custom_data') or {}
-        )
-        channel_ids: dict[str, int] = {}
-        count = 0
-        for message in bag_reader.iter_messages(bag):
-            if message.topic not in channel_ids:
-                topic = topics.get(message.topic)
-                if topic is None:
-                    raise BagWriteError(
-                        f'{source} has messages on {message.topic}, which {bag}/metadata.yaml '
-                        'does not list'
-                    )
-                channel_ids[message.topic] = writer.add_topic(
-                    message.topic,
-                    topic['type'],
-                    message_definition(topic['type']),
-                    yaml.safe_dump(topic['offered_qos_profiles'], sort_keys=False),
-                )
-            writer.write(
-                channel_ids[message.topic],
-                message.data,
-                message.log_time_ns,
-                message.publish_time_ns,
-            )
-            count += 1
-        writer.close()
-        os.replace(writer.mcap_path, source)
-        os.replace(writer.metadata_path, bag / 'metadata.yaml')
-        writer.bag_path.rmdir()
-    finally:
-        shutil.rmtree(work, ignore_errors=True)
-    return RecoveryResult(source, count, files[0].truncated)
+        self._bag_metadata().write(self.bag_path)
