@@ -18,7 +18,7 @@ import collections
 import math
 
 from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
-from linkage_kinematics.parameters import RunConfiguration
+from linkage_kinematics.parameters import MotionMode, RunConfiguration
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
 RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured
@@ -91,13 +91,13 @@ def key_values(
     ``log_file`` None means logging is disabled; ``log_size`` is the bag's size in bytes.
     """
     values = {
-        'end behavior': config.end_behavior,
-        'mode': config.mode,
+        'end behavior': config.end_behavior.value,
+        'mode': config.mode.value,
         'achieved rate (Hz)': f'{achieved_rate:.1f}',
     }
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
-    if config.mode == 'real_time':
+    if config.mode == MotionMode.REAL_TIME:
         values['rate_hz'] = f'{config.rate_hz:g}'
     else:
         values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'

@@ -43,6 +43,8 @@ from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
     describe_value,
+    EndBehavior,
+    MotionMode,
     NO_CPU_AFFINITY,
     NODE_NAME,
     PARAMETER_NAMES,
@@ -457,7 +459,7 @@ class LinkageNode(Node):
         In fixed_step mode the timer is re-armed for each step's time, and this first period only
         starts it.
         """
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             return 1.0 / self.config.rate_hz
         return 1e-3
 
@@ -481,7 +483,7 @@ class LinkageNode(Node):
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
             self._motion_start = now
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             self._advance_in_real_time(now)
         else:
             self._advance_steps(now)
@@ -535,7 +537,7 @@ class LinkageNode(Node):
         try:
             state = solve_sample(config, sample)
         except (DeadPointError, UnreachableError) as error:
-            if config.end_behavior == 'stop':
+            if config.end_behavior == EndBehavior.STOP:
                 self._cannot_go_on(str(error))
             # loop and bounce turn round at the dead point itself, which has no state to show.
             return
