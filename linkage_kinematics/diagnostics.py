@@ -90,11 +90,27 @@ def key_values(
 
     ``log_file`` None means logging is disabled; ``log_size`` is the bag's size in bytes.
     """
-    values = {
-        'end behavior': config.end_behavior.value,
-        'mode': config.mode.value,
-        'achieved rate (Hz)': f'{achieved_rate:.1f}',
-    }
+    # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
+    # the values that change at the top.
+    values = {}
+    if state is not None:
+        reachability = config.linkage.reachability
+        distance = reachability.dead_point_distance(state.alpha)
+        change_distance = reachability.change_point_distance(state.alpha)
+        residual = float(loop_closure_residual(config.linkage, state))
+        values.update({
+            'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
+            'alpha (rad)': repr(state.alpha),
+            'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
+            'dead point distance (deg)': (
+                'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
+            ),
+            'change point distance (deg)': (
+                'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
+            ),
+            'loop closure residual': f'{residual:.2e}',
+        })
+    values['achieved rate (Hz)'] = f'{achieved_rate:.1f}'
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
     if config.mode == MotionMode.REAL_TIME:
@@ -102,24 +118,9 @@ def key_values(
     else:
         values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'
     values['missed deadlines'] = str(int(missed_deadlines))
-    if state is not None:
-        reachability = config.linkage.reachability
-        distance = reachability.dead_point_distance(state.alpha)
-        change_distance = reachability.change_point_distance(state.alpha)
-        residual = float(loop_closure_residual(config.linkage, state))
-        values.update({
-            'alpha (rad)': repr(state.alpha),
-            'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
-            'dead point distance (deg)': (
-                'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
-            ),
-            'change point distance (deg)': (
-                'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
-            ),
-            'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
-            'loop closure residual': f'{residual:.2e}',
-        })
-    values['log file'] = LOG_DISABLED if log_file is None else log_file
     if log_file is not None and log_size is not None:
         values['log size (bytes)'] = str(int(log_size))
+    values['log file'] = LOG_DISABLED if log_file is None else log_file
+    values['mode'] = config.mode.value
+    values['end behavior'] = config.end_behavior.value
     return values

@@ -41,8 +41,9 @@ ALPHA_PATH = '/linkage/state.points[0].positions[0]'
 # state's stamp. Lichtblick's Plot takes every message of the x axis's topic for x values only,
 # so x must come from another topic than the plotted y values (docs/logging.md).
 X_ALPHA_PATH = '/joint_states.position[0]'
-# The 3D panel's width per height in the layout on a 16:10 screen (42 % of the width, 55 % of
-# the height less the toolbars); wider panels see more.
+# The least width per height of the 3D panel the framing is checked for: the layout's is about
+# 2 on a 16:10 screen (42 % of the width, 40 % of the height less the toolbars), and wider
+# panels see more.
 SCENE_ASPECT = 1.2
 # A message path without filters, slices or math modifiers: a topic, then fields with at most
 # one constant index each, e.g. /linkage/state.points[0].velocities[7].
@@ -325,7 +326,7 @@ def test_custom_x_and_y_come_from_other_topics_with_equal_counts_and_stamps(
     Pair x and y values by index (Lichtblick's and Foxglove's custom x axis).
 
     So each plotted y stream and its x stream have one message per state with the same stamps;
-    and x comes from another topic than y, since Lichtblick reads the x topic's messages for x only.
+    and x comes from another topic than y: Lichtblick reads the x topic's messages for x only.
     """
     custom = [config for config in plots(load_layout()).values() if config['xAxisVal'] == 'custom']
     assert len(custom) == 4
