@@ -75,10 +75,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             state = (
                 'was cut short; its complete part' if result.was_truncated else 'was complete; it'
             )
-            print(
-                f'linkage-replay: {bag} {state} is now {result.mcap_path} '
-                f'with summary ({result.message_count} messages)'
-            )
+            paths = ', '.join(str(path) for path in result.mcap_paths)
+            print(f'linkage-replay: {bag} {state} is now {paths} '
+                  f'with summary ({result.message_count} messages)')
             return 0
         files = reader.bag_files(bag)
         cut = [str(file.path) for file in files if file.truncated]

@@ -38,7 +38,6 @@ from linkage_kinematics.bag.errors import BagExistsError
 from linkage_kinematics.bag.metadata import (
     offered_qos_profiles_for,
     package_version,
-    qos_profiles_yaml,
 )
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
@@ -463,7 +462,7 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
         '/chatter',
         'std_msgs/msg/String',
         message_definition('std_msgs/msg/String'),
-        qos_profiles_yaml(offered_qos_profiles_for(QoSProfile(depth=7))),
+        offered_qos_profiles_for(QoSProfile(depth=7)),
     )
     payload = encode_cdr(String(data='hello'))
     writer.write(channel, payload, 1_000, 1_000)
@@ -511,7 +510,7 @@ def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: i
     writer = BagWriter(tmp_path / 'queued', metadata={}, flush_interval=3600.0)
     channels = [
         writer.add_topic(topic, 'std_msgs/msg/String', message_definition('std_msgs/msg/String'),
-                         qos_profiles_yaml(offered_qos_profiles_for(QoSProfile(depth=10))))
+                         offered_qos_profiles_for(QoSProfile(depth=10)))
         for topic in ('/a', '/b')
     ]
     written = [(('/a', '/b')[index % 2], encode_cdr(String(data=f'm{index}')), 1_000 + index)
@@ -836,7 +835,7 @@ def test_replay_rejects_bad_input_with_a_clear_message(
 
     foreign = tmp_path / 'foreign'
     writer = BagWriter(foreign, metadata={})
-    channel = writer.add_topic('/thing', 'foreign_msgs/msg/Thing', 'int32 x\n', '')
+    channel = writer.add_topic('/thing', 'foreign_msgs/msg/Thing', 'int32 x\n', [])
     writer.write(channel, b'\x00\x01\x00\x00\x05\x00\x00\x00', 1, 1)
     writer.close()
     assert replay_main([str(foreign)]) == 1

@@ -92,6 +92,8 @@ ACCEPTED = {
     'diagnostics.dead_point_warning': {'zero'},
     'log.enabled': set(),
     'log.folder': set(),
+    'log.max_bag_size': {'zero', 'huge'},    # 0 never splits; else at least 1024 bytes
+    'log.max_bag_duration': {'zero'},        # 0 never splits; at most 1e9 s
     'cpu_affinity': {'zero', 'negative'},    # CPU 0; −1 is no pinning; at most 1023
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
@@ -108,6 +110,8 @@ CONFIGURED = {
     'diagnostics.min_transmission_angle': lambda config: config.min_transmission_angle,
     'diagnostics.dead_point_warning': lambda config: config.dead_point_warning,
     'cpu_affinity': lambda config: config.cpu_affinity,
+    'log.max_bag_size': lambda config: config.log_max_bag_size,
+    'log.max_bag_duration': lambda config: config.log_max_bag_duration,
 }
 
 

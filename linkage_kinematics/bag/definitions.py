@@ -44,6 +44,11 @@ def _interface_file(package: str, name: str, suffix: str) -> Path | None:
             share = Path(get_package_share_directory(PACKAGE_NAME)) / 'interfaces' / package
         except PackageNotFoundError:
             return None
+    except OSError as error:  # ament_index_python's EnvironmentError: no ament index at all
+        raise MessageDefinitionError(
+            f'cannot look up {package}/msg/{name}{suffix}: {error} (source the ROS 2 setup '
+            'file, e.g. /opt/ros/jazzy/setup.bash, or a colcon install/setup.bash)'
+        ) from None
     candidate = share / 'msg' / f'{name}{suffix}'
     return candidate if candidate.is_file() else None
 

@@ -21,5 +21,9 @@ class BagExistsError(BagError, FileExistsError):
     """The bag folder to create already exists (nothing in it is touched)."""
 
 
+class LogFolderError(BagError):
+    """The folder the bags go into cannot be created or written."""
+
+
 class MessageDefinitionError(BagError):
     """A message type's .msg file (or one it uses) cannot be found in the ament index."""

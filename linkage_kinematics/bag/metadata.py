@@ -35,6 +35,7 @@ _TOP_KEY = 'rosbag2_bagfile_information'
 # offers them.
 TRANSIENT_LOCAL_TOPICS = frozenset({'/robot_description'})
 DEFAULT_DEPTH = 10
+TRANSIENT_LOCAL = 'transient_local'  # rosbag2's name of the latching durability
 
 
 def package_version() -> str:
@@ -80,7 +81,7 @@ def qos_profile(topic: str, offered: dict[str, Any] | None) -> Any:
 
     offered = offered or {}
     durability = offered.get('durability') or (
-        'transient_local' if topic in TRANSIENT_LOCAL_TOPICS else 'volatile'
+        TRANSIENT_LOCAL if topic in TRANSIENT_LOCAL_TOPICS else 'volatile'
     )
     return QoSProfile(
         history=_policy(HistoryPolicy, offered.get('history', 'keep_last')),

@@ -17,7 +17,7 @@ metadata.yaml, then exits. It runs in a session of its own, so a Ctrl-C meant fo
 (SIGINT to the terminal's process group) does not end it first.
 
 Frames on the child's stdin: one kind byte, a uint32 length, the payload. ``S`` (JSON:
-folder, metadata) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
+folder, metadata, split) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
 (JSON) adds a topic; ``M`` holds messages, each a ``<HqqI`` header (channel id, log time,
 publish time, length) and its bytes; ``F`` (empty) asks the child to write out everything it
 holds. The child answers on stdout with JSON lines: ``bag`` or ``channel`` for S and T,
@@ -39,8 +39,8 @@ import sys
 import time
 from typing import Any, BinaryIO
 
-from linkage_kinematics.bag.errors import BagError, BagExistsError
-from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
+from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
+from linkage_kinematics.bag.writer import BagWriter, NO_SPLIT, WRITE_BATCH
 
 _FRAME = struct.Struct('<cI')
 _MESSAGE = struct.Struct('<HqqI')
@@ -79,11 +79,13 @@ class BagWriterProcess:
 
     Errors of the child's writer come back as BagError from the next ``write`` (or
     ``close``) after the child reported them. ``cpus``, if given, are the CPUs the child may
-    run on (the node's ``cpu_affinity`` keeps it off the node's CPU).
+    run on (the node's ``cpu_affinity`` keeps it off the node's CPU); ``max_bag_size`` and
+    ``max_bag_duration_ns`` split the bag as ``BagWriter``'s do.
     """
 
     def __init__(
-        self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None
+        self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None,
+        max_bag_size: int = NO_SPLIT, max_bag_duration_ns: int = NO_SPLIT,
     ) -> None:
         self._process = subprocess.Popen(
             [sys.executable, '-m', __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -100,7 +102,12 @@ class BagWriterProcess:
         self._closed = False
         self.size_bytes = 0
         try:
-            reply = self._request(START, {'folder': str(folder), 'metadata': dict(metadata)})
+            # The child's one answer to START that is an error is about the folder.
+            reply = self._request(START, {
+                'folder': str(folder), 'metadata': dict(metadata),
+                'split': {'max_bag_size': max_bag_size,
+                          'max_bag_duration_ns': max_bag_duration_ns},
+            }, LogFolderError)
         except BagError:
             self._process.stdin.close()
             self._process.wait(timeout=CLOSE_TIMEOUT)
@@ -109,12 +116,13 @@ class BagWriterProcess:
         self.size_bytes = reply['size']
 
     def add_topic(
-        self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str
+        self, topic: str, type_name: str, message_definition: str,
+        offered_qos_profiles: list[dict[str, Any]], repeat_latest: bool = False,
     ) -> int:
         """``BagWriter.add_topic`` in the child; its channel id."""
         reply = self._request(TOPIC, {
             'topic': topic, 'type_name': type_name, 'message_definition': message_definition,
-            'offered_qos_profiles': offered_qos_profiles,
+            'offered_qos_profiles': offered_qos_profiles, 'repeat_latest': repeat_latest,
         })
         return int(reply['channel'])
 
@@ -221,8 +229,10 @@ class BagWriterProcess:
                              f'ended unexpectedly (status {self._process.wait()})')
             raise BagError(self._failure) from None
 
-    def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
-        """Send a frame and waits for the child's answer to it."""
+    def _request(
+        self, kind: bytes, payload: dict[str, Any], error_kind: type[BagError] = BagError
+    ) -> dict[str, Any]:
+        """Send a frame and wait for the child's answer to it (an error as ``error_kind``)."""
         self._send(kind, json.dumps(payload).encode('utf-8'))
         os.set_blocking(self._process.stdout.fileno(), True)
         line = self._process.stdout.readline()
@@ -233,7 +243,7 @@ class BagWriterProcess:
             )
         reply = json.loads(line)
         if 'error' in reply:
-            raise BagError(reply['error'])
+            raise error_kind(reply['error'])
         return reply
 
     def _read_replies(self) -> None:
@@ -260,7 +270,7 @@ class BagWriterProcess:
 # --- the child ------------------------------------------------------------------------------
 
 
-def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
+def _open_bag(folder: Path, metadata: dict[str, str], split: dict[str, int]) -> BagWriter:
     """Return a new bag folder in ``folder``, named as ``ros2 bag record`` names it."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
@@ -273,7 +283,7 @@ def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
     while True:
         name = base_name if suffix == 0 else f'{base_name}_{suffix}'
         try:
-            return BagWriter(folder / name, metadata=metadata)
+            return BagWriter(folder / name, metadata=metadata, **split)
         except BagExistsError:
             suffix += 1
         except BagError as error:
@@ -320,7 +330,8 @@ class _Child:
 
     def _start(self, request: dict[str, Any]) -> None:
         try:
-            self._writer = _open_bag(Path(request['folder']), request['metadata'])
+            self._writer = _open_bag(
+                Path(request['folder']), request['metadata'], request['split'])
         except BagError as error:
             self._reply(error=str(error))
             return
@@ -330,7 +341,7 @@ class _Child:
         try:
             channel = self._writer.add_topic(
                 request['topic'], request['type_name'], request['message_definition'],
-                request['offered_qos_profiles'],
+                request['offered_qos_profiles'], request['repeat_latest'],
             )
         except (BagError, ValueError) as error:
             self._reply(error=str(error))
