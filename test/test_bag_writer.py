@@ -535,7 +535,7 @@ def test_finished_size_is_the_size_of_the_bag_closed_then(tmp_path: Path, flushe
     writer = BagWriter(tmp_path / 'sized', metadata={'run': 'x'}, flush_interval=3600.0)
     channels = [
         writer.add_topic(topic, type_name, message_definition(type_name),
-                         qos_profiles_yaml(offered_qos_profiles_for(QoSProfile(depth=10))))
+                         offered_qos_profiles_for(QoSProfile(depth=10)))
         for topic, type_name in (('/a', 'std_msgs/msg/String'),
                                  ('/tf', 'tf2_msgs/msg/TFMessage'))
     ]
