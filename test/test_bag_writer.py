@@ -31,7 +31,7 @@ from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from linkage_kinematics import messages, scene
-from linkage_kinematics.bag import reader as bag_reader
+from linkage_kinematics.bag import player, reader as bag_reader
 from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
 from linkage_kinematics.bag.definitions import DEFINITION_SEPARATOR, message_definition
 from linkage_kinematics.bag.errors import BagExistsError
@@ -814,6 +814,22 @@ def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path
     assert 'Traceback' not in output_text and 'published' in output_text
     alphas = [message.points[0].positions[0] for message in listener.received['/linkage/state']]
     assert alphas.count(alphas[0]) >= 2  # the run started over
+
+
+def test_replay_leaves_out_excluded_topics_such_as_the_bags_tf(
+    node_run: dict[str, Any], capsys: pytest.CaptureFixture[str],
+) -> None:
+    bag = node_run['bag']
+    everything = player.plan_topics(bag, None)
+    # tf2_msgs is not installed here: its topics are skipped, with a warning
+    assert {plan.topic for plan in everything} == set(NODE_TOPICS)
+    assert 'skipping /tf' in capsys.readouterr().err
+    # beside a robot_state_publisher the bag's TF is left out, and nothing is said about it
+    without_tf = player.plan_topics(bag, None, ['/tf', '/tf_static'])
+    assert [plan.topic for plan in without_tf] == [plan.topic for plan in everything]
+    assert capsys.readouterr().err == ''
+    only_states = player.plan_topics(bag, ['/linkage/state', '/joint_states'], ['/joint_states'])
+    assert [plan.topic for plan in only_states] == ['/linkage/state']
 
 
 def test_replay_rejects_bad_input_with_a_clear_message(
