@@ -23,6 +23,7 @@ from linkage_kinematics.parameters import MotionMode, RunConfiguration
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
 RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured
 LOG_DISABLED = 'disabled'
+NOT_MEASURED = 'not measured yet'
 
 
 class StatusSchedule:
@@ -53,23 +54,25 @@ class StatusSchedule:
 
 
 class RateMeter:
-    """Ticks per second over the last RATE_WINDOW, measured at each status."""
+    """Ticks per second over the last RATE_WINDOW, measured at each status (None before)."""
 
     def __init__(self) -> None:
-        self.rate = 0.0
+        self.rate: float | None = None
         self._ticks = 0
         self._samples: collections.deque[tuple[int, int]] = collections.deque()
 
     def tick(self) -> None:
         self._ticks += 1
 
-    def update(self, now_ns: int) -> float:
-        """Return the rate over the samples of the last RATE_WINDOW before ``now_ns``."""
+    def update(self, now_ns: int) -> float | None:
+        """Return the rate since the latest status at least RATE_WINDOW before ``now_ns``."""
         samples = self._samples
         if samples and now_ns < samples[-1][0]:
             samples.clear()  # the clock went back
         samples.append((now_ns, self._ticks))
-        while now_ns - samples[0][0] > round(RATE_WINDOW * 1e9):
+        # Keep the last sample at least RATE_WINDOW old, so statuses further apart than that
+        # still measure over the time between them.
+        while len(samples) > 2 and now_ns - samples[1][0] >= round(RATE_WINDOW * 1e9):
             samples.popleft()
         (first_ns, first_ticks) = samples[0]
         if now_ns > first_ns:
@@ -80,7 +83,7 @@ class RateMeter:
 def key_values(
     config: RunConfiguration,
     state: LinkageState | None,
-    achieved_rate: float,
+    achieved_rate: float | None,
     missed_deadlines: int,
     log_file: str | None,
     log_size: int | None,
@@ -88,7 +91,8 @@ def key_values(
     """
     Return the status's key values (README, "Diagnostics") as diagnostic_msgs/KeyValue strings.
 
-    ``log_file`` None means logging is disabled; ``log_size`` is the bag's size in bytes.
+    ``achieved_rate`` None means not measured yet (the first status); ``log_file`` None means
+    logging is disabled; ``log_size`` is the bag's size in bytes.
     """
     # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
     # the values that change at the top.
@@ -110,7 +114,8 @@ def key_values(
             ),
             'loop closure residual': f'{residual:.2e}',
         })
-    values['achieved rate (Hz)'] = f'{achieved_rate:.1f}'
+    values['achieved rate (Hz)'] = (
+        NOT_MEASURED if achieved_rate is None else f'{achieved_rate:.1f}')
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
     if config.mode == MotionMode.REAL_TIME:

@@ -67,13 +67,18 @@ def test_a_clock_that_goes_back_starts_the_schedule_again() -> None:
 
 def test_rate_is_measured_over_the_last_window() -> None:
     meter = RateMeter()
-    assert meter.update(0) == 0.0
+    assert meter.update(0) is None  # nothing to measure over yet
     for step in range(1, 31):  # 100 ticks per 0.1 s, then 10
         for _ in range(100 if step <= 20 else 10):
             meter.tick()
         rate = meter.update(step * PERIOD_NS)
     # the last RATE_WINDOW (1 s) holds only the slow phase
     assert RATE_WINDOW <= 1.0 and rate == pytest.approx(10 / STATUS_PERIOD)
+    # statuses further apart than the window measure over the time between them
+    for _ in range(30):
+        meter.tick()
+    assert meter.update(30 * PERIOD_NS + round(1.5 * RATE_WINDOW * 1e9)) == pytest.approx(
+        30 / (1.5 * RATE_WINDOW))
 
 
 def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
@@ -84,6 +89,8 @@ def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
     assert values['alpha_step (deg)'] == '0.25'
     assert (values['achieved rate (Hz)'], values['missed deadlines']) == ('231.3', '3')
     assert values['log size (bytes)'] == '101588'
+    assert key_values(config, None, None, 0, None, None)['achieved rate (Hz)'] == (
+        'not measured yet')
     real_time = key_values(configuration(), None, 99.95, 0, None, None)
     assert (real_time['rate_hz'], real_time['log file']) == ('100', 'disabled')
     assert 'alpha_step (deg)' not in real_time and 'log size (bytes)' not in real_time
