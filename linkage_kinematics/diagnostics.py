@@ -47,9 +47,11 @@ class StatusSchedule:
     def due(self, stamp_ns: int) -> bool:
         """Whether the state stamped ``stamp_ns`` (states in the order published) carries one."""
         previous, self._last_state_ns = self._last_state_ns, stamp_ns
-        if self._last_status_ns is None or previous is None or stamp_ns < previous:
-            return True  # the first state of a motion, or the clock went back
-        spacing = stamp_ns - previous
+        if (self._last_status_ns is None or stamp_ns < self._last_status_ns
+                or (previous is not None and stamp_ns < previous)):
+            return True  # no status yet, or the clock went back
+        # The first state of a motion comes with its own status (sent just before it).
+        spacing = 0 if previous is None else stamp_ns - previous
         return stamp_ns + spacing - self._last_status_ns > self._period_ns
 
 

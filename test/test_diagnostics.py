@@ -61,6 +61,14 @@ def test_statuses_keep_within_the_period_as_the_crank_slows_and_speeds() -> None
     assert max(later - earlier for earlier, later in zip(carried, carried[1:])) <= PERIOD_NS
 
 
+def test_the_first_state_after_its_motions_status_carries_none() -> None:
+    schedule = StatusSchedule()
+    schedule.sent(1_000)  # the status that says the crank moves, at the first state's time
+    assert not schedule.due(1_000)
+    assert not schedule.due(1_000 + PERIOD_NS // 3)
+    assert schedule.due(1_000 + 3 * PERIOD_NS // 4)  # the next one would be too late
+
+
 def test_a_clock_that_goes_back_starts_the_schedule_again() -> None:
     assert statuses_with([0, 10, 20, 5, 15]) == [0, 5]
 
