@@ -135,21 +135,24 @@ class JointStream:
     """
 
     def __init__(self, joints: JointMap, driver: Driver, include_driver: bool) -> None:
-        order = TREE_ORDER[driver]
-        self._first = 0 if include_driver else 1
-        self._mappings = tuple(joints[link] for link in order[self._first:])
-        self.names = tuple(mapping.name for mapping in self._mappings)
+        self._mappings = tuple(joints[link] for link in TREE_ORDER[driver])
+        # the whole tree's names, root first, and the part of it that is published
+        self.tree_names = tuple(mapping.name for mapping in self._mappings)
+        self.published = slice(0 if include_driver else 1, None)
+        self.names = self.tree_names[self.published]
         self._driver = driver
         self._previous = (0.0, 0.0, 0.0)
 
     def values(self, state: LinkageState) -> tuple[tuple[float, ...], tuple[float, ...]]:
-        """Return the lab's positions (rad) and velocities (rad/s) at ``state``, in ``names``."""
+        """
+        Return the lab's positions (rad) and velocities (rad/s) at ``state``.
+
+        Of the whole tree (``tree_names``); ``published`` slices out those in ``names``.
+        """
         positions, velocities = tree_values(state, self._driver)
         self._previous = positions = unwrap_positions(positions, self._previous)
-        first = self._first
         return (
-            tuple(mapping.to_lab(value)
-                  for mapping, value in zip(self._mappings, positions[first:])),
+            tuple(mapping.to_lab(value) for mapping, value in zip(self._mappings, positions)),
             tuple(mapping.direction * value
-                  for mapping, value in zip(self._mappings, velocities[first:])),
+                  for mapping, value in zip(self._mappings, velocities)),
         )

@@ -22,6 +22,7 @@ import signal
 import sys
 from typing import Any
 
+from linkage_kinematics.diagnostics import RateMeter, report, StatusSchedule
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.motion import blocked_note
 from linkage_kinematics.node_outputs import NodeOutputs, StartupError
@@ -46,7 +47,6 @@ from linkage_kinematics.parameters import (
     Source,
 )
 from linkage_kinematics.placement import CpuPlacement
-from linkage_kinematics.status import report
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -86,9 +86,8 @@ class LinkageNode(Node):
         self.activity = 'starting'
         self._state: LinkageState | None = None
         self._state_ns = 0
-        self._window_start_ns: int | None = None
-        self._window_states = 0
-        self._achieved_rate = 0.0
+        self._rate_meter = RateMeter()
+        self._status_schedule = StatusSchedule()
         self._placement = CpuPlacement()
         self._place(config.cpu_affinity)
         self.outputs = NodeOutputs(self, config, self.parameter_values(),
@@ -183,7 +182,7 @@ class LinkageNode(Node):
         first = self._state is None
         self._state = state
         self._state_ns = stamp_ns
-        self._window_states += 1
+        self._rate_meter.tick()
         if first:
             self.publish_markers()
             self.outputs.publish_description(stamp_ns)
@@ -191,6 +190,8 @@ class LinkageNode(Node):
                 self.activity = 'moving'
             self.publish_diagnostics()
         self.outputs.publish_state(state, stamp_ns, motion_time)
+        if self._status_schedule.due(stamp_ns):
+            self.publish_diagnostics()
 
     def publish_markers(self) -> None:
         """Publish the scene of the latest state, stamped with that state's time."""
@@ -214,15 +215,14 @@ class LinkageNode(Node):
         if at_ns is None:
             fresh = self._state is not None and not self._source.stale
             at_ns = self._state_ns if fresh else now_ns
-        if self._window_start_ns is not None and now_ns > self._window_start_ns:
-            window = (now_ns - self._window_start_ns) * 1e-9
-            self._achieved_rate = self._window_states / window
-        self._window_start_ns = now_ns
-        self._window_states = 0
+        self._rate_meter.update(now_ns)
+        self._status_schedule.sent(at_ns)
+        recorder = self.outputs.recorder
         level, text, values = report(
             self.config, self._state, event or self.problem or self.outputs.recording_error,
-            self.activity, self._source.health, now_ns, self._achieved_rate,
-            self._source.missed_deadlines)
+            self.activity, self._source.health, now_ns, self._rate_meter.rate,
+            self._source.missed_deadlines, None if recorder is None else str(recorder.bag_path),
+            None if recorder is None else recorder.size_bytes)
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

@@ -22,11 +22,11 @@ from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.diagnostics import Level
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.joints import JointMap, JointStream
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.parameters import ConfigurationError, RunConfiguration, Source
-from linkage_kinematics.status import Level
 from linkage_kinematics.urdf import urdf_text
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -37,6 +37,14 @@ from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 
 DATA_QOS = QoSProfile(depth=10)
+# TF is logged, never published (see docs/logging.md), with tf2_ros's broadcaster QoS: the
+# static one keeps the last message for late subscribers, as robot_state_publisher's does.
+TF_TOPIC = '/tf'
+TF_STATIC_TOPIC = '/tf_static'
+TF_QOS = QoSProfile(depth=100)
+TF_STATIC_QOS = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
 # robot_state_publisher's convention: late joiners get the latest description.
 ROBOT_DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
@@ -79,6 +87,7 @@ class NodeOutputs:
         self._described: tuple[FourBar, JointMap] | None = None
         self._encoded: FourBar | None = None
         self._streamed: JointMap | None = None
+        self._robot_transforms: messages.RobotStateTransforms | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = config.frame_prefix + config.frame_id
         self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
@@ -97,6 +106,9 @@ class NodeOutputs:
              True if topic == self._diagnostics_topic else None)
             for topic, publisher in self._publishers.items()
         ]
+        # and the TF robot_state_publisher would publish, logged only (docs/logging.md)
+        topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
+                   (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         try:
             return Recorder(
                 self.config.log_folder, topics=topics, metadata=metadata, cpus=cpus,
@@ -111,6 +123,9 @@ class NodeOutputs:
     def send(self, topic: str, data: bytes, log_time_ns: int) -> None:
         """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""
         self._publishers[topic].publish(data)
+        self._record(topic, data, log_time_ns)
+
+    def _record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         if self.recorder is None or self.recording_error is not None:
             return
         try:
@@ -138,8 +153,14 @@ class NodeOutputs:
         """Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``."""
         self._prepare()
         positions, velocities = self._joints.values(state)
+        published = self._joints.published
         self.send(self._joint_states_topic,
-                  self._joint_state_encoder.encode(stamp_ns, positions, velocities), stamp_ns)
+                  self._joint_state_encoder.encode(stamp_ns, positions[published],
+                                                   velocities[published]), stamp_ns)
+        if self._robot_transforms is not None:
+            # What robot_state_publisher makes of the driver and the passive joints, bag only.
+            self._record(TF_TOPIC, self._robot_transforms.message(
+                dict(zip(self._joints.tree_names, positions)), stamp_ns), stamp_ns)
         self.send(self._state_topic, self._state_encoder.encode(state, stamp_ns, motion_time),
                   stamp_ns)
 
@@ -149,24 +170,29 @@ class NodeOutputs:
         self.send(self._markers_topic, self._marker_encoder.encode(state, stamp_ns), stamp_ns)
 
     def publish_description(self, stamp_ns: int) -> None:
-        """Publish the URDF if it is published and the geometry or the joints are new."""
+        """
+        Publish the URDF, if it is published and the geometry or the joints are new.
+
+        And log the /tf_static robot_state_publisher would publish for it (also where the lab's
+        own URDF is used: the node's has the lab's joints).
+        """
         config = self.config
         described = (config.linkage, config.joints)
-        if self._description_topic is None or self._described == described:
+        if self._described == described:
             return
         self._described = described
         text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
-        self.send(self._description_topic, encode_cdr(String(data=text)), stamp_ns)
+        if self._description_topic is not None:
+            self.send(self._description_topic, encode_cdr(String(data=text)), stamp_ns)
+        if self.recorder is not None:
+            self._robot_transforms = messages.RobotStateTransforms(text, config.frame_prefix)
+            self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(stamp_ns),
+                         stamp_ns)
 
     def publish_diagnostics(self, stamp_ns: int, level: Level, text: str,
                             values: dict[str, str]) -> None:
         """Publish one status in diagnostic_updater's layout, stamped ``stamp_ns``."""
         config = self.config
-        if self.recorder is None:
-            values['log file'] = 'disabled'
-        else:
-            values['log file'] = str(self.recorder.bag_path)
-            values['log size (bytes)'] = str(self.recorder.size_bytes)
         message = messages.diagnostic_array(
             Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000),
             f'{self._node.get_name()}: crank motion',
@@ -176,6 +202,20 @@ class NodeOutputs:
             values,
         )
         self.send(self._diagnostics_topic, encode_cdr(message), stamp_ns)
+
+    def flush_log(self) -> None:
+        """
+        Have the bag writer write out what it holds before the run's last status.
+
+        So that its log size is the bag's.
+        """
+        if self.recorder is None or self.recording_error is not None:
+            return
+        try:
+            self.recorder.flush()
+        except OSError as error:
+            self.recording_error = f'recording stopped: {error}'
+            self._node.get_logger().error(self.recording_error)
 
     def flush(self, timeout: float = 1.0) -> None:
         """

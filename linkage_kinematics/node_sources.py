@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from linkage_kinematics.diagnostics import MeasuredHealth
 from linkage_kinematics.joints import Link
 from linkage_kinematics.measured import MeasuredFollower, Rejection
 from linkage_kinematics.motion import dead_point_problem, DriveLawRun
 from linkage_kinematics.parameters import EndBehavior, RunConfiguration
-from linkage_kinematics.status import MeasuredHealth
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 
@@ -86,6 +86,7 @@ class DriveLawTimer:
                     f'reached alpha_end = {math.degrees(node.config.alpha_end):.6f}°; stopped')
                 self._node.get_logger().info(node.activity)
                 node.publish_markers()
+                node.outputs.flush_log()
                 node.publish_diagnostics()
                 node.exit_code = EXIT_OK
                 return
@@ -102,6 +103,7 @@ class DriveLawTimer:
         else:
             node.problem = f'the crank cannot go on: {detail}'
         self._node.get_logger().error(node.problem)
+        node.outputs.flush_log()
         node.publish_diagnostics()
         node.exit_code = EXIT_FAILED
 

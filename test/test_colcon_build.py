@@ -28,7 +28,7 @@ from sensor_msgs.msg import JointState
 DOMAIN_ID = 12
 PACKAGE_ENTRIES = (
     'package.xml', 'setup.py', 'setup.cfg', 'resource', 'linkage_kinematics', 'launch', 'config',
-    'urdf', 'foxglove',
+    'urdf', 'foxglove', 'interfaces',
 )
 
 
@@ -86,7 +86,9 @@ def test_colcon_build_installs_a_node_that_publishes(tmp_path):
     assert executable.is_file() and os.access(executable, os.X_OK)
     share = install / 'linkage_kinematics' / 'share' / 'linkage_kinematics'
     for installed in ('launch/linkage.launch.py', 'config/seed_constant.yaml',
-                      'config/seed_variable.yaml', 'urdf/linkage.urdf'):
+                      'config/seed_variable.yaml', 'urdf/linkage.urdf',
+                      'interfaces/tf2_msgs/msg/TFMessage.msg',
+                      'interfaces/tf2_msgs/msg/TFMessage.json'):
         assert (share / installed).is_file(), installed
 
     environment = _colcon_environment(install, ros_environment(DOMAIN_ID))

@@ -508,5 +508,6 @@ def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(
         lab_angle = driver_mapping.to_lab(node_angle)
         followed = follower.follow(index, [names[0]], [lab_angle], [1.0])
         positions, _ = stream.values(followed.state)
-        values = {names[0]: lab_angle, **dict(zip(stream.names, positions))}
+        assert math.remainder(positions[0] - lab_angle, TWO_PI) == pytest.approx(0.0, abs=1e-12)
+        values = {names[0]: lab_angle, **dict(zip(stream.names, positions[stream.published]))}
         assert chain_end(urdf, values, end[0]) == pytest.approx(end[1], abs=TOLERANCE)

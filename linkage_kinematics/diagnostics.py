@@ -2,16 +2,22 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-What ``/diagnostics`` says: the status level, its message and its key values.
+What the node's diagnostics say and when, without ROS.
 
-Pure functions of the configuration and the latest state, and ``MeasuredHealth``, the
-measured source's record of dropped samples and of the time since the last valid one. The node
-turns them into a ``diagnostic_msgs/DiagnosticArray`` (``messages.diagnostic_array``). README.md,
-section Diagnostics, documents every level and value. No ROS.
+``assess`` gives the status's level and message and ``report`` its whole content;
+``MeasuredHealth`` is the measured source's record of dropped samples and of the time since
+the last valid one. ``key_values`` formats the status's key values (README, "Diagnostics") so
+that a viewer shows them as they are: counts as integers, small residuals in scientific
+notation, and in each mode only the rate it uses. ``StatusSchedule`` says which states a
+status goes out with: one at least every ``STATUS_PERIOD`` of mechanism time, so that a
+replayed bag's diagnostics move with the mechanism. ``RateMeter`` measures the achieved state
+rate over the last ``RATE_WINDOW``, so that statuses that close together do not report the
+jitter of a few ticks.
 """
 
 from __future__ import annotations
 
+import collections
 from enum import IntEnum
 import math
 
@@ -19,7 +25,132 @@ from linkage_kinematics.joints import Driver, Link
 from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
 from linkage_kinematics.measured import Estimate, Rejection
 from linkage_kinematics.motion import blocked_note
-from linkage_kinematics.parameters import RunConfiguration, Source
+from linkage_kinematics.parameters import MotionMode, RunConfiguration, Source
+
+STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
+RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured
+LOG_DISABLED = 'disabled'
+NOT_MEASURED = 'not measured yet'
+
+
+class StatusSchedule:
+    """
+    Decide which states a status goes out with, so that statuses are at most STATUS_PERIOD apart.
+
+    A state carries one when the next state, as far after it as it came after the one before,
+    would be more than STATUS_PERIOD after the last status; where the states themselves are
+    further apart, every state carries one.
+    """
+
+    def __init__(self) -> None:
+        self._period_ns = round(STATUS_PERIOD * 1e9)
+        self._last_status_ns: int | None = None
+        self._last_state_ns: int | None = None
+
+    def sent(self, stamp_ns: int) -> None:
+        """Note a status stamped ``stamp_ns`` (sent with a state or for any other reason)."""
+        self._last_status_ns = stamp_ns
+
+    def due(self, stamp_ns: int) -> bool:
+        """Whether the state stamped ``stamp_ns`` (states in the order published) carries one."""
+        previous, self._last_state_ns = self._last_state_ns, stamp_ns
+        if (self._last_status_ns is None or stamp_ns < self._last_status_ns
+                or (previous is not None and stamp_ns < previous)):
+            return True  # no status yet, or the clock went back
+        # The first state of a motion comes with its own status (sent just before it).
+        spacing = 0 if previous is None else stamp_ns - previous
+        return stamp_ns + spacing - self._last_status_ns > self._period_ns
+
+
+class RateMeter:
+    """Ticks per second over the last RATE_WINDOW, measured at each status (None before)."""
+
+    def __init__(self) -> None:
+        self.rate: float | None = None
+        self._ticks = 0
+        self._samples: collections.deque[tuple[int, int]] = collections.deque()
+
+    def tick(self) -> None:
+        self._ticks += 1
+
+    def update(self, now_ns: int) -> float | None:
+        """Return the rate since the latest status at least RATE_WINDOW before ``now_ns``."""
+        samples = self._samples
+        if samples and now_ns < samples[-1][0]:
+            samples.clear()  # the clock went back
+        samples.append((now_ns, self._ticks))
+        # Keep the last sample at least RATE_WINDOW old, so statuses further apart than that
+        # still measure over the time between them.
+        while len(samples) > 2 and now_ns - samples[1][0] >= round(RATE_WINDOW * 1e9):
+            samples.popleft()
+        (first_ns, first_ticks) = samples[0]
+        if now_ns > first_ns:
+            self.rate = (self._ticks - first_ticks) / ((now_ns - first_ns) * 1e-9)
+        return self.rate
+
+
+def key_values(
+    config: RunConfiguration,
+    state: LinkageState | None,
+    achieved_rate: float | None,
+    missed_deadlines: int,
+    log_file: str | None,
+    log_size: int | None,
+    health: MeasuredHealth | None = None,
+    now_ns: int = 0,
+) -> dict[str, str]:
+    """
+    Return the status's key values (README, "Diagnostics") as diagnostic_msgs/KeyValue strings.
+
+    ``achieved_rate`` None means not measured yet (the first status); ``log_file`` None means
+    logging is disabled; ``log_size`` is the bag's size in bytes. ``health`` is the measured
+    source's (None under the drive law), whose values replace the drive law's pace and settings.
+    """
+    # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
+    # the values that change at the top.
+    values = {}
+    if state is not None:
+        # Distances along the driver's travel: the rocker-driven chain's for the rocker.
+        reachability = config.driven_linkage.reachability
+        angle = driver_angle(config, state)
+        distance = reachability.dead_point_distance(angle)
+        change_distance = reachability.change_point_distance(angle)
+        residual = float(loop_closure_residual(config.linkage, state))
+        values.update({
+            'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
+            'alpha (rad)': repr(state.alpha),
+            **({'rocker angle (deg)': f'{math.degrees(angle):.6f}'}
+               if config.driver is Driver.ROCKER else {}),
+            'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
+            'dead point distance (deg)': (
+                'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
+            ),
+            'change point distance (deg)': (
+                'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
+            ),
+            'loop closure residual': f'{residual:.2e}',
+        })
+    values['achieved rate (Hz)'] = (
+        NOT_MEASURED if achieved_rate is None else f'{achieved_rate:.1f}')
+    if health is not None:
+        values.update(health.values(now_ns, config))
+        if log_file is not None and log_size is not None:
+            values['log size (bytes)'] = str(int(log_size))
+        values['log file'] = LOG_DISABLED if log_file is None else log_file
+        return values
+    # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
+    # the pace, and rate_hz is not used.
+    if config.mode == MotionMode.REAL_TIME:
+        values['rate_hz'] = f'{config.rate_hz:g}'
+    else:
+        values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'
+    values['missed deadlines'] = str(int(missed_deadlines))
+    if log_file is not None and log_size is not None:
+        values['log size (bytes)'] = str(int(log_size))
+    values['log file'] = LOG_DISABLED if log_file is None else log_file
+    values['mode'] = config.mode.value
+    values['end behavior'] = config.end_behavior.value
+    return values
 
 
 class Level(IntEnum):
@@ -86,60 +217,26 @@ def report(
     activity: str,
     health: MeasuredHealth | None,
     now_ns: int,
-    achieved_rate: float,
+    achieved_rate: float | None,
     missed_deadlines: int,
+    log_file: str | None,
+    log_size: int | None,
 ) -> tuple[Level, str, dict[str, str]]:
     """
     Return the level, message and key values of one status (README, Diagnostics).
 
     ``health`` is the measured source's (None under the drive law); its drops since the last
-    status make it WARN and its staleness ERROR. ``achieved_rate`` counts states per second.
+    status make it WARN and its staleness ERROR. The rest as ``key_values`` takes them.
     """
-    values = {'achieved rate (Hz)': f'{achieved_rate:.1f}'}
     warnings: tuple[str, ...] = ()
     if health is not None:
-        values.update(health.values(now_ns, config))
         warnings = health.take_warnings()
         driver_name = config.joints[Link(config.driver.value)].name
         problem = problem or health.problem(now_ns, config.measured_timeout, driver_name)
-    else:
-        values.update({
-            'end behavior': config.end_behavior.value,
-            'mode': config.mode.value,
-            'rate_hz': f'{config.rate_hz:g}',
-            'missed deadlines': str(missed_deadlines),
-        })
-    values.update(state_values(config, state))
+    values = key_values(config, state, achieved_rate, missed_deadlines, log_file, log_size,
+                        health, now_ns)
     level, text = assess(config, state, problem, activity, warnings)
     return level, text, values
-
-
-def state_values(config: RunConfiguration, state: LinkageState | None) -> dict[str, str]:
-    """Return the key values of the latest state (none before the first)."""
-    if state is None:
-        return {}
-    reachability = config.driven_linkage.reachability
-    angle = driver_angle(config, state)
-    distance = reachability.dead_point_distance(angle)
-    change_distance = reachability.change_point_distance(angle)
-    residual = float(loop_closure_residual(config.linkage, state))
-    values = {
-        'alpha (rad)': repr(state.alpha),
-        'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
-    }
-    if config.driver is Driver.ROCKER:
-        values['rocker angle (deg)'] = f'{math.degrees(angle):.6f}'
-    values.update({
-        'dead point distance (deg)': (
-            'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
-        ),
-        'change point distance (deg)': (
-            'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
-        ),
-        'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
-        'loop closure residual': f'{residual:.3g}',
-    })
-    return values
 
 
 class MeasuredHealth:
