@@ -14,6 +14,7 @@ parameters, diagnostics and exit statuses are documented in README.md.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import json
 import math
 import os
@@ -48,8 +49,10 @@ from linkage_kinematics.parameters import (
     ParameterSpec,
     REAL_PARAMETERS,
     RunConfiguration,
+    unknown_parameters,
 )
 from linkage_kinematics.recording import encode_cdr, Recorder
+from linkage_kinematics.run_control import RunControl, ServiceAnswer
 from linkage_kinematics.urdf import urdf_text
 from rcl_interfaces.msg import (
     FloatingPointRange,
@@ -69,6 +72,7 @@ from rclpy.signals import SignalHandlerOptions
 from rclpy.time import Time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
+from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 
@@ -162,7 +166,13 @@ class LinkageNode(Node):
         super().__init__(NODE_NAME, **node_options)
         self.exit_code: int | None = None
         specs = self._declare_parameters()
+        # rclpy has no public accessor of the overrides given for this node; they include the
+        # `-p` arguments and the /** entries of parameter files, which rcl keeps as one set.
+        for warning in unknown_parameters(self._parameter_overrides,
+                                          self.list_parameters([], 0).names):
+            self.get_logger().warning(warning)
         self.config = build_configuration(self.parameter_values())
+        self._control = RunControl(self.config.autostart)
         # Ranges go into the descriptors only now, so that a bad start-up value gets
         # build_configuration's message; from here on rclpy enforces them too.
         for spec in specs:
@@ -224,8 +234,12 @@ class LinkageNode(Node):
         self.add_pre_set_parameters_callback(self._keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
-        # The motion starts now (its first state, scene first, is published at once), unless
-        # the clock does not run yet (use_sim_time before the first /clock).
+        self.create_service(Trigger, '~/pause', self._answer(self._pause))
+        self.create_service(Trigger, '~/resume', self._answer(self._resume))
+        self.create_service(Trigger, '~/reset', self._answer(self._reset))
+        # The motion starts now (its first state, scene first, is published at once), or with
+        # autostart false the node shows alpha_start and waits; either unless the clock does not
+        # run yet (use_sim_time before the first /clock).
         self._tick()
 
     # parameters
@@ -450,6 +464,8 @@ class LinkageNode(Node):
     def _restart_motion(self) -> None:
         self._motion_start: Time | None = None
         self._state: LinkageState | None = None
+        self._motion_started = False  # no state of this motion published yet
+        self._control.back_to_start()
         self._state_time: Time | None = None
         self._step = 0
         self._ticks = 0
@@ -463,6 +479,11 @@ class LinkageNode(Node):
         now = self.get_clock().now()
         if now.nanoseconds == 0:
             return  # use_sim_time and no /clock yet: the motion has no time to start at
+        if self._control.paused:
+            if self._state is None:
+                self._wait_at_alpha_start(now)
+            self._state_timer.cancel()  # ~/resume or a restart re-arms it
+            return
         if self._motion_start is None or now < self._motion_start:
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
@@ -546,7 +567,8 @@ class LinkageNode(Node):
         The first of a motion comes after its scene (so a viewer knows the frame before anything
         refers to it), the URDF if the geometry is new, and the status that says the crank moves.
         """
-        first = self._state is None
+        first = not self._motion_started
+        self._motion_started = True
         self._state = state
         self._state_time = at
         if first:
@@ -569,6 +591,67 @@ class LinkageNode(Node):
             self._state_encoder.encode(state, nanoseconds, motion_time),
             nanoseconds,
         )
+
+    def _wait_at_alpha_start(self, now: Time) -> None:
+        """
+        Publish the scene at alpha_start, the URDF if the geometry is new, and the status.
+
+        No state: the first one comes after ~/resume.
+        """
+        self._state = solve_sample(self.config, MotionSample(self.config.alpha_start))
+        self._state_time = now
+        if self._encoded_linkage != self.config.linkage:
+            self._prepare_encoders()
+        self._publish_markers()
+        if self._described_linkage != self.config.linkage:
+            self._publish_robot_description(now)
+        self._activity = self._control.activity(None)
+        self._publish_diagnostics()
+
+    # start control (~/pause, ~/resume, ~/reset)
+
+    def _answer(self, act: Callable[[], ServiceAnswer]) -> Callable[..., Trigger.Response]:
+        """Return a Trigger service callback that answers with what ``act`` did."""
+        def callback(_request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+            answer = act()
+            response.success, response.message = answer.success, answer.message
+            if answer.success:
+                self.get_logger().info(answer.message)
+            return response
+        return callback
+
+    def _pause(self) -> ServiceAnswer:
+        now = self.get_clock().now()
+        started = self._motion_started and self._motion_start is not None
+        answer = self._control.pause(
+            (now - self._motion_start).nanoseconds if started else None,
+            self._state.alpha if started else None,
+        )
+        if answer.success:
+            self._activity = self._control.activity(self._state.alpha if started else None)
+            self._publish_diagnostics()
+        return answer
+
+    def _resume(self) -> ServiceAnswer:
+        answer, held = self._control.resume()
+        if not answer.success:
+            return answer
+        if held is None:
+            self._restart_motion()  # from alpha_start
+        else:
+            self._motion_start = self.get_clock().now() - Duration(nanoseconds=held)
+            self._activity = 'moving'
+            self._publish_diagnostics()
+        self._state_timer.reset()
+        self._tick()
+        return answer
+
+    def _reset(self) -> ServiceAnswer:
+        answer = self._control.reset(self.config.alpha_start)
+        self._restart_motion()
+        self._state_timer.reset()
+        self._tick()
+        return answer
 
     def _prepare_encoders(self) -> None:
         linkage = self.config.linkage
@@ -644,6 +727,7 @@ class LinkageNode(Node):
     def _diagnostic_values(self) -> dict[str, str]:
         config = self.config
         values = {
+            'run state': self._control.state.value,
             'end behavior': config.end_behavior,
             'mode': config.mode,
             'achieved rate (Hz)': f'{self._achieved_rate:.1f}',

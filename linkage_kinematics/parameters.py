@@ -11,8 +11,9 @@ node, the demo and the tests all validate through it. README.md documents each p
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, replace
+import difflib
 import math
 from pathlib import Path
 from typing import Any
@@ -89,6 +90,7 @@ class RunConfiguration:
     log_enabled: bool
     log_folder: Path
     cpu_affinity: int
+    autostart: bool
     direction: int
     segment_end: float
     blocked_at: float | None
@@ -168,7 +170,9 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec('alpha_end', math.pi / 2.0,
                       'crank angle where one pass ends (rad), not alpha_start',
                       floating_range=(-MAX_ANGLE, MAX_ANGLE)),
-        ParameterSpec('end_behavior', 'stop',
+        # A node runs until it is stopped, as every ROS node does: by default the crank swings
+        # to and fro over its pass, which suits the paper's mechanism (it cannot turn fully).
+        ParameterSpec('end_behavior', 'bounce',
                       'at the end of a pass: stop (and exit), loop or bounce'),
         ParameterSpec('mode', 'real_time',
                       'real_time: α from node-clock time at rate_hz; fixed_step: steps of '
@@ -207,6 +211,10 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                       "process on the others (as ros2_control's cpu_affinity); -1 leaves "
                       'both to the operating system',
                       integer_range=(NO_CPU_AFFINITY, MAX_CPU, 1)),
+        ParameterSpec('autostart', True,
+                      'start the motion at once; false: publish the scene at alpha_start, the '
+                      'URDF and the status, then wait for ~/resume',
+                      read_only=True),
     )
 
 
@@ -388,6 +396,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     log_enabled = _flag(values, 'log.enabled')
     log_folder = Path(_text(values, 'log.folder'))
     cpu_affinity = _cpu(values)
+    autostart = _flag(values, 'autostart')
     blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
     segment_end = alpha_end if blocked_at is None else blocked_at
     travel = abs(segment_end - alpha_start)
@@ -414,6 +423,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         log_enabled=log_enabled,
         log_folder=log_folder,
         cpu_affinity=cpu_affinity,
+        autostart=autostart,
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,
         blocked_at=blocked_at,
@@ -424,6 +434,22 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         ),
         step_count=step_count,
     )
+
+
+def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[str]:
+    """
+    Return one warning per parameter in ``given`` that is not in ``declared``, sorted by name.
+
+    Each names the parameter and the closest of the node's own parameters, if one is close
+    (``rate`` → ``rate_hz``).
+    """
+    warnings = []
+    for name in sorted(set(given) - set(declared)):
+        closest = difflib.get_close_matches(name, PARAMETER_NAMES, n=1)
+        hint = f"; did you mean '{closest[0]}'?" if closest else ''
+        warnings.append(f"unknown parameter '{name}' ignored: {NODE_NAME} has no such "
+                        f'parameter{hint}')
+    return warnings
 
 
 def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
