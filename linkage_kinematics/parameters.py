@@ -452,9 +452,9 @@ def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[
     return warnings
 
 
-def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
+def mechanism_entries(parameters_file: str | Path) -> dict[str, dict[str, Any]]:
     """
-    Return the namespaces of a parameters file's ``/<namespace>/linkage_node`` entries.
+    Return the ``/<namespace>/linkage_node`` entries of a parameters file: namespace → parameters.
 
     In file order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry.
     """
@@ -465,10 +465,13 @@ def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
         raise ValueError(f'cannot read parameters file {path}: {error}') from None
     if not isinstance(entries, dict) or not entries:
         raise ValueError(f'{path} has no /<namespace>/{NODE_NAME} entries')
-    namespaces = []
-    for key in entries:
+    mechanisms = {}
+    for key, entry in entries.items():
         namespace, _, name = str(key).rpartition('/')
         if name != NODE_NAME or not namespace.startswith('/') or '*' in namespace:
             raise ValueError(f'{path}: entry {key!r} is not /<namespace>/{NODE_NAME}')
-        namespaces.append(namespace)
-    return namespaces
+        parameters = entry.get('ros__parameters') if isinstance(entry, dict) else None
+        if not isinstance(parameters, dict):
+            raise ValueError(f'{path}: entry {key!r} has no ros__parameters mapping')
+        mechanisms[namespace] = parameters
+    return mechanisms

@@ -93,6 +93,7 @@ ACCEPTED = {
     'log.enabled': set(),
     'log.folder': set(),
     'cpu_affinity': {'zero', 'negative'},    # CPU 0; −1 is no pinning; at most 1023
+    'autostart': set(),
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
 ACCEPTED_IN_CONTEXT = [{'ground_x': 0.0, 'ground_y': -1.3}, {'ground_x': 0, 'ground_y': -1.3}]
