@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Start linkage_node with one of the seed's scenarios, or with a parameters file of your own.
+Start linkage_node with one of the paper's runs, or with a parameters file of your own.
 
 ``scenario:=constant`` (default) or ``scenario:=variable`` picks config/seed_<scenario>.yaml;
 ``params_file:=FILE`` replaces it. The other arguments are those of robot_state_publisher's and
@@ -31,7 +31,7 @@ def generate_launch_description() -> LaunchDescription:
             'scenario',
             default_value='constant',
             choices=['constant', 'variable'],
-            description="drive law of the seed's 90° turn: constant (ω = 2 rad/s) or "
+            description="drive law of the paper's 90° turn: constant (ω = 2 rad/s) or "
             'variable (ω = 0.10 + 2.3·α)',
         ),
         DeclareLaunchArgument(
