@@ -84,18 +84,20 @@ def test_python_launch_files_use_only_launch_api_every_jazzy_release_has(name: s
 
 def _declared_arguments(tree: ast.AST) -> dict[str, dict[str, ast.expr]]:
     """Return the DeclareLaunchArgument calls of a Python launch file: name → keywords."""
-    arguments = {}
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Call) and getattr(node.func, 'id', None) == 'DeclareLaunchArgument':
-            name = ast.literal_eval(node.args[0])
-            arguments[name] = {keyword.arg: keyword.value for keyword in node.keywords}
-    return arguments
+    return {ast.literal_eval(call.args[0]): {word.arg: word.value for word in call.keywords}
+            for call in _calls(tree, 'DeclareLaunchArgument')}
+
+
+def _calls(tree: ast.AST, function: str) -> list[ast.Call]:
+    """Return the calls of ``function`` (by its plain name) in a Python launch file."""
+    return [node for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and getattr(node.func, 'id', None) == function]
 
 
 def _configurations(tree: ast.AST) -> dict[int, str]:
     """Return the LaunchConfiguration('name') calls of a Python launch file: id → name."""
-    return {id(node): ast.literal_eval(node.args[0]) for node in ast.walk(tree)
-            if isinstance(node, ast.Call) and getattr(node.func, 'id', None) == 'LaunchConfiguration'}
+    return {id(node): ast.literal_eval(node.args[0])
+            for node in _calls(tree, 'LaunchConfiguration')}
 
 
 def _node_parameters(tree: ast.AST) -> dict[str, str]:
