@@ -107,6 +107,81 @@ def minimal_states(
             for name, index in zip(QUANTITIES, (1, 2, 5, 6, 7, 8))}
 
 
+def minimal_numpy_closed_form(
+    crank: float, coupler: float, rocker: float, ground_x: float, ground_y: float,
+    branch: int | np.ndarray, omega0: float, k: float, alpha: np.ndarray,
+) -> tuple[np.ndarray, ...]:
+    """
+    Return ``minimal_closed_form`` as bare whole-array ``numpy`` code.
+
+    No checks, no pieces, no state object: the same 22 outputs as a tuple of arrays. The yardstick
+    for the vectorised path's overhead (``solve_many``); a sine that rounded to zero gives inf or
+    NaN there.
+    """
+    sin_alpha = np.sin(alpha)
+    cos_alpha = np.cos(alpha)
+    pin_a_x = crank * sin_alpha
+    pin_a_y = -crank * cos_alpha
+    to_c_x = ground_x - pin_a_x
+    to_c_y = ground_y - pin_a_y
+    distance = np.sqrt(to_c_x * to_c_x + to_c_y * to_c_y)
+    u_x = to_c_x / distance
+    u_y = to_c_y / distance
+    along = (coupler * coupler - rocker * rocker + distance * distance) / (2.0 * distance)
+    heron = ((coupler + rocker - distance) * (rocker + distance - coupler)
+             * (coupler + distance - rocker) * (coupler + rocker + distance))
+    height = branch * np.sqrt(np.maximum(heron, 0.0)) / (2.0 * distance)
+    coupler_x = along * u_x - height * u_y
+    coupler_y = along * u_y + height * u_x
+    rocker_along = along - distance
+    rocker_x = rocker_along * u_x - height * u_y
+    rocker_y = rocker_along * u_y + height * u_x
+    e_ab_x = coupler_x / coupler
+    e_ab_y = coupler_y / coupler
+    e_bc_x = rocker_x / rocker
+    e_bc_y = rocker_y / rocker
+    sine = height * distance / (coupler * rocker)
+    omega = omega0 + k * alpha
+    omega_dot = k * omega
+    velocity_a_x = crank * omega * cos_alpha
+    velocity_a_y = crank * omega * sin_alpha
+    omega_squared = omega * omega
+    acceleration_a_x = crank * (omega_dot * cos_alpha - omega_squared * sin_alpha)
+    acceleration_a_y = crank * (omega_dot * sin_alpha + omega_squared * cos_alpha)
+    coupler_sine = coupler * sine
+    rocker_sine = rocker * sine
+    omega_ab = -(velocity_a_x * e_bc_x + velocity_a_y * e_bc_y) / coupler_sine
+    omega_bc = -(velocity_a_x * e_ab_x + velocity_a_y * e_ab_y) / rocker_sine
+    coupler_centripetal = coupler * omega_ab * omega_ab
+    rocker_centripetal = rocker * omega_bc * omega_bc
+    w_x = acceleration_a_x - coupler_centripetal * e_ab_x + rocker_centripetal * e_bc_x
+    w_y = acceleration_a_y - coupler_centripetal * e_ab_y + rocker_centripetal * e_bc_y
+    omega_dot_ab = -(w_x * e_bc_x + w_y * e_bc_y) / coupler_sine
+    omega_dot_bc = -(w_x * e_ab_x + w_y * e_ab_y) / rocker_sine
+    rocker_tangential = rocker * omega_dot_bc
+    return (
+        alpha, np.arctan2(rocker_y, -rocker_x), np.arctan2(coupler_y, coupler_x), omega,
+        omega_dot, omega_ab, omega_bc, omega_dot_ab, omega_dot_bc, pin_a_x, pin_a_y,
+        ground_x + rocker_x, ground_y + rocker_y, velocity_a_x, velocity_a_y,
+        -omega_bc * rocker_y, omega_bc * rocker_x, acceleration_a_x, acceleration_a_y,
+        -rocker_tangential * e_bc_y - rocker_centripetal * e_bc_x,
+        rocker_tangential * e_bc_x - rocker_centripetal * e_bc_y,
+        np.arctan2(np.abs(sine), e_ab_x * e_bc_x + e_ab_y * e_bc_y),
+    )
+
+
+def minimal_numpy_states(
+    linkage: FourBar, alphas: list[float], drive: DriveLaw, sides: list[int]
+) -> States:
+    """``minimal_numpy_closed_form`` over the angles, each on the given side of A→C."""
+    with np.errstate(divide='ignore', invalid='ignore'):
+        columns = minimal_numpy_closed_form(
+            linkage.crank_length, linkage.coupler_length, linkage.rocker_length,
+            linkage.ground_x, linkage.ground_y, np.array(sides), drive.omega0, drive.k,
+            np.array(alphas))
+    return {name: list(columns[index]) for name, index in zip(QUANTITIES, (1, 2, 5, 6, 7, 8))}
+
+
 # --- Generic solution of the loop-closure equations -----------------------------------------
 # Unknowns x = (γ, β); with A = OA·(sin α, −cos α), B = A + AB·(cos γ, sin γ) and
 # B = C + BC·(−cos β, sin β), the loop closes where

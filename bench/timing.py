@@ -34,6 +34,28 @@ def interleaved_medians(
     return {name: statistics.median(times) for name, times in samples.items()}
 
 
+def paired_ratio(
+    first: Callable[[], int], second: Callable[[], int], pairs: int
+) -> float:
+    """
+    Median over ``pairs`` back-to-back runs of the ratio of ``first``'s time to ``second``'s.
+
+    Per configuration; the two alternate which runs first. Each ratio compares two runs a few
+    milliseconds apart, so a burst of another process's work moves single pairs, not the
+    median: a steadier figure for an overhead goal than the ratio of two medians taken among
+    many other methods' runs.
+    """
+    ratios = []
+    for index in range(pairs):
+        seconds = {}
+        for workload in ((first, second) if index % 2 == 0 else (second, first)):
+            start = time.perf_counter()
+            count = workload()
+            seconds[workload] = (time.perf_counter() - start) / count
+        ratios.append(seconds[first] / seconds[second])
+    return statistics.median(ratios)
+
+
 def machine_description() -> str:
     """CPU model, cores, load, Python and numpy versions, for the report."""
     model = 'unknown CPU'

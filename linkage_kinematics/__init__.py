@@ -6,6 +6,7 @@ Exact kinematics of a planar four-bar linkage.
 
 (the seed's disk, coupler and rocker) for ROS 2.
 
-The kinematics (``geometry``, ``drive``, ``kinematics``) is a pure library that needs only numpy;
-the ROS node and the command-line tools are thin shells around it.
+The kinematics (``geometry``, ``drive``, and ``kinematics`` over ``closed_form``,
+``singular_points`` and ``continuation``) is a pure library that needs only numpy; the ROS node
+and the command-line tools are thin shells around it.
 """

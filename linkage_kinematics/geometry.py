@@ -45,8 +45,14 @@ TOUCH_TOLERANCE = 1e-14
 ANGLE_TOLERANCE = 1e-14
 # Lengths and coordinates are kept within these magnitudes so that the products of four lengths
 # in the closed form (Heron's formula) neither overflow nor underflow in double precision.
-MAX_LENGTH = 1e60
-MIN_LENGTH = 1e-60
+MAX_SOLVABLE_LENGTH = 1e60
+MIN_SOLVABLE_LENGTH = 1e-60
+# The dimensions that make a FourBar, in its constructor's order: its link lengths and the
+# coordinates of the pivot C. The node's geometry parameters and linkage-sweep's geometry options
+# carry these names.
+LINK_LENGTHS = ('crank_length', 'coupler_length', 'rocker_length')
+GROUND_COORDINATES = ('ground_x', 'ground_y')
+DIMENSIONS = LINK_LENGTHS + GROUND_COORDINATES
 
 
 class GeometryError(ValueError):
@@ -176,19 +182,19 @@ class FourBar:
     closure: LoopClosure = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in ('crank_length', 'coupler_length', 'rocker_length'):
+        for name in LINK_LENGTHS:
             value = getattr(self, name)
-            if not _is_real(value) or not MIN_LENGTH <= value <= MAX_LENGTH:
+            if not _is_real(value) or not MIN_SOLVABLE_LENGTH <= value <= MAX_SOLVABLE_LENGTH:
                 raise GeometryError(
-                    f'{name} must be a length from {MIN_LENGTH:g} to {MAX_LENGTH:g} m, '
-                    f'got {value!r}'
+                    f'{name} must be a length from {MIN_SOLVABLE_LENGTH:g} to '
+                    f'{MAX_SOLVABLE_LENGTH:g} m, got {value!r}'
                 )
-        for name in ('ground_x', 'ground_y'):
+        for name in GROUND_COORDINATES:
             value = getattr(self, name)
-            if not _is_real(value) or not abs(value) <= MAX_LENGTH:
+            if not _is_real(value) or not abs(value) <= MAX_SOLVABLE_LENGTH:
                 raise GeometryError(
-                    f'{name} must be a coordinate from {-MAX_LENGTH:g} to {MAX_LENGTH:g} m, '
-                    f'got {value!r}'
+                    f'{name} must be a coordinate from {-MAX_SOLVABLE_LENGTH:g} to '
+                    f'{MAX_SOLVABLE_LENGTH:g} m, got {value!r}'
                 )
         closure, reachability = _loop_closure(self)
         object.__setattr__(self, 'closure', _closure_constants(self, closure))

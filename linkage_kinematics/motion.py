@@ -18,7 +18,7 @@ import math
 
 from linkage_kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics import continued_branch, LinkageState, solve
-from linkage_kinematics.parameters import RunConfiguration
+from linkage_kinematics.parameters import EndBehavior, RunConfiguration
 
 
 @dataclass(frozen=True)
@@ -54,7 +54,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
     None when a 'stop' motion has reached a dead point before alpha_end: the crank cannot go on.
     """
     duration = config.segment_duration
-    if config.end_behavior == 'stop':
+    if config.end_behavior == EndBehavior.STOP:
         if elapsed >= duration:
             if config.blocked_at is not None:
                 return None
@@ -63,7 +63,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
             _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, elapsed)),
             motion_time=elapsed,
         )
-    if config.end_behavior == 'loop':
+    if config.end_behavior == EndBehavior.LOOP:
         passes = math.floor(elapsed / duration)
         in_pass = elapsed - passes * duration
         return MotionSample(
@@ -73,6 +73,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
             motion_time=elapsed,
             pass_index=passes,
         )
+    # EndBehavior.BOUNCE
     cycles = math.floor(elapsed / (2.0 * duration))
     in_cycle = elapsed - cycles * 2.0 * duration
     backwards = in_cycle > duration
@@ -104,13 +105,13 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
     def time_of(alpha: float) -> float:
         return config.drive.time_to(config.alpha_start, alpha)
 
-    if config.end_behavior == 'stop':
+    if config.end_behavior == EndBehavior.STOP:
         if step >= points:
             return None
         alpha = _step_alpha(config, step)
         return MotionSample(alpha, motion_time=time_of(alpha), final=(
             config.blocked_at is None and step == points - 1))
-    if config.end_behavior == 'loop':
+    if config.end_behavior == EndBehavior.LOOP:
         # Over whole turns the end of one pass is the start of the next: visit it once.
         per_pass = config.step_count if config.whole_turns else points
         passes, index = divmod(step, per_pass)
@@ -122,6 +123,7 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
             motion_time=passes * duration + time_of(alpha),
             pass_index=passes,
         )
+    # EndBehavior.BOUNCE
     per_cycle = max(2 * (points - 1), 1)
     cycles, index = divmod(step, per_cycle)
     if index < points:
@@ -155,9 +157,9 @@ def blocked_note(config: RunConfiguration) -> str | None:
     if config.blocked_at is None:
         return None
     outcome = {
-        'stop': 'the run will end there with an error',
-        'loop': 'the crank restarts from alpha_start there',
-        'bounce': 'the crank reverses there',
+        EndBehavior.STOP: 'the run will end there with an error',
+        EndBehavior.LOOP: 'the crank restarts from alpha_start there',
+        EndBehavior.BOUNCE: 'the crank reverses there',
     }[config.end_behavior]
     return (
         f'dead point at {math.degrees(config.blocked_at):.6f}° before alpha_end = '
@@ -174,7 +176,7 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
     """
     if config.blocked_at is None or current_pass <= previous_pass:
         return False
-    if config.end_behavior == 'bounce':
+    if config.end_behavior == EndBehavior.BOUNCE:
         return previous_pass % 2 == 0 or current_pass - previous_pass >= 2
     return True
 
@@ -182,9 +184,9 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
 def dead_point_problem(config: RunConfiguration) -> str:
     """Return the ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
     outcome = {
-        'stop': 'stops; the run cannot go on',
-        'loop': 'restarts from alpha_start',
-        'bounce': 'reverses',
+        EndBehavior.STOP: 'stops; the run cannot go on',
+        EndBehavior.LOOP: 'restarts from alpha_start',
+        EndBehavior.BOUNCE: 'reverses',
     }[config.end_behavior]
     return (
         f'the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° '

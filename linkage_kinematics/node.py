@@ -42,6 +42,8 @@ from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
     describe_value,
+    EndBehavior,
+    MotionMode,
     NO_CPU_AFFINITY,
     NODE_NAME,
     PARAMETER_NAMES,
@@ -457,7 +459,7 @@ class LinkageNode(Node):
         In fixed_step mode the timer is re-armed for each step's time, and this first period only
         starts it.
         """
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             return 1.0 / self.config.rate_hz
         return 1e-3
 
@@ -488,7 +490,7 @@ class LinkageNode(Node):
             # First tick, or ROS time jumped back (e.g. a simulation restarted): start over.
             self._restart_motion()
             self._motion_start = now
-        if self.config.mode == 'real_time':
+        if self.config.mode == MotionMode.REAL_TIME:
             self._advance_in_real_time(now)
         else:
             self._advance_steps(now)
@@ -542,7 +544,7 @@ class LinkageNode(Node):
         try:
             state = solve_sample(config, sample)
         except (DeadPointError, UnreachableError) as error:
-            if config.end_behavior == 'stop':
+            if config.end_behavior == EndBehavior.STOP:
                 self._cannot_go_on(str(error))
             # loop and bounce turn round at the dead point itself, which has no state to show.
             return
@@ -728,8 +730,8 @@ class LinkageNode(Node):
         config = self.config
         values = {
             'run state': self._control.state.value,
-            'end behavior': config.end_behavior,
-            'mode': config.mode,
+            'end behavior': config.end_behavior.value,
+            'mode': config.mode.value,
             'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
             'rate_hz': f'{config.rate_hz:g}',
             'missed deadlines': str(self._missed_deadlines),

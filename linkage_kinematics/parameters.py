@@ -14,14 +14,18 @@ from __future__ import annotations
 from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, replace
 import difflib
+from enum import StrEnum
 import math
 from pathlib import Path
 from typing import Any
 
 from linkage_kinematics.drive import DriveError, DriveLaw
 from linkage_kinematics.geometry import (
+    DIMENSIONS,
     FourBar,
     GeometryError,
+    GROUND_COORDINATES,
+    LINK_LENGTHS,
     preset,
     TWO_PI,
     UnreachableError,
@@ -31,14 +35,13 @@ from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 import yaml
 
 NODE_NAME = 'linkage_node'
-END_BEHAVIORS = ('stop', 'loop', 'bounce')
-MODES = ('real_time', 'fixed_step')
-GEOMETRY_PARAMETERS = ('crank_length', 'coupler_length', 'rocker_length', 'ground_x', 'ground_y')
 MAX_RATE_HZ = 10000.0
 MAX_DISPLAY_RATE_HZ = 1000.0
 MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
 NO_CPU_AFFINITY = -1
-MAX_LENGTH = 1e6  # m; lengths and ground coordinates, far beyond any mechanism
+# m; the largest length and |ground coordinate| the node's parameters take, far beyond any
+# mechanism (geometry.MAX_SOLVABLE_LENGTH is what the library itself can solve)
+MAX_PARAMETER_LENGTH = 1e6
 MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
 MAX_OMEGA0 = 1e4  # rad/s
 MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
@@ -50,6 +53,21 @@ MIN_PASS_DURATION = 1e-6
 _STEP_COUNT_TOLERANCE = 1e-9
 # α − alpha_start within this of a whole number of turns is a whole-turn loop.
 _WHOLE_TURN_TOLERANCE = 1e-9
+
+
+class EndBehavior(StrEnum):
+    """What the crank does at the end of a pass: parameter ``end_behavior``, by its value."""
+
+    STOP = 'stop'
+    LOOP = 'loop'
+    BOUNCE = 'bounce'
+
+
+class MotionMode(StrEnum):
+    """When the node computes and publishes a state: parameter ``mode``, by its value."""
+
+    REAL_TIME = 'real_time'
+    FIXED_STEP = 'fixed_step'
 
 
 class ConfigurationError(ValueError):
@@ -78,8 +96,8 @@ class RunConfiguration:
     branch: int
     alpha_start: float
     alpha_end: float
-    end_behavior: str
-    mode: str
+    end_behavior: EndBehavior
+    mode: MotionMode
     alpha_step: float
     rate_hz: float
     display_rate_hz: float
@@ -131,6 +149,15 @@ class ParameterSpec:
     integer_range: tuple[int, int, int] | None = None
 
 
+_DIMENSION_TEXTS = {
+    'crank_length': 'disk radius OA, greater than 0',
+    'coupler_length': 'coupler length AB, greater than 0',
+    'rocker_length': 'rocker length BC, greater than 0',
+    'ground_x': 'x of the fixed pivot C relative to O',
+    'ground_y': 'y of the fixed pivot C relative to O',
+}
+
+
 def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
     """All parameters; the geometry defaults come from ``preset_name`` ('' → no defaults)."""
     geometry = preset(preset_name).geometry if preset_name else None
@@ -138,16 +165,12 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec(
             name,
             getattr(geometry, name) if geometry is not None else None,
-            f"{text} (m); defaults to the preset's value, required when preset is ''",
-            floating_range=limits,
+            f"{_DIMENSION_TEXTS[name]} (m); defaults to the preset's value, required when preset "
+            "is ''",
+            floating_range=((0.0 if name in LINK_LENGTHS else -MAX_PARAMETER_LENGTH),
+                            MAX_PARAMETER_LENGTH),
         )
-        for name, text, limits in (
-            ('crank_length', 'disk radius OA, greater than 0', (0.0, MAX_LENGTH)),
-            ('coupler_length', 'coupler length AB, greater than 0', (0.0, MAX_LENGTH)),
-            ('rocker_length', 'rocker length BC, greater than 0', (0.0, MAX_LENGTH)),
-            ('ground_x', 'x of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
-            ('ground_y', 'y of the fixed pivot C relative to O', (-MAX_LENGTH, MAX_LENGTH)),
-        )
+        for name in DIMENSIONS
     )
     return (
         ParameterSpec(
@@ -172,9 +195,9 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                       floating_range=(-MAX_ANGLE, MAX_ANGLE)),
         # A node runs until it is stopped, as every ROS node does: by default the crank swings
         # to and fro over its pass, which suits the paper's mechanism (it cannot turn fully).
-        ParameterSpec('end_behavior', 'bounce',
+        ParameterSpec('end_behavior', EndBehavior.BOUNCE.value,
                       'at the end of a pass: stop (and exit), loop or bounce'),
-        ParameterSpec('mode', 'real_time',
+        ParameterSpec('mode', MotionMode.REAL_TIME.value,
                       'real_time: α from node-clock time at rate_hz; fixed_step: steps of '
                       'alpha_step, each published when the drive law reaches it'),
         ParameterSpec('alpha_step', math.radians(0.5),
@@ -306,18 +329,18 @@ def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
             preset(preset_name)
         except GeometryError as error:
             raise ConfigurationError('preset', str(error)) from None
-    for name in GEOMETRY_PARAMETERS:
+    for name in DIMENSIONS:
         if values.get(name) is None:
             raise ConfigurationError(name, "has no value: with preset '' all five of "
-                                     f"{', '.join(GEOMETRY_PARAMETERS)} must be given")
-    for name in ('crank_length', 'coupler_length', 'rocker_length'):
-        _positive(values, name, 'm', MAX_LENGTH)
-    for name in ('ground_x', 'ground_y'):
-        _within(values, name, -MAX_LENGTH, MAX_LENGTH, 'm')
+                                     f"{', '.join(DIMENSIONS)} must be given")
+    for name in LINK_LENGTHS:
+        _positive(values, name, 'm', MAX_PARAMETER_LENGTH)
+    for name in GROUND_COORDINATES:
+        _within(values, name, -MAX_PARAMETER_LENGTH, MAX_PARAMETER_LENGTH, 'm')
     try:
-        linkage = FourBar(*(_real(values, name) for name in GEOMETRY_PARAMETERS))
+        linkage = FourBar(**{name: _real(values, name) for name in DIMENSIONS})
     except GeometryError as error:
-        raise ConfigurationError(', '.join(GEOMETRY_PARAMETERS), str(error)) from None
+        raise ConfigurationError(', '.join(DIMENSIONS), str(error)) from None
     return preset_name, linkage
 
 
@@ -382,8 +405,8 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     drive = DriveLaw(omega0, k)
     alpha_start = _within(values, 'alpha_start', -MAX_ANGLE, MAX_ANGLE)
     alpha_end = _within(values, 'alpha_end', -MAX_ANGLE, MAX_ANGLE)
-    end_behavior = _text(values, 'end_behavior', END_BEHAVIORS)
-    mode = _text(values, 'mode', MODES)
+    end_behavior = EndBehavior(_text(values, 'end_behavior', tuple(EndBehavior)))
+    mode = MotionMode(_text(values, 'mode', tuple(MotionMode)))
     alpha_step = _positive(values, 'alpha_step', 'rad', TWO_PI)
     rate_hz = _positive(values, 'rate_hz', 'Hz', MAX_RATE_HZ)
     display_rate_hz = _positive(values, 'display_rate_hz', 'Hz', MAX_DISPLAY_RATE_HZ)

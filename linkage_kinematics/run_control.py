@@ -12,11 +12,11 @@ that a paused motion goes on where it stopped. README.md documents the services.
 from __future__ import annotations
 
 from dataclasses import dataclass
-import enum
+from enum import StrEnum
 import math
 
 
-class RunState(enum.Enum):
+class RunState(StrEnum):
     """Whether the crank moves; the value is what diagnostics show."""
 
     RUNNING = 'running'

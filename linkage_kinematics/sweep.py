@@ -28,7 +28,14 @@ import unicodedata
 from linkage_kinematics.bag_reader import bag_files, BagError, read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, GeometryError, preset, PRESETS, UnreachableError
+from linkage_kinematics.geometry import (
+    DIMENSIONS,
+    FourBar,
+    GeometryError,
+    preset,
+    PRESETS,
+    UnreachableError,
+)
 from linkage_kinematics.kinematics import (
     continued_branch,
     DeadPointError,
@@ -48,7 +55,6 @@ DEFAULT_TURN_DEG = 90.0
 DEFAULT_OMEGA0 = 2.0
 # A sweep this long is already about 200 MB of CSV; more is almost surely a mistyped step.
 MAX_ROWS = 1_000_000
-_GEOMETRY_OPTIONS = ('crank_length', 'coupler_length', 'rocker_length', 'ground_x', 'ground_y')
 _ANGLE_COLUMNS = (('α (°)', 'alpha_deg'), ('β (°)', 'beta_deg'), ('γ (°)', 'gamma_deg'))
 _VELOCITY_COLUMNS = _ANGLE_COLUMNS + (
     ('V_A (m/s)', 'v_a'),
@@ -229,7 +235,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         conflicting = [
             '--' + name.replace('_', '-')
             for name in ('preset', 'omega0', 'k', 'branch', 'alpha_start', 'alpha_end',
-                         'alpha_step', *_GEOMETRY_OPTIONS)
+                         'alpha_step', *DIMENSIONS)
             if getattr(args, name) is not None
         ]
         if conflicting:
@@ -278,7 +284,7 @@ def _computed_sweep(args: argparse.Namespace) -> tuple[LinkageState, np.ndarray,
     preset_name = args.preset or 'paper'
     chosen = preset(preset_name)
     overrides = {
-        name: getattr(args, name) for name in _GEOMETRY_OPTIONS if getattr(args, name) is not None
+        name: getattr(args, name) for name in DIMENSIONS if getattr(args, name) is not None
     }
     linkage = dataclasses.replace(chosen.geometry, **overrides) if overrides else chosen.geometry
     omega0 = DEFAULT_OMEGA0 * chosen.drive_sign if args.omega0 is None else args.omega0
