@@ -171,6 +171,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     from linkage_kinematics.node import LinkageNode
     import rclpy
     from rclpy.parameter import Parameter
+    from rclpy.serialization import deserialize_message
     from sensor_msgs.msg import JointState
 
     count = 300 if quick else 1500
@@ -199,12 +200,13 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
             state = solve_sample(config, samples[0])
             stamp = clock.now()
-            bare_message = messages.joint_state(state, stamp.to_msg())
             joint_state_encoder = messages.JointStateEncoder()
             state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
             positions = messages.joint_positions(state)
             joint_state_data = joint_state_encoder.encode(state, stamp.nanoseconds, positions)
             trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
+            # the node's own JointState, as a subscriber's rclpy decodes it
+            bare_message = deserialize_message(joint_state_data, JointState)
             time.sleep(STARTUP_S)  # let the listener match both publishers
 
             def compute() -> int:

@@ -19,7 +19,7 @@ import subprocess
 import sys
 
 from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
-from linkage_kinematics.bag_reader import BagError, read_states
+from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.sweep import format_tables, write_plot
 
@@ -67,7 +67,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             bag = _run_node(config_folder / params_name, arguments.log_folder)
             _stamps, state = read_states(bag)
-        except (RuntimeError, OSError, BagError) as error:
+        except (RuntimeError, OSError) as error:  # a BagError is an OSError
             print(f'linkage-demo: {title}: {error}', file=sys.stderr)
             return 1
         figure = bag.parent / f'{bag.name}.png'

@@ -2,13 +2,16 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-ROS messages built from a LinkageState: the node's topics, reusable by benchmarks and tools.
+The node's messages, from a LinkageState: one way to make each.
 
-Each builder is a plain function of the library's state (plus a stamp); none computes any
-kinematics. The node does not build its per-tick messages and the scene: their encoders
-(``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write the same bytes
-as ``encode_cdr`` of the builders' messages straight from the state, from the same value
-functions, into a layout prepared once per geometry (``recording.FixedShapeEncoder``).
+The per-tick messages and the scene are never built as rclpy messages: their encoders
+(``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write their CDR bytes
+straight from the state into a layout prepared once per geometry from a template message
+(``bag.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
+describe. The diagnostics are built (``diagnostic_array``) and encoded by ``encode_cdr``. None
+of this computes any kinematics: the values come from the value functions here
+(``joint_positions``, ``joint_velocities``, ``disk_orientation``) and from
+``bag.state_layout``. Colours and sizes come from ``scene``.
 """
 
 from __future__ import annotations
@@ -16,13 +19,14 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 import math
 
-from builtin_interfaces.msg import Duration, Time
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
-from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
+from linkage_kinematics import scene
+from linkage_kinematics.bag.cdr import FixedShapeEncoder
+from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
-from linkage_kinematics.recording import FixedShapeEncoder
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
@@ -33,33 +37,10 @@ MARKER_NAMESPACE = 'linkage'
 # Marker ids are fixed so that every MarkerArray updates the same markers in place.
 DISK_ID, BARS_ID, PIN_A_ID, PIN_B_ID, PIVOT_O_ID, PIVOT_C_ID = range(6)
 
-_DISK_THICKNESS = 0.01  # m; the disk is drawn just below the plane of the bars
-_BAR_WIDTH = 0.02  # m
-_PIN_DIAMETER = 0.05  # m
-_PIVOT_SIZE = 0.07  # m
 
-
-def _color(red: float, green: float, blue: float, alpha: float = 1.0) -> ColorRGBA:
-    return ColorRGBA(r=red, g=green, b=blue, a=alpha)
-
-
-DISK_COLOR = _color(0.55, 0.6, 0.7, 0.6)
-CRANK_COLOR = _color(0.2, 0.3, 0.9)
-COUPLER_COLOR = _color(0.95, 0.55, 0.1)
-ROCKER_COLOR = _color(0.15, 0.7, 0.3)
-PIN_COLOR = _color(0.85, 0.1, 0.1)
-PIVOT_COLOR = _color(0.15, 0.15, 0.15)
-
-
-def time_msg(nanoseconds: int) -> Time:
-    """Return a builtin_interfaces/Time from integer nanoseconds."""
-    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
-
-
-def duration_msg(seconds: float) -> Duration:
-    """Return a builtin_interfaces/Duration from (non-negative) seconds."""
-    sec, nanosec = duration_fields(seconds)
-    return Duration(sec=sec, nanosec=nanosec)
+def _color(color: scene.Rgba, alpha: float | None = None) -> ColorRGBA:
+    return ColorRGBA(r=color.red, g=color.green, b=color.blue,
+                     a=color.alpha if alpha is None else alpha)
 
 
 def duration_fields(seconds: float) -> tuple[int, int]:
@@ -92,21 +73,13 @@ def joint_velocities(state: LinkageState) -> tuple[float, float, float]:
     return (state.omega, state.omega_ab - state.omega, state.omega_bc - state.omega_ab)
 
 
-def joint_state(
-    state: LinkageState,
-    stamp: Time,
-    previous_positions: Sequence[float] = (0.0, 0.0, 0.0),
-) -> JointState:
-    """/joint_states: the URDF's three joints; frame_id stays empty as joint_state_publisher's."""
-    message = JointState(name=list(JOINT_NAMES))
-    message.header.stamp = stamp
-    message.position = joint_positions(state, previous_positions)
-    message.velocity = joint_velocities(state)
-    return message
-
-
 class JointStateEncoder:
-    """The bytes of ``joint_state`` (encode_cdr), straight from a state."""
+    """
+    The bytes of ``joint_states``, straight from a state.
+
+    The URDF's three joints (``JOINT_NAMES``) with ``joint_positions`` and ``joint_velocities``;
+    frame_id stays empty, as joint_state_publisher's.
+    """
 
     def __init__(self) -> None:
         template = JointState(name=list(JOINT_NAMES), position=[0.0] * 3, velocity=[0.0] * 3)
@@ -123,71 +96,13 @@ class JointStateEncoder:
         )
 
 
-def state_coordinates(
-    linkage: FourBar, state: LinkageState
-) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
-    """
-    Return the positions.
-
-    Velocities and accelerations of ``STATE_JOINT_NAMES`` (see ``linkage_state``).
-    """
-    crank = linkage.crank_length
-    rocker = linkage.rocker_length
-    return (
-        (
-            state.alpha, state.beta, state.gamma,
-            state.pin_a_x, state.pin_a_y, state.pin_b_x, state.pin_b_y,
-            math.pi - state.beta, crank * state.alpha, rocker * state.beta,
-        ),
-        (
-            state.omega, -state.omega_bc, state.omega_ab,
-            state.velocity_a_x, state.velocity_a_y, state.velocity_b_x, state.velocity_b_y,
-            state.omega_bc, crank * state.omega, -rocker * state.omega_bc,
-        ),
-        (
-            state.omega_dot, -state.omega_dot_bc, state.omega_dot_ab,
-            state.acceleration_a_x, state.acceleration_a_y,
-            state.acceleration_b_x, state.acceleration_b_y,
-            state.omega_dot_bc, crank * state.omega_dot, -rocker * state.omega_dot_bc,
-        ),
-    )
-
-
-def linkage_state(
-    linkage: FourBar,
-    state: LinkageState,
-    stamp: Time,
-    motion_time: float,
-    frame_id: str,
-) -> JointTrajectory:
-    """
-    /linkage/state: the full state as one trajectory point (see README, "Topics").
-
-    ``positions``, ``velocities`` and ``accelerations`` hold each coordinate of
-    ``STATE_JOINT_NAMES`` and its first and second time derivatives: α, β, γ, A_x, A_y, B_x,
-    B_y, then the rocker angle θ_BC = π − β (rates ω_BC, ω̇_BC) and the arc coordinates of the
-    pins along their circles, OA·α (rate V_A = OA·ω) and BC·β (rate V_B = −BC·ω_BC), so that
-    every quantity of the paper is one plain field. ``motion_time`` (s) is the drive-law time
-    since the motion left alpha_start.
-    """
-    positions, velocities, accelerations = state_coordinates(linkage, state)
-    point = JointTrajectoryPoint(
-        positions=positions,
-        velocities=velocities,
-        accelerations=accelerations,
-        time_from_start=duration_msg(motion_time),
-    )
-    message = JointTrajectory(joint_names=list(STATE_JOINT_NAMES), points=[point])
-    message.header.stamp = stamp
-    message.header.frame_id = frame_id
-    return message
-
-
 class LinkageStateEncoder:
     """
-    The bytes of ``linkage_state`` (encode_cdr) of one linkage and frame.
+    The bytes of ``linkage/state`` of one linkage and frame, straight from a state.
 
-    Straight from a state.
+    The full state as one trajectory point (README, "Topics"): the coordinates of
+    ``bag.state_layout``, and as ``time_from_start`` the drive-law time since the motion left
+    alpha_start.
     """
 
     def __init__(self, linkage: FourBar, frame_id: str) -> None:
@@ -203,6 +118,7 @@ class LinkageStateEncoder:
         ])
 
     def encode(self, state: LinkageState, stamp_ns: int, motion_time: float) -> bytes:
+        """Return the message of ``state`` stamped ``stamp_ns``, ``motion_time`` s in."""
         positions, velocities, accelerations = state_coordinates(self._linkage, state)
         return self._encoder.encode((
             *divmod(stamp_ns, 1_000_000_000), *positions, *velocities, *accelerations,
@@ -227,39 +143,13 @@ def disk_orientation(state: LinkageState) -> tuple[float, float]:
     return math.sin(0.5 * state.alpha), math.cos(0.5 * state.alpha)
 
 
-def marker_array(
-    linkage: FourBar,
-    state: LinkageState,
-    stamp: Time,
-    frame_id: str,
-) -> MarkerArray:
-    """
-    /linkage/markers.
-
-    Disk (CYLINDER at O), the three bars (one LINE_LIST coloured per bar), pins A and B (SPHEREs)
-    and the ground pivots O and C (CUBEs), in namespace ``linkage``.
-    """
-    message = _new_marker_array(linkage, frame_id)
-    disk, bars, pin_a, pin_b, pivot_o, pivot_c = message.markers
-    pin_a_point = Point(x=state.pin_a_x, y=state.pin_a_y)
-    pin_b_point = Point(x=state.pin_b_x, y=state.pin_b_y)
-    bars.points[1] = pin_a_point
-    bars.points[2] = pin_a_point
-    bars.points[3] = pin_b_point
-    bars.points[4] = pin_b_point
-    pin_a.pose.position = pin_a_point
-    pin_b.pose.position = pin_b_point
-    disk.pose.orientation.z, disk.pose.orientation.w = disk_orientation(state)
-    for marker in message.markers:
-        marker.header.stamp = stamp
-    return message
-
-
 class MarkerArrayEncoder:
     """
-    The bytes of ``marker_array`` (encode_cdr) of one linkage and frame.
+    The bytes of ``linkage/markers`` of one linkage and frame, straight from a state.
 
-    Straight from a state.
+    Disk (CYLINDER at O, turned by α), the three bars (one LINE_LIST coloured per bar), pins A
+    and B (SPHEREs) and the ground pivots O and C (CUBEs), in namespace ``linkage``, every
+    marker stamped with the state's time.
     """
 
     _PIN_A_PATHS = (f'markers[{BARS_ID}].points[1]', f'markers[{BARS_ID}].points[2]',
@@ -279,6 +169,7 @@ class MarkerArrayEncoder:
         self._encoder = FixedShapeEncoder(template, varying)
 
     def encode(self, state: LinkageState, stamp_ns: int) -> bytes:
+        """Return the scene of ``state`` stamped ``stamp_ns``."""
         pin_a = (state.pin_a_x, state.pin_a_y)
         pin_b = (state.pin_b_x, state.pin_b_y)
         return self._encoder.encode((
@@ -289,30 +180,32 @@ class MarkerArrayEncoder:
 
 
 def _new_marker_array(linkage: FourBar, frame_id: str) -> MarkerArray:
-    disk = _marker(DISK_ID, Marker.CYLINDER, frame_id, DISK_COLOR)
-    disk.pose.position.z = -_DISK_THICKNESS
+    crank, coupler, rocker = (
+        _color(scene.CRANK_COLOR), _color(scene.COUPLER_COLOR), _color(scene.ROCKER_COLOR))
+    disk = _marker(DISK_ID, Marker.CYLINDER, frame_id,
+                   _color(scene.DISK_COLOR, scene.DISK_MARKER_ALPHA))
+    disk.pose.position.z = -scene.DISK_THICKNESS
     disk.scale.x = disk.scale.y = 2.0 * linkage.crank_length
-    disk.scale.z = _DISK_THICKNESS
+    disk.scale.z = scene.DISK_THICKNESS
 
-    bars = _marker(BARS_ID, Marker.LINE_LIST, frame_id, CRANK_COLOR)
-    bars.scale.x = _BAR_WIDTH
+    bars = _marker(BARS_ID, Marker.LINE_LIST, frame_id, crank)
+    bars.scale.x = scene.BAR_WIDTH
     ground_c = Point(x=linkage.ground_x, y=linkage.ground_y)
     # O→A, A→B, B→C; points 1–4 are replaced with A and B on every update.
     bars.points = [Point(), Point(), Point(), Point(), Point(), ground_c]
-    bars.colors = [CRANK_COLOR, CRANK_COLOR, COUPLER_COLOR, COUPLER_COLOR,
-                   ROCKER_COLOR, ROCKER_COLOR]
+    bars.colors = [crank, crank, coupler, coupler, rocker, rocker]
 
     pins = []
     for marker_id in (PIN_A_ID, PIN_B_ID):
-        pin = _marker(marker_id, Marker.SPHERE, frame_id, PIN_COLOR)
-        pin.scale.x = pin.scale.y = pin.scale.z = _PIN_DIAMETER
+        pin = _marker(marker_id, Marker.SPHERE, frame_id, _color(scene.PIN_COLOR))
+        pin.scale.x = pin.scale.y = pin.scale.z = scene.PIN_DIAMETER
         pins.append(pin)
 
     pivots = []
     for marker_id, position in ((PIVOT_O_ID, Point()), (PIVOT_C_ID, ground_c)):
-        pivot = _marker(marker_id, Marker.CUBE, frame_id, PIVOT_COLOR)
+        pivot = _marker(marker_id, Marker.CUBE, frame_id, _color(scene.PIVOT_COLOR))
         pivot.pose.position = position
-        pivot.scale.x = pivot.scale.y = pivot.scale.z = _PIVOT_SIZE
+        pivot.scale.x = pivot.scale.y = pivot.scale.z = scene.PIVOT_SIZE
         pivots.append(pivot)
     return MarkerArray(markers=[disk, bars, *pins, *pivots])
 

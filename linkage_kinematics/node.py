@@ -18,15 +18,19 @@ from collections.abc import Callable
 import json
 import math
 import os
+import re
 import signal
 import sys
 import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import bag_reader, messages
-from linkage_kinematics.bag_writer import package_version
-from linkage_kinematics.bag_writer_process import set_process_affinity
+from linkage_kinematics import messages
+from linkage_kinematics.bag.cdr import encode_cdr
+from linkage_kinematics.bag.errors import LogFolderError
+from linkage_kinematics.bag.metadata import BagMetadata, package_version
+from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.bag.writer_process import set_process_affinity
 from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
 from linkage_kinematics.motion import (
@@ -53,7 +57,6 @@ from linkage_kinematics.parameters import (
     RunConfiguration,
     unknown_parameters,
 )
-from linkage_kinematics.recording import encode_cdr, Recorder
 from linkage_kinematics.run_control import RunControl, ServiceAnswer
 from linkage_kinematics.urdf import urdf_text
 from rcl_interfaces.msg import (
@@ -92,14 +95,19 @@ ROBOT_DESCRIPTION_QOS = QoSProfile(
 )
 
 
+class StartupError(Exception):
+    """The node cannot start for a reason other than a parameter; the message names it."""
+
+
 def parameter_descriptor(spec: ParameterSpec, with_range: bool = True) -> ParameterDescriptor:
-    """Return the ROS descriptor of a parameter (its range only ``with_range``)."""
+    """Return a parameter's ROS descriptor (range and read-only flag only ``with_range``)."""
     # dynamic_typing lets a wrongly typed value reach build_configuration, whose message
     # names the parameter; rclpy's own type check does not.
     descriptor = ParameterDescriptor(
         name=spec.name,
         description=spec.description,
-        read_only=spec.read_only,
+        # rclpy refuses a later descriptor, with its range, for a read-only parameter
+        read_only=spec.read_only and with_range,
         dynamic_typing=True,
     )
     if with_range and spec.floating_range is not None:
@@ -178,7 +186,8 @@ class LinkageNode(Node):
         # Ranges go into the descriptors only now, so that a bad start-up value gets
         # build_configuration's message; from here on rclpy enforces them too.
         for spec in specs:
-            if spec.floating_range is not None or spec.integer_range is not None:
+            if (spec.floating_range is not None or spec.integer_range is not None
+                    or spec.read_only):
                 self.set_descriptor(spec.name, parameter_descriptor(spec))
         if blocked_note(self.config) is not None:
             self.get_logger().warning(blocked_note(self.config))
@@ -387,25 +396,29 @@ class LinkageNode(Node):
         """
         Return a recorder for every topic, before anything is published.
 
-        ConfigurationError naming log.folder if it cannot be written.
+        ConfigurationError naming log.folder if it cannot be written; StartupError for any other
+        reason, such as a message definition that cannot be found (before any folder is made).
         """
         metadata = {
             'parameters': json.dumps(self.parameter_values(), sort_keys=True),
             'package_version': package_version(),
         }
+        # The latest status starts every file of a split bag, as the latched URDF does.
+        topics = [
+            (topic, publisher.msg_type, publisher.qos_profile,
+             True if topic == self._diagnostics_topic else None)
+            for topic, publisher in self._topic_publishers.items()
+        ]
         try:
-            recorder = Recorder(
-                self.config.log_folder, metadata=metadata, cpus=self._bag_writer_cpus
+            return Recorder(
+                self.config.log_folder, topics=topics, metadata=metadata,
+                cpus=self._bag_writer_cpus, max_bag_size=self.config.log_max_bag_size,
+                max_bag_duration=self.config.log_max_bag_duration,
             )
-        except OSError as error:
+        except LogFolderError as error:
             raise ConfigurationError('log.folder', str(error)) from None
-        try:
-            for topic, publisher in self._topic_publishers.items():
-                recorder.add_topic(topic, publisher.msg_type, publisher.qos_profile)
-        except OSError as error:
-            recorder.close()
-            raise ConfigurationError('log.folder', str(error)) from None
-        return recorder
+        except OSError as error:  # every BagError
+            raise StartupError(f'cannot record: {error}') from None
 
     def _publish(self, topic: str, message: Any, log_time_ns: int) -> None:
         self._send(topic, encode_cdr(message), log_time_ns)
@@ -446,7 +459,7 @@ class LinkageNode(Node):
             self.get_logger().error(f'could not finalize the log: {error}')
             return False
         bag = self._recorder.bag_path
-        count = bag_reader.bag_information(bag)['message_count']
+        count = BagMetadata.read(bag).message_count
         self.get_logger().info(f'bag finalized: {bag}, {count} messages')
         return True
 
@@ -766,21 +779,27 @@ class LinkageNode(Node):
 # --- process ------------------------------------------------------------------------------
 
 
-def _report_configuration_error(error: ConfigurationError) -> None:
+def _report_start_up_failure(text: str) -> None:
     """
-    Return the one line saying which parameter is bad and why.
+    Report the one line saying why the node cannot start.
 
     To the node's logger (console, /rosout, log file) and plainly to stderr.
     """
-    get_logger(NODE_NAME).fatal(f'invalid parameter {error}')
-    print(f'{NODE_NAME}: invalid parameter {error}', file=sys.stderr, flush=True)
+    get_logger(NODE_NAME).fatal(text)
+    print(f'{NODE_NAME}: {text}', file=sys.stderr, flush=True)
 
 
 def main(args: list[str] | None = None) -> int:
     """Run the node until it finishes, or until SIGINT or SIGTERM; return the exit status."""
     # rclpy's own SIGINT handler would shut the context down under our feet; ours lets the
     # loop below finalize the log first.
-    rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    try:
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
+    except RuntimeError as error:  # rclpy's RCLError: ROS arguments rcl cannot use
+        # rcl's text, without the source locations it appends ('…, at /src/rcl/x.c:352')
+        _report_start_up_failure(
+            'cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
+        return EXIT_CONFIGURATION
     received: list[int] = []
 
     def request_stop(signal_number: int, _frame: object) -> None:
@@ -792,7 +811,10 @@ def main(args: list[str] | None = None) -> int:
         try:
             node = LinkageNode()
         except ConfigurationError as error:
-            _report_configuration_error(error)
+            _report_start_up_failure(f'invalid parameter {error}')
+            return EXIT_CONFIGURATION
+        except StartupError as error:
+            _report_start_up_failure(str(error))
             return EXIT_CONFIGURATION
         # The events executor dispatches timers and services from C++ instead of rebuilding a
         # wait set in Python for every callback: at 1 kHz it halves the process's CPU

@@ -19,6 +19,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from linkage_kinematics.bag.writer import MIN_SPLIT_SIZE, NO_SPLIT
 from linkage_kinematics.drive import DriveError, DriveLaw
 from linkage_kinematics.geometry import (
     DIMENSIONS,
@@ -37,6 +38,8 @@ import yaml
 NODE_NAME = 'linkage_node'
 MAX_RATE_HZ = 10000.0
 MAX_DISPLAY_RATE_HZ = 1000.0
+MAX_BAG_SIZE = 2**63 - 1  # bytes; the largest int64 parameter
+MAX_BAG_DURATION = 1e9  # s, about 32 years
 MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
 NO_CPU_AFFINITY = -1
 # m; the largest length and |ground coordinate| the node's parameters take, far beyond any
@@ -107,6 +110,8 @@ class RunConfiguration:
     dead_point_warning: float
     log_enabled: bool
     log_folder: Path
+    log_max_bag_size: int
+    log_max_bag_duration: float
     cpu_affinity: int
     autostart: bool
     direction: int
@@ -229,6 +234,14 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec('log.folder', 'bags',
                       'folder that receives a new bag per run (relative to the working '
                       'directory)', read_only=True),
+        ParameterSpec('log.max_bag_size', NO_SPLIT,
+                      "bytes after which the bag goes on in a new file (rosbag2's "
+                      f'--max-bag-size); 0 never splits, else at least {MIN_SPLIT_SIZE}',
+                      read_only=True, integer_range=(NO_SPLIT, MAX_BAG_SIZE, 1)),
+        ParameterSpec('log.max_bag_duration', float(NO_SPLIT),
+                      "seconds after which the bag goes on in a new file (rosbag2's "
+                      '--max-bag-duration, here also a fraction); 0 never splits',
+                      read_only=True, floating_range=(0.0, MAX_BAG_DURATION)),
         ParameterSpec('cpu_affinity', NO_CPU_AFFINITY,
                       "CPU that every thread of the node's process runs on, its bag writer "
                       "process on the others (as ros2_control's cpu_affinity); -1 leaves "
@@ -316,6 +329,18 @@ def _cpu(values: Mapping[str, Any]) -> int:
             'cpu_affinity',
             f'must be {NO_CPU_AFFINITY} (no pinning) or a CPU number in [0, {MAX_CPU}], got '
             f'{describe_value(value)}',
+        )
+    return value
+
+
+def _bag_size(values: Mapping[str, Any]) -> int:
+    value = values.get('log.max_bag_size')
+    if (isinstance(value, bool) or not isinstance(value, int)
+            or not (value == NO_SPLIT or MIN_SPLIT_SIZE <= value <= MAX_BAG_SIZE)):
+        raise ConfigurationError(
+            'log.max_bag_size',
+            f'must be {NO_SPLIT} (no split) or a size in [{MIN_SPLIT_SIZE}, {MAX_BAG_SIZE}] '
+            f'bytes, got {describe_value(value)}',
         )
     return value
 
@@ -418,6 +443,8 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     dead_point_warning = _within(values, 'diagnostics.dead_point_warning', 0.0, math.pi)
     log_enabled = _flag(values, 'log.enabled')
     log_folder = Path(_text(values, 'log.folder'))
+    log_max_bag_size = _bag_size(values)
+    log_max_bag_duration = _within(values, 'log.max_bag_duration', 0.0, MAX_BAG_DURATION, 's')
     cpu_affinity = _cpu(values)
     autostart = _flag(values, 'autostart')
     blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
@@ -445,6 +472,8 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         dead_point_warning=dead_point_warning,
         log_enabled=log_enabled,
         log_folder=log_folder,
+        log_max_bag_size=log_max_bag_size,
+        log_max_bag_duration=log_max_bag_duration,
         cpu_affinity=cpu_affinity,
         autostart=autostart,
         direction=1 if segment_end > alpha_start else -1,

@@ -25,7 +25,8 @@ import sys
 from typing import Optional, TextIO
 import unicodedata
 
-from linkage_kinematics.bag_reader import bag_files, BagError, read_states
+from linkage_kinematics.bag.errors import BagError
+from linkage_kinematics.bag.reader import bag_files, read_states
 from linkage_kinematics.cli_types import number
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import (

@@ -23,13 +23,23 @@ from __future__ import annotations
 import math
 
 from linkage_kinematics.geometry import FourBar, preset
+from linkage_kinematics.scene import (
+    BAR_HEIGHT,
+    BAR_WIDTH,
+    COUPLER_COLOR,
+    DISK_COLOR,
+    DISK_THICKNESS,
+    GROUND_COLOR,
+    PIN_COLOR,
+    PIN_DIAMETER,
+    PIVOT_COLOR,
+    PIVOT_SIZE,
+    Rgba,
+    ROCKER_COLOR,
+)
 
 DEFAULT_FRAME_ID = 'linkage_base'
-_BAR_WIDTH = 0.02  # m
-_BAR_HEIGHT = 0.01  # m
-_DISK_THICKNESS = 0.01  # m
-_PIN_RADIUS = 0.025  # m
-_PIVOT_SIZE = 0.07  # m
+_PIN_RADIUS = 0.5 * PIN_DIAMETER
 
 
 def _number(value: float) -> str:
@@ -74,13 +84,17 @@ def _joint(name: str, parent: str, child: str, xyz: str) -> str:
     )
 
 
+def _rgba(color: Rgba) -> str:
+    return ' '.join(f'{channel:g}' for channel in color)
+
+
 _MATERIALS = (
-    ('pivot', '0.15 0.15 0.15 1'),
-    ('ground', '0.5 0.5 0.5 1'),
-    ('disk', '0.55 0.6 0.7 1'),
-    ('pin', '0.85 0.1 0.1 1'),
-    ('coupler', '0.95 0.55 0.1 1'),
-    ('rocker', '0.15 0.7 0.3 1'),
+    ('pivot', PIVOT_COLOR),
+    ('ground', GROUND_COLOR),
+    ('disk', DISK_COLOR),
+    ('pin', PIN_COLOR),
+    ('coupler', COUPLER_COLOR),
+    ('rocker', ROCKER_COLOR),
 )
 
 
@@ -95,10 +109,10 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
     rocker = linkage.rocker_length
     ground = linkage.ground_length
     ground_heading = math.atan2(linkage.ground_y, linkage.ground_x)
-    pivot = _box(_PIVOT_SIZE, _PIVOT_SIZE, _PIVOT_SIZE)
+    pivot = _box(PIVOT_SIZE, PIVOT_SIZE, PIVOT_SIZE)
     materials = ''.join(
-        f'  <material name="{name}"><color rgba="{rgba}"/></material>\n'
-        for name, rgba in _MATERIALS
+        f'  <material name="{name}"><color rgba="{_rgba(color)}"/></material>\n'
+        for name, color in _MATERIALS
     )
     base = (
         f'  <link name="{frame_id}">\n'
@@ -106,8 +120,8 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
         + _visual(pivot, _xyz(linkage.ground_x, linkage.ground_y, 0.0), 'pivot')
         # The ground link OC, drawn below the moving parts.
         + _visual(
-            _box(ground, _BAR_WIDTH, _BAR_HEIGHT),
-            _xyz(0.5 * linkage.ground_x, 0.5 * linkage.ground_y, -2.0 * _PIVOT_SIZE),
+            _box(ground, BAR_WIDTH, BAR_HEIGHT),
+            _xyz(0.5 * linkage.ground_x, 0.5 * linkage.ground_y, -2.0 * PIVOT_SIZE),
             'ground',
             rpy=f'0 0 {_number(ground_heading)}',
         )
@@ -115,19 +129,19 @@ def urdf_text(linkage: FourBar, frame_id: str = DEFAULT_FRAME_ID) -> str:
     )
     disk = (
         '  <link name="disk">\n'
-        + _visual(_cylinder(crank, _DISK_THICKNESS), _xyz(0.0, 0.0, -_DISK_THICKNESS), 'disk')
+        + _visual(_cylinder(crank, DISK_THICKNESS), _xyz(0.0, 0.0, -DISK_THICKNESS), 'disk')
         + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, -crank, 0.0), 'pin')
         + '  </link>\n'
     )
     coupler_link = (
         '  <link name="coupler">\n'
-        + _visual(_box(coupler, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * coupler, 0.0, 0.0),
+        + _visual(_box(coupler, BAR_WIDTH, BAR_HEIGHT), _xyz(0.5 * coupler, 0.0, 0.0),
                   'coupler')
         + '  </link>\n'
     )
     rocker_link = (
         '  <link name="rocker">\n'
-        + _visual(_box(rocker, _BAR_WIDTH, _BAR_HEIGHT), _xyz(0.5 * rocker, 0.0, 0.0), 'rocker')
+        + _visual(_box(rocker, BAR_WIDTH, BAR_HEIGHT), _xyz(0.5 * rocker, 0.0, 0.0), 'rocker')
         + _visual(_sphere(_PIN_RADIUS), _xyz(0.0, 0.0, 0.0), 'pin')
         + '  </link>\n'
     )

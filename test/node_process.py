@@ -20,7 +20,7 @@ import sys
 import time
 from typing import Any
 
-from linkage_kinematics import messages
+from builtin_interfaces.msg import Time
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState
 from linkage_kinematics.parameters import parameter_specs
@@ -31,11 +31,14 @@ from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.task import Future
+from rosbags.typesys import get_typestore, Stores
 from rosgraph_msgs.msg import Clock
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 # s; a generous bound on any one wait in these tests, also on a busy machine
 PROCESS_TIMEOUT = 60.0
+# The message types of ROS 2 Jazzy, as rosbags knows them independently of rclpy.
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:
@@ -124,14 +127,14 @@ def run_node(
 
 
 def bag_writer_pid(node_pid: int) -> int:
-    """Return the process id of the node's bag writer (bag_writer_process), its child."""
+    """Return the process id of the node's bag writer (bag.writer_process), its child."""
     for stat in Path('/proc').glob('[0-9]*/stat'):
         try:
             fields = stat.read_text().rsplit(')', 1)[1].split()
             cmdline = (stat.parent / 'cmdline').read_bytes()
         except OSError:
             continue  # a process that ended meanwhile
-        if int(fields[1]) == node_pid and b'linkage_kinematics.bag_writer_process' in cmdline:
+        if int(fields[1]) == node_pid and b'linkage_kinematics.bag.writer_process' in cmdline:
             return int(stat.parent.name)
     raise AssertionError(f'no bag writer process under the node (pid {node_pid})')
 
@@ -230,7 +233,7 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
 
     (a lost /clock message is sent again; the same time again makes no tick).
     """
-    message = Clock(clock=messages.time_msg(clock_ns))
+    message = Clock(clock=time_msg(clock_ns))
 
     def ticked() -> bool:
         return bool(states) and stamp_ns(states[-1]) == clock_ns
@@ -240,6 +243,16 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
         if listener.spin_until(ticked, timeout=0.5):
             return
     raise AssertionError(f'no state stamped {clock_ns} ns')
+
+
+def time_msg(nanoseconds: int) -> Time:
+    """Return a builtin_interfaces/Time from integer nanoseconds."""
+    return Time(sec=nanoseconds // 1_000_000_000, nanosec=nanoseconds % 1_000_000_000)
+
+
+def decode(data: bytes, type_name: str) -> Any:
+    """Decode CDR bytes of ``type_name`` (``pkg/msg/Name``) with rosbags, an independent reader."""
+    return TYPESTORE.deserialize_cdr(data, type_name)
 
 
 def stamp_ns(message: Any) -> int:

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-bag_reader against bags written by an independent writer (mcap_ros2's), whole.
+bag.reader against bags written by an independent writer (mcap_ros2's), whole.
 
 Cut and broken.
 """
@@ -13,14 +13,9 @@ import math
 from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory
-from linkage_kinematics.bag_reader import (
-    bag_files,
-    BagError,
-    iter_messages,
-    read_states,
-    STATE_JOINT_NAMES,
-    STATE_TOPIC,
-)
+from linkage_kinematics.bag.errors import BagError
+from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
+from linkage_kinematics.bag.state_layout import STATE_JOINT_NAMES, STATE_TOPIC
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import LinkageState, solve_many

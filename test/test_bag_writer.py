@@ -30,29 +30,25 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from linkage_kinematics import bag_reader, messages
-from linkage_kinematics.bag_writer import (
-    BagExistsError,
-    BagWriter,
-    DEFINITION_SEPARATOR,
-    message_definition,
+from linkage_kinematics import messages, scene
+from linkage_kinematics.bag import reader as bag_reader
+from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
+from linkage_kinematics.bag.definitions import DEFINITION_SEPARATOR, message_definition
+from linkage_kinematics.bag.errors import BagExistsError
+from linkage_kinematics.bag.metadata import (
+    offered_qos_profiles_for,
     package_version,
-    WRITE_BATCH,
 )
+from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
-from linkage_kinematics.recording import (
-    encode_cdr,
-    FixedShapeEncoder,
-    offered_qos_profiles_yaml,
-    Recorder,
-    ros_type_name,
-)
 from linkage_kinematics.replay import main as replay_main
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
 from node_process import (
+    decode,
     expected_state_point,
     Listener,
     PROCESS_TIMEOUT,
@@ -62,20 +58,21 @@ from node_process import (
     stamp_ns,
     start_node,
     stop_process,
+    time_msg,
+    TYPESTORE,
 )
+import numpy as np
 import pytest
 import rclpy
 from rclpy.qos import QoSProfile
 from rclpy.serialization import deserialize_message, serialize_message
 from rosbags.rosbag2 import Reader
-from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import CameraInfo, JointState, Range
 from std_msgs.msg import Float64, String
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from visualization_msgs.msg import Marker, MarkerArray
 import yaml
 
-TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 NODE_TOPICS = {
     '/joint_states': JointState,
     '/linkage/state': JointTrajectory,
@@ -146,16 +143,25 @@ def message_stamp_ns(message: Any) -> int:
 
 
 def sample_messages() -> list[Any]:
-    """One message of every type the node logs, built by the node's own message builders."""
+    """
+    Return one message of every type the node logs.
+
+    The per-tick messages and the scene as rclpy decodes the bytes of the node's encoders (the
+    only way the node makes them), the status built as the node builds it.
+    """
     paper = preset('paper')
     state = solve(paper.geometry, 0.3, DriveLaw(2.0, 0.0))
-    stamp = messages.time_msg(1_234_567_890_123)
+    stamp_ns = 1_234_567_890_123
     return [
-        messages.joint_state(state, stamp),  # empty effort: the case rclpy pads
-        messages.linkage_state(paper.geometry, state, stamp, 0.1, 'linkage_base'),
-        messages.marker_array(paper.geometry, state, stamp, 'linkage_base'),
+        # empty effort: the case rclpy pads
+        deserialize_message(messages.JointStateEncoder().encode(
+            state, stamp_ns, messages.joint_positions(state)), JointState),
+        deserialize_message(messages.LinkageStateEncoder(paper.geometry, 'linkage_base').encode(
+            state, stamp_ns, 0.1), JointTrajectory),
+        deserialize_message(messages.MarkerArrayEncoder(paper.geometry, 'linkage_base').encode(
+            state, stamp_ns), MarkerArray),
         messages.diagnostic_array(
-            stamp, 'linkage_node: crank motion', 'four-bar', DiagnosticStatus.WARN,
+            time_msg(stamp_ns), 'linkage_node: crank motion', 'four-bar', DiagnosticStatus.WARN,
             '1.2° from a dead point', {'α (deg)': '12.5', 'empty': ''},
         ),
         String(data="<robot name='ü'/>"),
@@ -322,6 +328,27 @@ def test_encode_cdr_follows_every_reshaping_of_a_trajectory(
         assert_exact_encoding(encode_cdr(message), message)
 
 
+def assert_one_encoding(data: bytes, msg_type: type) -> Any:
+    """
+    Check that ``data`` is one message's exact encoding; return rosbags' decoding of it.
+
+    rosbags encodes what it decodes to the very same bytes, and encode_cdr writes the same bytes
+    of what rclpy decodes.
+    """
+    assert data == encoded_by_rosbags(data, ros_type_name(msg_type))
+    assert encode_cdr(deserialize_message(data, msg_type)) == data
+    return decode(data, ros_type_name(msg_type))
+
+
+def rgba(color: Any) -> tuple[float, float, float, float]:
+    """Return a decoded ColorRGBA as the float32 values of the wire."""
+    return color.r, color.g, color.b, color.a
+
+
+def float32(*values: float) -> tuple[float, ...]:
+    return tuple(float(np.float32(value)) for value in values)
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     preset_name=st.sampled_from(['paper', 'paper_full_turn', 'grashof_crank_rocker']),
@@ -331,30 +358,70 @@ def test_encode_cdr_follows_every_reshaping_of_a_trajectory(
     frame_id=st.sampled_from(['', 'linkage_base', 'ü/base', 'left/linkage_base']),
     previous=st.tuples(*[st.floats(-100.0, 100.0)] * 3),
 )
-def test_the_nodes_encoders_write_what_encode_cdr_writes_of_the_builders_messages(
+def test_the_nodes_encoders_write_each_message_exactly_as_the_independent_readers_decode_it(
     preset_name: str, alpha: float, stamp: int, motion_time: float, frame_id: str,
     previous: tuple[float, float, float],
 ) -> None:
     """
-    Return the per-tick messages and the scene, encoded straight from the state.
+    The per-tick messages and the scene, encoded straight from the state.
 
-    Are byte for byte encode_cdr of the messages the builders make (frame ids of any length shift
-    the alignment of everything after them).
+    Are each one message's exact encoding, and rosbags decodes from them the state's values
+    (frame ids of any length shift the alignment of everything after them).
     """
     linkage = preset(preset_name).geometry
     try:
         state = solve(linkage, alpha, DriveLaw(2.0, 0.3))
     except ValueError:  # an unreachable or dead-point angle has no state to encode
         return
-    stamp_msg = messages.time_msg(stamp)
+    seconds, nanoseconds = divmod(stamp, 1_000_000_000)
     positions = messages.joint_positions(state, previous)
-    assert messages.JointStateEncoder().encode(state, stamp, positions) == encode_cdr(
-        messages.joint_state(state, stamp_msg, previous))
-    assert messages.LinkageStateEncoder(linkage, frame_id).encode(
-        state, stamp, motion_time) == encode_cdr(
-        messages.linkage_state(linkage, state, stamp_msg, motion_time, frame_id))
-    assert messages.MarkerArrayEncoder(linkage, frame_id).encode(state, stamp) == encode_cdr(
-        messages.marker_array(linkage, state, stamp_msg, frame_id))
+    joints = assert_one_encoding(
+        messages.JointStateEncoder().encode(state, stamp, positions), JointState)
+    assert (joints.header.stamp.sec, joints.header.stamp.nanosec) == (seconds, nanoseconds)
+    assert joints.header.frame_id == ''
+    assert list(joints.name) == list(messages.JOINT_NAMES)
+    assert tuple(joints.position) == positions
+    assert tuple(joints.velocity) == messages.joint_velocities(state)
+    assert len(joints.effort) == 0
+
+    trajectory = assert_one_encoding(
+        messages.LinkageStateEncoder(linkage, frame_id).encode(state, stamp, motion_time),
+        JointTrajectory)
+    assert (trajectory.header.stamp.sec, trajectory.header.stamp.nanosec) == (
+        seconds, nanoseconds)
+    assert trajectory.header.frame_id == frame_id
+    (point,) = trajectory.points
+    assert (tuple(point.positions), tuple(point.velocities), tuple(point.accelerations)) == (
+        expected_state_point(linkage, state))
+    elapsed = point.time_from_start
+    assert elapsed.sec * 1_000_000_000 + elapsed.nanosec == round(motion_time * 1e9)
+
+    scene_message = assert_one_encoding(
+        messages.MarkerArrayEncoder(linkage, frame_id).encode(state, stamp), MarkerArray)
+    markers = scene_message.markers
+    assert [m.id for m in markers] == list(range(6))
+    for marker in markers:
+        assert (marker.header.stamp.sec, marker.header.stamp.nanosec) == (seconds, nanoseconds)
+        assert (marker.header.frame_id, marker.ns) == (frame_id, messages.MARKER_NAMESPACE)
+    pin_a, pin_b = (state.pin_a_x, state.pin_a_y), (state.pin_b_x, state.pin_b_y)
+    ground_c = (linkage.ground_x, linkage.ground_y)
+    bars = markers[messages.BARS_ID]
+    assert [(p.x, p.y) for p in bars.points] == [(0.0, 0.0), pin_a, pin_a, pin_b, pin_b,
+                                                 ground_c]
+    assert [rgba(c) for c in bars.colors] == [
+        float32(*color) for color in (scene.CRANK_COLOR, scene.CRANK_COLOR, scene.COUPLER_COLOR,
+                                      scene.COUPLER_COLOR, scene.ROCKER_COLOR,
+                                      scene.ROCKER_COLOR)]
+    position = markers[messages.PIN_A_ID].pose.position
+    assert (position.x, position.y) == pin_a
+    position = markers[messages.PIN_B_ID].pose.position
+    assert (position.x, position.y) == pin_b
+    position = markers[messages.PIVOT_C_ID].pose.position
+    assert (position.x, position.y) == ground_c
+    disk = markers[messages.DISK_ID]
+    assert (disk.pose.orientation.z, disk.pose.orientation.w) == messages.disk_orientation(state)
+    assert disk.scale.x == disk.scale.y == 2.0 * linkage.crank_length
+    assert rgba(disk.color) == float32(*scene.DISK_COLOR[:3], scene.DISK_MARKER_ALPHA)
 
 
 def test_a_fixed_shape_encoder_of_one_field_and_one_naming_no_field() -> None:
@@ -393,7 +460,7 @@ def test_bag_writer_defaults_chunked_zstd_ros2_profile_and_time_flush(tmp_path: 
         '/chatter',
         'std_msgs/msg/String',
         message_definition('std_msgs/msg/String'),
-        offered_qos_profiles_yaml(QoSProfile(depth=7)),
+        offered_qos_profiles_for(QoSProfile(depth=7)),
     )
     payload = encode_cdr(String(data='hello'))
     writer.write(channel, payload, 1_000, 1_000)
@@ -441,7 +508,7 @@ def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: i
     writer = BagWriter(tmp_path / 'queued', metadata={}, flush_interval=3600.0)
     channels = [
         writer.add_topic(topic, 'std_msgs/msg/String', message_definition('std_msgs/msg/String'),
-                         offered_qos_profiles_yaml(QoSProfile(depth=10)))
+                         offered_qos_profiles_for(QoSProfile(depth=10)))
         for topic in ('/a', '/b')
     ]
     written = [(('/a', '/b')[index % 2], encode_cdr(String(data=f'm{index}')), 1_000 + index)
@@ -743,7 +810,7 @@ def test_replay_rejects_bad_input_with_a_clear_message(
 
     foreign = tmp_path / 'foreign'
     writer = BagWriter(foreign, metadata={})
-    channel = writer.add_topic('/thing', 'foreign_msgs/msg/Thing', 'int32 x\n', '')
+    channel = writer.add_topic('/thing', 'foreign_msgs/msg/Thing', 'int32 x\n', [])
     writer.write(channel, b'\x00\x01\x00\x00\x05\x00\x00\x00', 1, 1)
     writer.close()
     assert replay_main([str(foreign)]) == 1

@@ -18,7 +18,8 @@ import signal
 import subprocess
 import sys
 
-from linkage_kinematics import bag_reader
+from linkage_kinematics.bag import reader as bag_reader
+from linkage_kinematics.bag.metadata import BagMetadata
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,
@@ -160,6 +161,6 @@ def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: 
     (bag,) = (tmp_path / 'bags').iterdir()
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
-    count = bag_reader.bag_information(bag)['message_count']
+    count = BagMetadata.read(bag).message_count
     assert count >= 5
     assert f'bag finalized: {bag}, {count} messages' in (tmp_path / 'node.log').read_text()

@@ -14,7 +14,8 @@ from pathlib import Path
 import subprocess
 import sys
 
-from linkage_kinematics.bag_reader import bag_information, read_states
+from linkage_kinematics.bag.metadata import BagMetadata
+from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.drive import DriveLaw
 import matplotlib.image
 import numpy as np
@@ -40,8 +41,7 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
     # Each bag lasts the seed's turn in mechanism time, its 181 steps of 0.5° each logged when
     # the drive law reaches it.
     for bag, drive in zip(bags, (DriveLaw(2.0), DriveLaw(0.1, 2.3))):
-        information = bag_information(bag)
-        assert information['duration']['nanoseconds'] == round(
+        assert BagMetadata.read(bag).duration_ns == round(
             drive.time_to(0.0, math.pi / 2) * 1e9)
         log_times, states = read_states(bag)
         assert len(log_times) == 181
@@ -49,7 +49,7 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
         elapsed_ns = log_times - log_times[0]
         assert list(elapsed_ns) == [
             round(drive.time_to(0.0, alpha) * 1e9) for alpha in states.alpha]
-    assert [round(bag_information(bag)['duration']['nanoseconds'] * 1e-6) for bag in bags] == [
+    assert [round(BagMetadata.read(bag).duration_ns * 1e-6) for bag in bags] == [
         785, 1571]
     constant, variable = completed.stdout.split('Variable law')
     # Table 1 and 2, α = 0 and 90° rows (constant law)

@@ -25,7 +25,7 @@ from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
-from node_process import REPOSITORY, start_node, stop_process
+from node_process import decode, REPOSITORY, start_node, stop_process
 import pytest
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import get_types_from_msg
@@ -332,6 +332,12 @@ def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
 # --- the paper's quantities as plain fields of /linkage/state ------------------------------------
 
 
+def published_point(state: Any) -> Any:
+    """Return the point of the node's linkage/state message of ``state``, as rosbags decodes it."""
+    data = messages.LinkageStateEncoder(PAPER, 'o').encode(state, 0, 0.0)
+    return decode(data, 'trajectory_msgs/msg/JointTrajectory').points[0]
+
+
 @pytest.mark.parametrize('drive', [DriveLaw(2.0), SEED_VARIABLE, DriveLaw(-1.5, 0.4)])
 @pytest.mark.parametrize('alpha_deg', [0.0, 17.0, 45.0, 90.0, 150.0])
 def test_rocker_angle_and_pin_arcs_are_the_papers_coordinates(
@@ -344,7 +350,7 @@ def test_rocker_angle_and_pin_arcs_are_the_papers_coordinates(
     8a and 8b–9), their rates the tangential accelerations.
     """
     state = solve(PAPER, math.radians(alpha_deg), drive)
-    point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, 'o').points[0]
+    point = published_point(state)
     rocker_angle, pin_a_arc, pin_b_arc = point.positions[7:]
     assert (PAPER.ground_x + PAPER.rocker_length * math.cos(rocker_angle),
             PAPER.ground_y + PAPER.rocker_length * math.sin(rocker_angle)) == pytest.approx(
@@ -376,7 +382,7 @@ def test_plain_fields_match_the_seeds_table_for_the_constant_law() -> None:
     """Table 1 and 2 rows the seed gets right (see shared/seed/README.md)."""
     def fields(alpha: float) -> tuple[Any, Any]:
         state = solve(PAPER, alpha, DriveLaw(2.0))
-        point = messages.linkage_state(PAPER, state, messages.time_msg(0), 0.0, 'o').points[0]
+        point = published_point(state)
         return point.velocities, point.accelerations
 
     velocities, accelerations = fields(0.0)

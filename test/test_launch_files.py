@@ -21,7 +21,7 @@ import re
 import xml.etree.ElementTree as ElementTree
 
 from ament_index_python.packages import get_package_share_directory
-from linkage_kinematics.bag_reader import read_states
+from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.parameters import mechanism_entries, PARAMETER_NAMES
 from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process

@@ -18,7 +18,7 @@ import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics import messages
-from linkage_kinematics.bag_reader import STATE_JOINT_NAMES
+from linkage_kinematics.bag.state_layout import STATE_JOINT_NAMES
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset, TWO_PI
 from linkage_kinematics.kinematics import solve

@@ -19,7 +19,7 @@ import math
 import signal
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics.bag_reader import bag_files, iter_messages, read_states
+from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
@@ -92,6 +92,8 @@ ACCEPTED = {
     'diagnostics.dead_point_warning': {'zero'},
     'log.enabled': set(),
     'log.folder': set(),
+    'log.max_bag_size': {'zero', 'huge'},    # 0 never splits; else at least 1024 bytes
+    'log.max_bag_duration': {'zero'},        # 0 never splits; at most 1e9 s
     'cpu_affinity': {'zero', 'negative'},    # CPU 0; −1 is no pinning; at most 1023
     'autostart': set(),
 }
@@ -109,6 +111,8 @@ CONFIGURED = {
     'diagnostics.min_transmission_angle': lambda config: config.min_transmission_angle,
     'diagnostics.dead_point_warning': lambda config: config.dead_point_warning,
     'cpu_affinity': lambda config: config.cpu_affinity,
+    'log.max_bag_size': lambda config: config.log_max_bag_size,
+    'log.max_bag_duration': lambda config: config.log_max_bag_duration,
 }
 
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import signal
 
-from linkage_kinematics import bag_reader, messages
+from linkage_kinematics.bag import reader as bag_reader
 from linkage_kinematics.parameters import PARAMETER_NAMES, parameter_specs
 from node_process import (
     drive_sim_clock,
@@ -29,6 +29,7 @@ from node_process import (
     stamp_ns,
     start_node,
     stop_process,
+    time_msg,
 )
 from rclpy.parameter import Parameter
 from rclpy.parameter_client import AsyncParameterClient
@@ -109,7 +110,7 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
             for n in range(1, 7):
                 clock_ns = before[-1] + n * STEP
                 if n % 2:
-                    clock.publish(Clock(clock=messages.time_msg(clock_ns)))
+                    clock.publish(Clock(clock=time_msg(clock_ns)))
                 else:
                     drive_sim_clock(listener, clock, states, clock_ns)
                     after.append(clock_ns)

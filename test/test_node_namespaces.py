@@ -14,7 +14,7 @@ from pathlib import Path
 import re
 import signal
 
-from linkage_kinematics.bag_reader import bag_information
+from linkage_kinematics.bag.metadata import BagMetadata
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import preset
 from linkage_kinematics.kinematics import solve
@@ -107,7 +107,7 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
         assert recording == finalized and Path(recording).is_dir()
         assert Path(recording).parent == bags and recording not in seen
         seen.add(recording)
-        assert int(count) == bag_information(recording)['message_count']
+        assert int(count) == BagMetadata.read(recording).message_count
         with Reader(recording) as reader:
             topics = {connection.topic for connection in reader.connections}
         assert topics == {_topic(namespace, name) for name in (

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from linkage_kinematics.bag_reader import iter_messages
+from linkage_kinematics.bag.reader import iter_messages
 from linkage_kinematics.drive import DriveLaw
 from node_process import run_node
 import pytest

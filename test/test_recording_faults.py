@@ -22,7 +22,7 @@ import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticStatus
-from linkage_kinematics import bag_reader
+from linkage_kinematics.bag import reader as bag_reader
 from mcap.exceptions import EndOfFile
 from mcap.reader import make_reader
 from mcap.records import Channel, Message

@@ -16,7 +16,7 @@ import signal
 import statistics
 import time
 
-from linkage_kinematics import bag_reader
+from linkage_kinematics.bag import reader as bag_reader
 from node_process import start_node, stop_process
 import pytest
 from rosbags.rosbag2 import Reader

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The node's side of logging: rclpy messages in, a rosbag2 MCAP bag (bag_writer) out.
+CDR encoding: rclpy messages in, the bytes the node publishes and logs out.
 
 The node encodes each message once (``encode_cdr``, or for its per-tick messages and its
 scene a ``FixedShapeEncoder`` that writes the same bytes), publishes those bytes and logs the
@@ -22,17 +22,13 @@ messages), and leaves padding bytes as it finds them.
 """
 from __future__ import annotations
 
-from collections.abc import Callable, Set
+from collections.abc import Callable
 import functools
 import importlib
 import operator
-from pathlib import Path
 import struct
 from typing import Any
 
-from linkage_kinematics.bag_writer import BagWriteError, message_definition
-from linkage_kinematics.bag_writer_process import BagWriterProcess
-from rclpy.qos import QoSProfile
 from rosidl_parser.definition import (
     AbstractNestedType,
     AbstractString,
@@ -41,7 +37,6 @@ from rosidl_parser.definition import (
     BasicType,
     NamespacedType,
 )
-import yaml
 
 # XCDR1, little endian: the representation identifier and two option bytes.
 ENCAPSULATION_HEADER = b'\x00\x01\x00\x00'
@@ -56,10 +51,6 @@ _PRIMITIVES = {
 # How a plan entry is written: a run of fixed-size fields (primitives and messages made only of
 # them) in one struct code, a string, a message, and sequences (or arrays) of each.
 _FIXED, _STRING, _MESSAGE, _PRIMITIVE_LIST, _FIXED_LIST, _STRING_LIST, _MESSAGE_LIST = range(7)
-
-
-class RecordingError(OSError):
-    """Logging cannot go on (folder not writable, disk full); the message names the file."""
 
 
 def ros_type_name(msg_type: type) -> str:
@@ -325,73 +316,3 @@ class FixedShapeEncoder:
     def encode(self, values: tuple) -> bytes:
         """Return the message with ``values`` (``value_count`` of them) in the varying fields."""
         return ENCAPSULATION_HEADER + self._struct.pack(*self._order(self._constants + values))
-
-
-def _duration(nanoseconds: int) -> dict[str, int]:
-    return {'sec': nanoseconds // 1_000_000_000, 'nsec': nanoseconds % 1_000_000_000}
-
-
-def offered_qos_profiles_yaml(qos: QoSProfile) -> str:
-    """rosbag2's (Jazzy, metadata version 9) YAML text for a publisher offering ``qos``."""
-    profile = {
-        'history': qos.history.name.lower(),
-        'depth': qos.depth,
-        'reliability': qos.reliability.name.lower(),
-        'durability': qos.durability.name.lower(),
-        'deadline': _duration(qos.deadline.nanoseconds),
-        'lifespan': _duration(qos.lifespan.nanoseconds),
-        'liveliness': qos.liveliness.name.lower(),
-        'liveliness_lease_duration': _duration(qos.liveliness_lease_duration.nanoseconds),
-        'avoid_ros_namespace_conventions': qos.avoid_ros_namespace_conventions,
-    }
-    return yaml.safe_dump([profile], sort_keys=False)
-
-
-class Recorder:
-    """
-    Logs a run into a new rosbag2 bag folder inside ``folder`` (never overwriting one).
-
-    Written by a BagWriter in a process of its own (bag_writer_process).
-    """
-
-    def __init__(
-        self, folder: Path, *, metadata: dict[str, str], cpus: Set[int] | None = None
-    ) -> None:
-        try:
-            self._writer = BagWriterProcess(folder, metadata=metadata, cpus=cpus)
-        except BagWriteError as error:
-            raise RecordingError(str(error)) from None
-        self.bag_path: Path = self._writer.bag_path
-        self._channels: dict[str, int] = {}
-
-    @property
-    def size_bytes(self) -> int:
-        """Return the MCAP file's size as the writer last reported it (every 0.25 s at most)."""
-        return self._writer.size_bytes
-
-    def add_topic(self, topic: str, msg_type: type, qos: QoSProfile) -> None:
-        type_name = ros_type_name(msg_type)
-        try:
-            self._channels[topic] = self._writer.add_topic(
-                topic, type_name, message_definition(type_name), offered_qos_profiles_yaml(qos)
-            )
-        except BagWriteError as error:
-            raise RecordingError(str(error)) from None
-
-    def run_writer_on(self, cpus: Set[int]) -> None:
-        """Let the bag writer process run only on ``cpus``."""
-        self._writer.run_on(cpus)
-
-    def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        """Log ``data``, a message of ``topic`` encoded by ``encode_cdr``."""
-        try:
-            self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
-        except BagWriteError as error:
-            raise RecordingError(str(error)) from None
-
-    def close(self) -> None:
-        """Finishes the bag: waits until its writer has written everything it was given."""
-        try:
-            self._writer.close()
-        except BagWriteError as error:
-            raise RecordingError(str(error)) from None

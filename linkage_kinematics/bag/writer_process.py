@@ -8,7 +8,7 @@ The Python mcap writer stops for 4–15 ms each time it ends a chunk (it writes 
 message index entry by entry); at a 5 kHz timer that is 20–75 ticks. In a thread it would
 still hold the GIL for those milliseconds. Here the node only appends each message to a
 buffer and hands batches to a pipe (``BagWriterProcess``); ``python -m
-linkage_kinematics.bag_writer_process`` runs the ``BagWriter`` on the other end, on whatever
+linkage_kinematics.bag.writer_process`` runs the ``BagWriter`` on the other end, on whatever
 core is free.
 
 The child lives as long as the pipe: when the node closes it, or dies in any way (SIGKILL
@@ -17,13 +17,13 @@ metadata.yaml, then exits. It runs in a session of its own, so a Ctrl-C meant fo
 (SIGINT to the terminal's process group) does not end it first.
 
 Frames on the child's stdin: one kind byte, a uint32 length, the payload. ``S`` (JSON:
-folder, metadata) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
+folder, metadata, split) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
 (JSON) adds a topic; ``M`` holds messages, each a ``<HqqI`` header (channel id, log time,
 publish time, length) and its bytes. The child answers on stdout with JSON lines: ``bag`` or
 ``channel`` for S and T, ``size`` now and then, ``error`` when the bag cannot go on, and
 ``closed`` when it is done.
 
-Plain Python (no rclpy), as bag_writer.
+Plain Python (no rclpy), as ``writer``.
 """
 from __future__ import annotations
 
@@ -38,12 +38,8 @@ import sys
 import time
 from typing import Any, BinaryIO
 
-from linkage_kinematics.bag_writer import (
-    BagExistsError,
-    BagWriteError,
-    BagWriter,
-    WRITE_BATCH,
-)
+from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
+from linkage_kinematics.bag.writer import BagWriter, NO_SPLIT, WRITE_BATCH
 
 _FRAME = struct.Struct('<cI')
 _MESSAGE = struct.Struct('<HqqI')
@@ -80,13 +76,15 @@ class BagWriterProcess:
     A new bag folder in ``folder`` named after the local time (``rosbag2_%Y_%m_%d-%H_%M_%S``,
     ``_1``, … if taken).
 
-    Errors of the child's writer come back as BagWriteError from the next ``write`` (or
+    Errors of the child's writer come back as BagError from the next ``write`` (or
     ``close``) after the child reported them. ``cpus``, if given, are the CPUs the child may
-    run on (the node's ``cpu_affinity`` keeps it off the node's CPU).
+    run on (the node's ``cpu_affinity`` keeps it off the node's CPU); ``max_bag_size`` and
+    ``max_bag_duration_ns`` split the bag as ``BagWriter``'s do.
     """
 
     def __init__(
-        self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None
+        self, folder: Path | str, *, metadata: Mapping[str, str], cpus: Set[int] | None = None,
+        max_bag_size: int = NO_SPLIT, max_bag_duration_ns: int = NO_SPLIT,
     ) -> None:
         self._process = subprocess.Popen(
             [sys.executable, '-m', __name__], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -103,8 +101,13 @@ class BagWriterProcess:
         self._closed = False
         self.size_bytes = 0
         try:
-            reply = self._request(START, {'folder': str(folder), 'metadata': dict(metadata)})
-        except BagWriteError:
+            # The child's one answer to START that is an error is about the folder.
+            reply = self._request(START, {
+                'folder': str(folder), 'metadata': dict(metadata),
+                'split': {'max_bag_size': max_bag_size,
+                          'max_bag_duration_ns': max_bag_duration_ns},
+            }, LogFolderError)
+        except BagError:
             self._process.stdin.close()
             self._process.wait(timeout=CLOSE_TIMEOUT)
             raise
@@ -112,12 +115,13 @@ class BagWriterProcess:
         self.size_bytes = reply['size']
 
     def add_topic(
-        self, topic: str, type_name: str, message_definition: str, offered_qos_profiles: str
+        self, topic: str, type_name: str, message_definition: str,
+        offered_qos_profiles: list[dict[str, Any]], repeat_latest: bool = False,
     ) -> int:
         """``BagWriter.add_topic`` in the child; its channel id."""
         reply = self._request(TOPIC, {
             'topic': topic, 'type_name': type_name, 'message_definition': message_definition,
-            'offered_qos_profiles': offered_qos_profiles,
+            'offered_qos_profiles': offered_qos_profiles, 'repeat_latest': repeat_latest,
         })
         return int(reply['channel'])
 
@@ -128,7 +132,7 @@ class BagWriterProcess:
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
         """Queues one serialized message; a full or old batch goes to the child."""
         if self._failure is not None or self._closed:
-            raise BagWriteError(self._failure or f'bag {self.bag_path} is closed')
+            raise BagError(self._failure or f'bag {self.bag_path} is closed')
         self._queued += _MESSAGE.pack(channel_id, log_time_ns, publish_time_ns, len(data))
         self._queued += data
         self._queued_count += 1
@@ -140,7 +144,7 @@ class BagWriterProcess:
         """
         Hand over what is queued, lets the child finish the bag and waits for it.
 
-        Idempotent; raises BagWriteError if the bag could not be finished.
+        Idempotent; raises BagError if the bag could not be finished.
         """
         if self._closed:
             return
@@ -148,7 +152,7 @@ class BagWriterProcess:
         if self._failure is None and self._queued:
             try:
                 self._send_queued()
-            except BagWriteError:
+            except BagError:
                 pass  # reported below with what the child says
         os.set_blocking(self._process.stdout.fileno(), True)
         try:
@@ -157,7 +161,7 @@ class BagWriterProcess:
         except subprocess.TimeoutExpired:
             self._process.kill()
             self._process.wait()
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer of {self.bag_path} did not finish within {CLOSE_TIMEOUT:g} s'
             ) from None
         self._replies += rest
@@ -168,9 +172,9 @@ class BagWriterProcess:
                 closing_error = reply['error']
             closed = closed or 'closed' in reply
         if closing_error is not None:
-            raise BagWriteError(closing_error)
+            raise BagError(closing_error)
         if not closed:
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer of {self.bag_path} ended with status '
                 f'{self._process.returncode} before finishing the bag'
             )
@@ -178,7 +182,7 @@ class BagWriterProcess:
     def _send_queued(self) -> None:
         self._read_replies()
         if self._failure is not None:
-            raise BagWriteError(self._failure)
+            raise BagError(self._failure)
         batch, self._queued = self._queued, bytearray()
         self._queued_count = 0
         self._batch_started = time.monotonic()
@@ -192,21 +196,23 @@ class BagWriterProcess:
         except BrokenPipeError:
             self._failure = (f"the bag writer of {getattr(self, 'bag_path', 'the log')} "
                              f'ended unexpectedly (status {self._process.wait()})')
-            raise BagWriteError(self._failure) from None
+            raise BagError(self._failure) from None
 
-    def _request(self, kind: bytes, payload: dict[str, Any]) -> dict[str, Any]:
-        """Send a frame and waits for the child's answer to it."""
+    def _request(
+        self, kind: bytes, payload: dict[str, Any], error_kind: type[BagError] = BagError
+    ) -> dict[str, Any]:
+        """Send a frame and wait for the child's answer to it (an error as ``error_kind``)."""
         self._send(kind, json.dumps(payload).encode('utf-8'))
         os.set_blocking(self._process.stdout.fileno(), True)
         line = self._process.stdout.readline()
         os.set_blocking(self._process.stdout.fileno(), False)
         if not line:
-            raise BagWriteError(
+            raise BagError(
                 f'the bag writer ended with status {self._process.wait()} before answering'
             )
         reply = json.loads(line)
         if 'error' in reply:
-            raise BagWriteError(reply['error'])
+            raise error_kind(reply['error'])
         return reply
 
     def _read_replies(self) -> None:
@@ -229,12 +235,12 @@ class BagWriterProcess:
 # --- the child ------------------------------------------------------------------------------
 
 
-def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
+def _open_bag(folder: Path, metadata: dict[str, str], split: dict[str, int]) -> BagWriter:
     """Return a new bag folder in ``folder``, named as ``ros2 bag record`` names it."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        raise BagWriteError(
+        raise BagError(
             f'cannot create log folder {folder}: {error.strerror or error}'
         ) from None
     base_name = time.strftime('rosbag2_%Y_%m_%d-%H_%M_%S')
@@ -242,11 +248,11 @@ def _open_bag(folder: Path, metadata: dict[str, str]) -> BagWriter:
     while True:
         name = base_name if suffix == 0 else f'{base_name}_{suffix}'
         try:
-            return BagWriter(folder / name, metadata=metadata)
+            return BagWriter(folder / name, metadata=metadata, **split)
         except BagExistsError:
             suffix += 1
-        except BagWriteError as error:
-            raise BagWriteError(f'cannot log into folder {folder}: {error}') from None
+        except BagError as error:
+            raise BagError(f'cannot log into folder {folder}: {error}') from None
 
 
 class _Child:
@@ -287,8 +293,9 @@ class _Child:
 
     def _start(self, request: dict[str, Any]) -> None:
         try:
-            self._writer = _open_bag(Path(request['folder']), request['metadata'])
-        except BagWriteError as error:
+            self._writer = _open_bag(
+                Path(request['folder']), request['metadata'], request['split'])
+        except BagError as error:
             self._reply(error=str(error))
             return
         self._reply(bag=str(self._writer.bag_path), size=self._writer.size_bytes)
@@ -297,9 +304,9 @@ class _Child:
         try:
             channel = self._writer.add_topic(
                 request['topic'], request['type_name'], request['message_definition'],
-                request['offered_qos_profiles'],
+                request['offered_qos_profiles'], request['repeat_latest'],
             )
-        except (BagWriteError, ValueError) as error:
+        except (BagError, ValueError) as error:
             self._reply(error=str(error))
             return
         self._reply(channel=channel)
@@ -316,7 +323,7 @@ class _Child:
                 offset += _MESSAGE.size
                 write(channel_id, batch[offset:offset + length], log_time_ns, publish_time_ns)
                 offset += length
-        except BagWriteError as error:
+        except BagError as error:
             self._failed = True
             self._reply(error=str(error))
             return
@@ -332,7 +339,7 @@ class _Child:
             return
         try:
             self._writer.close()
-        except BagWriteError as error:
+        except BagError as error:
             self._reply(error=str(error), in_close=True)
         self._reply(closed=True, size=self._writer.size_bytes)
 

@@ -22,8 +22,17 @@ import io
 import os
 from pathlib import Path
 import struct
-from typing import Any, NamedTuple, Optional
+from typing import NamedTuple, Optional
 
+from linkage_kinematics.bag.errors import BagError
+from linkage_kinematics.bag.metadata import BagMetadata, METADATA_FILE
+from linkage_kinematics.bag.state_layout import (
+    READ_COORDINATES,
+    state_from_coordinates,
+    state_point,
+    STATE_TOPIC,
+    STATE_TYPE,
+)
 from linkage_kinematics.kinematics import LinkageState
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
@@ -31,19 +40,7 @@ from mcap.reader import NonSeekingReader
 from mcap.records import Channel, Message, Schema
 from mcap_ros2.decoder import DecoderFactory
 import numpy as np
-import yaml
 import zstandard
-
-STATE_TOPIC = '/linkage/state'
-STATE_TYPE = 'trajectory_msgs/msg/JointTrajectory'
-STATE_JOINT_NAMES = (
-    'alpha', 'beta', 'gamma', 'pin_a_x', 'pin_a_y', 'pin_b_x', 'pin_b_y',
-    'rocker_angle', 'pin_a_arc', 'pin_b_arc',
-)
-# Bags logged before the rocker angle and the pin arcs were added hold only the first seven
-# coordinates; those map onto LinkageState in the same way, so both read alike.
-SEVEN_STATE_JOINT_NAMES = STATE_JOINT_NAMES[:7]
-_READ_COORDINATES = len(SEVEN_STATE_JOINT_NAMES)
 
 _MAGIC = b'\x89MCAP0\r\n'
 _RECORD_PREFIX = struct.Struct('<BQ')  # opcode, length of the record's content
@@ -52,10 +49,6 @@ _RECORD_PREFIX = struct.Struct('<BQ')  # opcode, length of the record's content
 _CORRUPT_DATA_ERRORS = (McapError, ValueError, struct.error, zstandard.ZstdError, RuntimeError)
 # Failures of mcap_ros2's CDR decoder on a message that does not match its schema.
 _UNDECODABLE_ERRORS = (McapError, ValueError, struct.error, IndexError)
-
-
-class BagError(ValueError):
-    """A bag cannot be read: missing, not MCAP, damaged, or without the expected messages."""
 
 
 class BagMessage(NamedTuple):
@@ -153,56 +146,35 @@ def read_states(path: str | os.PathLike[str]) -> tuple[np.ndarray, LinkageState]
                 f'{where} cannot be decoded: message encoding {channel.message_encoding!r} with '
                 f"schema encoding {schema.encoding!r} (expected 'cdr' and 'ros2msg')"
             )
-        point = _state_point(trajectory, where)
+        point = state_point(trajectory, where)
         stamp = trajectory.header.stamp
         stamps.append(stamp.sec * 1_000_000_000 + stamp.nanosec)
-        positions.append(point.positions[:_READ_COORDINATES])
-        velocities.append(point.velocities[:_READ_COORDINATES])
-        accelerations.append(point.accelerations[:_READ_COORDINATES])
+        positions.append(point.positions[:READ_COORDINATES])
+        velocities.append(point.velocities[:READ_COORDINATES])
+        accelerations.append(point.accelerations[:READ_COORDINATES])
     if not stamps:
         present = ', '.join(sorted(other_topics)) if other_topics else 'none'
         raise BagError(f'{path} holds no {STATE_TOPIC} messages (topics present: {present})')
-    return np.array(stamps, dtype=np.int64), _state_from_columns(
+    return np.array(stamps, dtype=np.int64), state_from_coordinates(
         np.array(positions, dtype=float),
         np.array(velocities, dtype=float),
         np.array(accelerations, dtype=float),
     )
 
 
-def bag_information(folder: str | os.PathLike[str]) -> dict[str, Any]:
-    """Return the ``rosbag2_bagfile_information`` of a bag folder's metadata.yaml."""
-    metadata_path = Path(folder) / 'metadata.yaml'
-    try:
-        return yaml.safe_load(metadata_path.read_text(encoding='utf-8'))[
-            'rosbag2_bagfile_information'
-        ]
-    except (OSError, ValueError, yaml.YAMLError, KeyError, TypeError) as error:
-        raise _not_metadata(metadata_path, error) from None
-
-
-def _not_metadata(metadata_path: Path, error: BaseException) -> BagError:
-    return BagError(
-        f'{metadata_path} is not rosbag2 bag metadata ({type(error).__name__}: '
-        f'{_one_line(error)})'
-    )
-
-
 def _folder_files(folder: Path) -> list[Path]:
-    metadata_path = folder / 'metadata.yaml'
+    metadata_path = folder / METADATA_FILE
     if not metadata_path.exists():
         paths = sorted(folder.glob('*.mcap'))
         if not paths:
             raise BagError(f'{folder} is not a bag: no metadata.yaml and no .mcap file')
         return paths
-    information = bag_information(folder)
-    try:
-        storage = information.get('storage_identifier', 'mcap')
-        relative_paths = information['relative_file_paths']
-    except (KeyError, TypeError, AttributeError) as error:
-        raise _not_metadata(metadata_path, error) from None
+    metadata = BagMetadata.read(folder)
+    storage = metadata.storage_identifier
+    relative_paths = metadata.relative_file_paths
     if storage != 'mcap':
         raise BagError(f'{folder} stores its messages in {storage!r}; only MCAP bags can be read')
-    if not isinstance(relative_paths, list) or not relative_paths:
+    if not relative_paths:
         raise BagError(f'{metadata_path} lists no bag files')
     paths = [folder / str(relative) for relative in relative_paths]
     missing = [str(file_path) for file_path in paths if not file_path.is_file()]
@@ -233,6 +205,8 @@ def _scan(file_path: Path) -> McapFile:
                         return McapFile(file_path, size, end + len(_MAGIC), complete=True)
                     break
                 offset = end
+    except BagError:
+        raise
     except OSError as error:
         raise BagError(f'cannot read {file_path}: {error.strerror or error}') from None
     return McapFile(file_path, size, offset, complete=False)
@@ -279,63 +253,3 @@ def _iter_records(files: list[McapFile]) -> Iterator[tuple[Optional[Schema], Cha
 def _one_line(error: BaseException) -> str:
     """Return an error's text on one line (YAML and decoder errors span several)."""
     return ' '.join(str(error).split())
-
-
-def _state_point(trajectory: Any, where: str) -> Any:
-    """
-    Return the one point of a decoded ``/linkage/state`` message.
-
-    Checked against the topic contract (the current joint names, or the seven of earlier bags).
-    """
-    names = tuple(trajectory.joint_names)
-    if names not in (STATE_JOINT_NAMES, SEVEN_STATE_JOINT_NAMES):
-        raise BagError(
-            f'{where} has joint_names {list(names)}; expected {list(STATE_JOINT_NAMES)} '
-            f'(or its first seven, as logged before the last three were added)'
-        )
-    points = trajectory.points
-    if len(points) != 1:
-        raise BagError(f'{where} has {len(points)} points; expected exactly 1')
-    point = points[0]
-    for field in ('positions', 'velocities', 'accelerations'):
-        count = len(getattr(point, field))
-        if count != len(names):
-            raise BagError(
-                f'{where} has {count} {field}; expected {len(names)} (one per joint)'
-            )
-    return point
-
-
-def _state_from_columns(
-    positions: np.ndarray, velocities: np.ndarray, accelerations: np.ndarray
-) -> LinkageState:
-    """
-    Map the message's first seven coordinates.
-
-    (see README, topic ``/linkage/state``) onto LinkageState; the last three (rocker angle, pin
-    arcs) restate them.
-    """
-    return LinkageState(
-        alpha=positions[:, 0],
-        beta=positions[:, 1],
-        gamma=positions[:, 2],
-        omega=velocities[:, 0],
-        omega_dot=accelerations[:, 0],
-        omega_ab=velocities[:, 2],
-        omega_bc=-velocities[:, 1],
-        omega_dot_ab=accelerations[:, 2],
-        omega_dot_bc=-accelerations[:, 1],
-        pin_a_x=positions[:, 3],
-        pin_a_y=positions[:, 4],
-        pin_b_x=positions[:, 5],
-        pin_b_y=positions[:, 6],
-        velocity_a_x=velocities[:, 3],
-        velocity_a_y=velocities[:, 4],
-        velocity_b_x=velocities[:, 5],
-        velocity_b_y=velocities[:, 6],
-        acceleration_a_x=accelerations[:, 3],
-        acceleration_a_y=accelerations[:, 4],
-        acceleration_b_x=accelerations[:, 5],
-        acceleration_b_y=accelerations[:, 6],
-        transmission_angle=np.full(len(positions), np.nan),
-    )
