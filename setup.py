@@ -22,6 +22,14 @@ setup(
          glob('interfaces/tf2_msgs/msg/*')),
     ],
     install_requires=['setuptools', 'numpy'],
+    # The test suite's own dependencies (requirements.txt pins them; package.xml names them for
+    # rosdep). Naming pytest here makes `colcon test` run the suite with pytest.
+    extras_require={
+        'test': [
+            'pytest', 'hypothesis', 'mpmath', 'rosbags', 'colcon-core', 'colcon-ros',
+            'colcon-python-setup-py', 'ament-flake8', 'ament-pep257',
+        ],
+    },
     zip_safe=True,
     maintainer='linkage_kinematics maintainers',
     maintainer_email='linkage-kinematics@example.org',

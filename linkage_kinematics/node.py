@@ -17,6 +17,7 @@ README.md.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import re
 import signal
 import sys
@@ -45,8 +46,10 @@ from linkage_kinematics.parameters import (
     PARAMETER_NAMES,
     RunConfiguration,
     Source,
+    unknown_parameters,
 )
 from linkage_kinematics.placement import CpuPlacement
+from linkage_kinematics.run_control import RunControl, ServiceAnswer
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -55,6 +58,7 @@ from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.signals import SignalHandlerOptions
+from std_srvs.srv import Trigger
 
 DIAGNOSTICS_PERIOD = 1.0  # s
 
@@ -77,7 +81,13 @@ class LinkageNode(Node):
         super().__init__(NODE_NAME, **node_options)
         self.exit_code: int | None = None
         specs = declare_parameters(self)
+        # rclpy has no public accessor of the overrides given for this node; they include the
+        # `-p` arguments and the /** entries of parameter files, which rcl keeps as one set.
+        for warning in unknown_parameters(self._parameter_overrides,
+                                          self.list_parameters([], 0).names):
+            self.get_logger().warning(warning)
         self.config = config = build_configuration(self.parameter_values())
+        self.control = RunControl(config.autostart)
         add_ranges(self, specs)
         if blocked_note(config) is not None:
             self.get_logger().warning(blocked_note(config))
@@ -86,6 +96,7 @@ class LinkageNode(Node):
         self.activity = 'starting'
         self._state: LinkageState | None = None
         self._state_ns = 0
+        self._motion_started = False  # a state of this motion published (not only the scene)
         self._rate_meter = RateMeter()
         self._status_schedule = StatusSchedule()
         self._placement = CpuPlacement()
@@ -103,6 +114,9 @@ class LinkageNode(Node):
         self._source: DriveLawTimer | MeasuredSubscription = (
             MeasuredSubscription(self) if config.source is Source.MEASURED
             else DriveLawTimer(self))
+        for name, act in (('pause', self._source.pause), ('resume', self._source.resume),
+                          ('reset', self._source.reset)):
+            self.create_service(Trigger, f'~/{name}', self._answer(act))
         self._source.start()
 
     # parameters
@@ -157,6 +171,16 @@ class LinkageNode(Node):
             self.forget_state()
             self._source.restart()
 
+    def _answer(self, act: Callable[[], ServiceAnswer]) -> Callable[..., Trigger.Response]:
+        """Return a Trigger service callback (~/pause, ~/resume, ~/reset) answering as ``act``."""
+        def callback(_request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+            answer = act()
+            response.success, response.message = answer.success, answer.message
+            if answer.success:
+                self.get_logger().info(answer.message)
+            return response
+        return callback
+
     def _place(self, cpu: int) -> None:
         change = self._placement.place(cpu)
         if change is not None:
@@ -168,9 +192,28 @@ class LinkageNode(Node):
         """Return the node clock's time (ns)."""
         return self.get_clock().now().nanoseconds
 
+    @property
+    def state(self) -> LinkageState | None:
+        """Return the latest state shown (published, or the scene of a motion waiting)."""
+        return self._state
+
+    @property
+    def motion_started(self) -> bool:
+        """Whether a state of this motion was published (not only the scene of it waiting)."""
+        return self._motion_started
+
     def forget_state(self) -> None:
         """Make the next state a motion's first: its scene and status go out before it."""
         self._state = None
+        self._motion_started = False
+
+    def show_waiting(self, state: LinkageState, stamp_ns: int) -> None:
+        """Publish the scene of ``state``, the URDF if new, and the status; no state."""
+        self._state = state
+        self._state_ns = stamp_ns
+        self.publish_markers()
+        self.outputs.publish_description(stamp_ns)
+        self.publish_diagnostics()
 
     def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
         """
@@ -179,7 +222,8 @@ class LinkageNode(Node):
         The first of a motion comes after its scene (so a viewer knows the frame before anything
         refers to it), the URDF if the geometry is new, and the status that says it moves.
         """
-        first = self._state is None
+        first = not self._motion_started
+        self._motion_started = True
         self._state = state
         self._state_ns = stamp_ns
         self._rate_meter.tick()
@@ -223,6 +267,7 @@ class LinkageNode(Node):
             self.activity, self._source.health, now_ns, self._rate_meter.rate,
             self._source.missed_deadlines, None if recorder is None else str(recorder.bag_path),
             None if recorder is None else recorder.size_bytes)
+        values = {'run state': self.control.state.value, **values}
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

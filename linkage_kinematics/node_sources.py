@@ -17,8 +17,9 @@ from typing import TYPE_CHECKING
 from linkage_kinematics.diagnostics import MeasuredHealth
 from linkage_kinematics.joints import Link
 from linkage_kinematics.measured import MeasuredFollower, Rejection
-from linkage_kinematics.motion import dead_point_problem, DriveLawRun
+from linkage_kinematics.motion import dead_point_problem, DriveLawRun, MotionSample, solve_sample
 from linkage_kinematics.parameters import EndBehavior, RunConfiguration
+from linkage_kinematics.run_control import ServiceAnswer
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 
@@ -58,17 +59,66 @@ class DriveLawTimer:
         self.run.config = new
 
     def restart(self) -> None:
-        """Start the motion again from alpha_start, now."""
-        self.run.restart()
+        """Start the motion again from alpha_start, now (a paused one waits there)."""
+        self._back_to_start()
         self._node.destroy_timer(self._timer)
         self._timer = self._node.create_timer(self.run.timer_period, self.tick)
         self.tick()
+
+    def _back_to_start(self) -> None:
+        self.run.restart()
+        self._node.forget_state()
+        self._node.control.back_to_start()
+
+    # ~/pause, ~/resume, ~/reset
+
+    def pause(self) -> ServiceAnswer:
+        node = self._node
+        started = node.motion_started and self.run.start_ns is not None
+        alpha = node.state.alpha if started else None
+        answer = node.control.pause(
+            node.now_ns() - self.run.start_ns if started else None, alpha)
+        if answer.success:
+            node.activity = node.control.activity(alpha)
+            node.publish_diagnostics()
+        return answer
+
+    def resume(self) -> ServiceAnswer:
+        node = self._node
+        answer, held_ns = node.control.resume()
+        if not answer.success:
+            return answer
+        if held_ns is None:
+            self._back_to_start()  # from alpha_start
+        else:
+            # The motion goes on where it stopped: its time origin moves by the pause.
+            self.run.start_ns = node.now_ns() - held_ns
+            node.activity = 'moving'
+            node.publish_diagnostics()
+        self._timer.reset()
+        self.tick()
+        return answer
+
+    def reset(self) -> ServiceAnswer:
+        answer = self._node.control.reset(self._node.config.alpha_start)
+        self._back_to_start()
+        self._timer.reset()
+        self.tick()
+        return answer
 
     def tick(self) -> None:
         node = self._node
         now_ns = node.now_ns()
         if node.exit_code is not None or now_ns == 0:
             return  # finished, or use_sim_time and no /clock yet: no time to start at
+        if node.control.paused:
+            if node.state is None:
+                # Waiting at alpha_start (autostart false, or reset while paused): its scene.
+                node.activity = node.control.activity(None)
+                node.show_waiting(
+                    solve_sample(node.config, MotionSample(node.config.alpha_start)), now_ns)
+            self._timer.cancel()  # ~/resume or a restart re-arms it
+            return
         if self.run.start_ns is None or now_ns < self.run.start_ns:
             node.forget_state()  # the motion starts (again): its scene and status come first
         due_states, next_ns, blocked = self.run.advance(now_ns)
@@ -120,7 +170,9 @@ class MeasuredSubscription:
         self.health = MeasuredHealth(node.now_ns())
         self.stale = False  # no valid sample within measured.timeout
         self._driver_name = config.joints[Link(config.driver.value)].name
-        node.activity = f'waiting for {self._driver_name} on measured_joint_states'
+        node.activity = (
+            f'paused: {self._driver_name} is not followed until ~/resume' if node.control.paused
+            else f'waiting for {self._driver_name} on measured_joint_states')
         node.create_subscription(
             JointState, 'measured_joint_states', self._on_message, MEASURED_QOS)
         self._freshness_timer = node.create_timer(0.25 * config.measured_timeout,
@@ -147,7 +199,36 @@ class MeasuredSubscription:
         self._follower.restart()
         self._node.publish_description()
 
+    # ~/pause, ~/resume, ~/reset
+
+    def pause(self) -> ServiceAnswer:
+        node = self._node
+        if not node.control.pause(None, None).success:
+            return ServiceAnswer(False, 'already paused; ~/resume goes on')
+        node.activity = f'paused: {self._driver_name} is not followed until ~/resume'
+        node.publish_diagnostics()
+        return ServiceAnswer(True, f'paused: samples of {self._driver_name} are ignored')
+
+    def resume(self) -> ServiceAnswer:
+        node = self._node
+        answer, _ = node.control.resume()
+        if not answer.success:
+            return answer
+        # What the mechanism did meanwhile is unknown: its next sample starts the motion afresh.
+        self._follower.restart()
+        node.activity = f'waiting for {self._driver_name} on measured_joint_states'
+        node.publish_diagnostics()
+        return ServiceAnswer(True, f'following {self._driver_name} again from its next sample')
+
+    def reset(self) -> ServiceAnswer:
+        self._follower.restart()
+        paused = self._node.control.paused
+        return ServiceAnswer(True, 'the motion starts afresh at the next valid sample' + (
+            '; paused: ~/resume follows it' if paused else ''))
+
     def _on_message(self, message: JointState) -> None:
+        if self._node.control.paused:
+            return  # ~/pause: not followed, not counted
         stamp = message.header.stamp
         followed = self._follower.follow(stamp.sec * 1_000_000_000 + stamp.nanosec,
                                          message.name, message.position, message.velocity)

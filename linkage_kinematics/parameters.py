@@ -11,8 +11,9 @@ node, the demo and the tests all validate through it. README.md documents each p
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass, replace
+import difflib
 from enum import StrEnum
 import math
 from pathlib import Path
@@ -134,6 +135,7 @@ class RunConfiguration:
     measured_timeout: float
     max_jump: float
     acceleration_time_constant: float
+    autostart: bool
     direction: int
     segment_end: float
     blocked_at: float | None
@@ -236,7 +238,9 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec('alpha_end', math.pi / 2.0,
                       'crank angle where one pass ends (rad), not alpha_start',
                       floating_range=(-MAX_ANGLE, MAX_ANGLE)),
-        ParameterSpec('end_behavior', EndBehavior.STOP.value,
+        # A node runs until it is stopped, as every ROS node does: by default the crank swings
+        # to and fro over its pass, which suits the paper's mechanism (it cannot turn fully).
+        ParameterSpec('end_behavior', EndBehavior.BOUNCE.value,
                       'at the end of a pass: stop (and exit), loop or bounce'),
         ParameterSpec('mode', MotionMode.REAL_TIME.value,
                       'real_time: α from node-clock time at rate_hz; fixed_step: steps of '
@@ -306,6 +310,10 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                       "time constant of the low-pass filter on the driver's angular "
                       'acceleration estimate (s); 0 for the raw difference of velocities',
                       floating_range=(0.0, MAX_TIME_CONSTANT)),
+        ParameterSpec('autostart', True,
+                      'start the motion at once; false: publish the scene at alpha_start, the '
+                      'URDF and the status, then wait for ~/resume',
+                      read_only=True),
     )
 
 
@@ -545,6 +553,14 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         if not math.isfinite(steps):
             raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
         step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
+    autostart = _flag(values, 'autostart')
+    blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
+    segment_end = alpha_end if blocked_at is None else blocked_at
+    travel = abs(segment_end - alpha_start)
+    steps = travel / alpha_step
+    if not math.isfinite(steps):
+        raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
+    step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     return RunConfiguration(
         preset=preset_name,
         linkage=linkage,
@@ -574,6 +590,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         measured_timeout=measured_timeout,
         max_jump=max_jump,
         acceleration_time_constant=acceleration_time_constant,
+        autostart=autostart,
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,
         blocked_at=blocked_at,
@@ -586,9 +603,25 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     )
 
 
-def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
+def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[str]:
     """
-    Return the namespaces of a parameters file's ``/<namespace>/linkage_node`` entries.
+    Return one warning per parameter in ``given`` that is not in ``declared``, sorted by name.
+
+    Each names the parameter and the closest of the node's own parameters, if one is close
+    (``rate`` → ``rate_hz``).
+    """
+    warnings = []
+    for name in sorted(set(given) - set(declared)):
+        closest = difflib.get_close_matches(name, PARAMETER_NAMES, n=1)
+        hint = f"; did you mean '{closest[0]}'?" if closest else ''
+        warnings.append(f"unknown parameter '{name}' ignored: {NODE_NAME} has no such "
+                        f'parameter{hint}')
+    return warnings
+
+
+def mechanism_entries(parameters_file: str | Path) -> dict[str, dict[str, Any]]:
+    """
+    Return the ``/<namespace>/linkage_node`` entries of a parameters file: namespace → parameters.
 
     In file order: one mechanism each (launch/mechanisms.launch.py). ValueError names a bad entry.
     """
@@ -599,10 +632,13 @@ def mechanism_namespaces(parameters_file: str | Path) -> list[str]:
         raise ValueError(f'cannot read parameters file {path}: {error}') from None
     if not isinstance(entries, dict) or not entries:
         raise ValueError(f'{path} has no /<namespace>/{NODE_NAME} entries')
-    namespaces = []
-    for key in entries:
+    mechanisms = {}
+    for key, entry in entries.items():
         namespace, _, name = str(key).rpartition('/')
         if name != NODE_NAME or not namespace.startswith('/') or '*' in namespace:
             raise ValueError(f'{path}: entry {key!r} is not /<namespace>/{NODE_NAME}')
-        namespaces.append(namespace)
-    return namespaces
+        parameters = entry.get('ros__parameters') if isinstance(entry, dict) else None
+        if not isinstance(parameters, dict):
+            raise ValueError(f'{path}: entry {key!r} has no ros__parameters mapping')
+        mechanisms[namespace] = parameters
+    return mechanisms

@@ -114,9 +114,11 @@ def stop_process(process: subprocess.Popen) -> None:
         process.wait(timeout=PROCESS_TIMEOUT)
 
 
-def run_node(parameters: Mapping[str, Any], domain_id: int, output: Path) -> tuple[int, str]:
+def run_node(
+    parameters: Mapping[str, Any], domain_id: int, output: Path, ros_arguments: Sequence[str] = ()
+) -> tuple[int, str]:
     """Run a node to its end; return its exit status and output."""
-    process = start_node(parameters, domain_id, output)
+    process = start_node(parameters, domain_id, output, ros_arguments=ros_arguments)
     try:
         status = process.wait(timeout=PROCESS_TIMEOUT)
     finally:

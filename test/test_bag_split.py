@@ -165,8 +165,8 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: 
     """The seed's 0.785 s turn in files of 0.2 s: each holds the URDF and a status."""
     folder = tmp_path / 'bags'
     status, output = run_node(
-        {'log.folder': str(folder), 'log.max_bag_duration': 0.2, 'rate_hz': 200.0}, DOMAIN_ID,
-        tmp_path / 'node.log')
+        {'log.folder': str(folder), 'log.max_bag_duration': 0.2, 'rate_hz': 200.0,
+         'end_behavior': 'stop'}, DOMAIN_ID, tmp_path / 'node.log')
     assert status == 0, output
     bag = only_bag(folder)
     files = assert_metadata_lists_every_file(bag)

@@ -1,12 +1,18 @@
 # Copyright 2026 linkage_kinematics maintainers
 # SPDX-License-Identifier: Apache-2.0
 
-"""The package builds in a colcon workspace and its installed linkage_node runs and publishes."""
+"""
+The package in a colcon workspace.
+
+It builds, its installed linkage_node runs and publishes, and `colcon test` runs the suite with
+pytest and `colcon test-result` counts it.
+"""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+import re
 import shutil
 import signal
 import subprocess
@@ -23,6 +29,7 @@ from node_process import (
     start_node,
     stop_process,
 )
+import pytest
 from sensor_msgs.msg import JointState
 
 DOMAIN_ID = 12
@@ -30,12 +37,16 @@ PACKAGE_ENTRIES = (
     'package.xml', 'setup.py', 'setup.cfg', 'resource', 'linkage_kinematics', 'launch', 'config',
     'urdf', 'foxglove', 'interfaces',
 )
+# What the nested `colcon test` runs in full: quick tests that need the test dependencies
+# (hypothesis, and mpmath through test/reference.py). Naming them keeps the nested suite from
+# running this module again, and so from nesting for ever.
+NESTED_TESTS = ('test/test_drive.py',)
 
 
 def _package_files() -> list[str]:
-    """Return the package's files as git knows them (tracked, or new and not ignored)."""
+    """Return the repository's files as a clone has them (tracked, or new and not ignored)."""
     listed = subprocess.run(
-        ['git', 'ls-files', '--cached', '--others', '--exclude-standard', '--', *PACKAGE_ENTRIES],
+        ['git', 'ls-files', '--cached', '--others', '--exclude-standard'],
         cwd=REPOSITORY, check=True, capture_output=True, text=True,
     ).stdout.split()
     return [path for path in listed if (REPOSITORY / path).is_file()]
@@ -65,22 +76,58 @@ def _colcon_environment(install: Path, base: dict[str, str]) -> dict[str, str]:
     return environment
 
 
-def test_colcon_build_installs_a_node_that_publishes(tmp_path):
-    workspace = tmp_path / 'ws'
+def _colcon(workspace: Path, *arguments: str) -> str:
+    """Run colcon in ``workspace`` on this environment's ROS; its output (it must succeed)."""
+    colcon = Path(sys.executable).parent / 'colcon'
+    completed = subprocess.run(
+        [str(colcon), *arguments], cwd=workspace,
+        env={**os.environ, 'AMENT_PREFIX_PATH': sys.prefix}, capture_output=True, text=True,
+        timeout=PROCESS_TIMEOUT * 4,
+    )
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    return completed.stdout
+
+
+def _collected(arguments: list[str], cwd: Path) -> int:
+    """Return how many tests pytest collects with ``arguments`` in ``cwd``."""
+    output = subprocess.run(
+        [sys.executable, '-m', 'pytest', '--collect-only', '-q', *arguments], cwd=cwd,
+        capture_output=True, text=True, check=True,
+    ).stdout
+    return int(re.search(r'^(\d+) tests? collected', output, re.MULTILINE)[1])
+
+
+@pytest.fixture(scope='module')
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Return a colcon workspace with this repository (as git knows it) built in it."""
+    workspace = tmp_path_factory.mktemp('colcon') / 'ws'
     source = workspace / 'src' / 'linkage_kinematics'
     for path in _package_files():
         target = source / path
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(REPOSITORY / path, target)
-    colcon = Path(sys.executable).parent / 'colcon'
-    build_environment = {**os.environ, 'AMENT_PREFIX_PATH': sys.prefix}
-    build = subprocess.run(
-        [str(colcon), 'build', '--base-paths', 'src'],
-        cwd=workspace, env=build_environment, capture_output=True, text=True,
-        timeout=PROCESS_TIMEOUT * 4,
-    )
-    assert build.returncode == 0, build.stdout + build.stderr
+    _colcon(workspace, 'build', '--base-paths', 'src')
+    return workspace
 
+
+def test_colcon_test_runs_the_suite_with_pytest_and_test_result_counts_it(
+    workspace: Path,
+) -> None:
+    # The whole suite is collected in colcon's test environment: pytest runs it (not unittest's
+    # discovery, which finds none of these tests) and every test module imports.
+    output = _colcon(workspace, 'test', '--base-paths', 'src', '--event-handlers',
+                     'console_direct+', '--pytest-args', '--collect-only', '-q')
+    everything = _collected([], REPOSITORY)
+    assert f'{everything} tests collected' in output, output
+    # A part of it runs to the end, and colcon test-result counts each of its tests.
+    _colcon(workspace, 'test', '--base-paths', 'src', '--pytest-args', *NESTED_TESTS)
+    summary = _colcon(workspace, 'test-result', '--verbose')
+    expected = _collected(list(NESTED_TESTS), REPOSITORY)
+    assert expected > 0
+    assert f'Summary: {expected} tests, 0 errors, 0 failures, 0 skipped' in summary, summary
+
+
+def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: Path) -> None:
     install = workspace / 'install'
     executable = install / 'linkage_kinematics' / 'lib' / 'linkage_kinematics' / 'linkage_node'
     assert executable.is_file() and os.access(executable, os.X_OK)

@@ -4,10 +4,11 @@
 """
 The launch files and their parameters files.
 
-Tested without `launch` (not installable here): what they name exists in the installed share/ and
-entry points, they use only launch API that every Jazzy release has (launch 3.4.0 on), and each
-parameters file starts the node to its end with ``--params-file``, in the namespaces it is meant
-for.
+Tested without `launch` (not installable here): the launch arguments read from each launch
+description (the Python files' DeclareLaunchArgument calls, the XML's <arg> elements) and where
+they go, what they name exists in the installed share/ and entry points, they use only launch API
+that every Jazzy release has (launch 3.4.0 on), and each parameters file starts the node to its
+end with ``--params-file``, in the namespaces it is meant for.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ import xml.etree.ElementTree as ElementTree
 from ament_index_python.packages import get_package_share_directory
 from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.parameters import mechanism_namespaces
+from linkage_kinematics.parameters import mechanism_entries, PARAMETER_NAMES
 from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
 import pytest
 from rosbags.rosbag2 import Reader
@@ -40,7 +41,14 @@ LAUNCH_API = {
     'launch.substitutions': {'LaunchConfiguration'},
     'launch_ros.actions': {'Node'},
     'ament_index_python.packages': {'get_package_share_directory'},
-    'linkage_kinematics.parameters': {'NODE_NAME', 'mechanism_namespaces'},
+    'linkage_kinematics.parameters': {'NODE_NAME', 'mechanism_entries'},
+}
+# The arguments of robot_state_publisher's and nav2's launch files, and the bag log's: each launch
+# file declares them and passes each to the node parameter named here (None: not a parameter).
+COMMON_ARGUMENTS = {
+    'namespace': None, 'use_sim_time': 'use_sim_time', 'params_file': None,
+    'autostart': 'autostart', 'log_enabled': 'log.enabled', 'log_folder': 'log.folder',
+    'log_level': None,
 }
 
 
@@ -74,41 +82,119 @@ def test_python_launch_files_use_only_launch_api_every_jazzy_release_has(name: s
         node.name for node in tree.body if isinstance(node, ast.FunctionDef)}
 
 
-def test_the_scenario_launch_files_name_existing_parameters_files() -> None:
+def _declared_arguments(tree: ast.AST) -> dict[str, dict[str, ast.expr]]:
+    """Return the DeclareLaunchArgument calls of a Python launch file: name → keywords."""
+    return {ast.literal_eval(call.args[0]): {word.arg: word.value for word in call.keywords}
+            for call in _calls(tree, 'DeclareLaunchArgument')}
+
+
+def _calls(tree: ast.AST, function: str) -> list[ast.Call]:
+    """Return the calls of ``function`` (by its plain name) in a Python launch file."""
+    return [node for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and getattr(node.func, 'id', None) == function]
+
+
+def _configurations(tree: ast.AST) -> dict[int, str]:
+    """Return the LaunchConfiguration('name') calls of a Python launch file: id → name."""
+    return {id(node): ast.literal_eval(node.args[0])
+            for node in _calls(tree, 'LaunchConfiguration')}
+
+
+def _node_parameters(tree: ast.AST) -> dict[str, str]:
+    """Return the parameters a Python launch file sets from its arguments: parameter → argument."""
+    names = _configurations(tree)
+    pairs = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Dict):  # {'parameter': LaunchConfiguration('argument'), …}
+            pairs += zip(node.keys, node.values)
+        elif isinstance(node, ast.Assign) and isinstance(node.targets[0], ast.Subscript):
+            pairs.append((node.targets[0].slice, node.value))  # parameters['…'] = …
+    return {ast.literal_eval(key): names[id(value)] for key, value in pairs if id(value) in names}
+
+
+@pytest.mark.parametrize('name', PYTHON_LAUNCH_FILES)
+def test_each_launch_file_declares_the_common_arguments_and_passes_them_on(name: str) -> None:
+    tree = ast.parse((SHARE / 'launch' / name).read_text())
+    arguments = _declared_arguments(tree)
+    assert set(COMMON_ARGUMENTS) <= set(arguments), sorted(arguments)
+    for argument, keywords in arguments.items():
+        assert ast.literal_eval(keywords['description']).strip(), argument
+        # Every argument is read somewhere (beyond its own declaration).
+        assert argument in _configurations(tree).values(), argument
+    assert ast.literal_eval(arguments['use_sim_time']['default_value']) == 'false'
+    assert ast.literal_eval(arguments['autostart']['default_value']) == 'true'
+    assert ast.literal_eval(arguments['namespace']['default_value']) == ''
+    parameters = _node_parameters(tree)
+    assert parameters == {parameter: argument for argument, parameter in COMMON_ARGUMENTS.items()
+                          if parameter is not None}
+    assert set(parameters) <= {*PARAMETER_NAMES, 'use_sim_time'}
+    node = next(node for node in ast.walk(tree) if isinstance(node, ast.Call)
+                and getattr(node.func, 'id', None) == 'Node')
+    keywords = {keyword.arg: keyword.value for keyword in node.keywords}
+    assert ast.dump(keywords['ros_arguments'].elts[0]) == ast.dump(ast.Constant('--log-level'))
+    assert _configurations(keywords['ros_arguments']).popitem()[1] == 'log_level'
+
+
+def test_the_xml_twin_declares_the_python_files_arguments_and_sets_the_same_parameters() -> None:
+    python = ast.parse((SHARE / 'launch' / 'linkage.launch.py').read_text())
+    python_arguments = _declared_arguments(python)
+    xml = ElementTree.parse(SHARE / 'launch' / 'linkage.launch.xml').getroot()
+    xml_arguments = {argument.get('name'): argument for argument in xml.iter('arg')}
+    assert list(xml_arguments) == list(python_arguments)
+    for name, argument in xml_arguments.items():
+        if name != 'params_file':
+            assert argument.get('default') == ast.literal_eval(
+                python_arguments[name]['default_value']), name
+        assert argument.get('description') == ast.literal_eval(
+            python_arguments[name]['description']), name
+    (node,) = xml.iter('node')
+    assert (node.get('pkg'), node.get('exec'), node.get('namespace'), node.get('ros_args')) == (
+        'linkage_kinematics', 'linkage_node', '$(var namespace)', '--log-level $(var log_level)')
+    (from_file, *values) = node.iter('param')
+    assert from_file.get('from') == '$(var params_file)'
+    assert {param.get('name'): param.get('value') for param in values} == {
+        parameter: f'$(var {argument})' for parameter, argument in _node_parameters(python).items()
+    }
+
+
+def test_the_scenario_picks_an_existing_parameters_file_in_both_twins() -> None:
     python_tree = ast.parse((SHARE / 'launch' / 'linkage.launch.py').read_text())
-    (argument,) = [node for node in ast.walk(python_tree) if isinstance(node, ast.Call)
-                   and getattr(node.func, 'id', None) == 'DeclareLaunchArgument']
-    keywords = {keyword.arg: keyword.value for keyword in argument.keywords}
-    choices = ast.literal_eval(keywords['choices'])
-    assert ast.literal_eval(keywords['default_value']) in choices
+    arguments = _declared_arguments(python_tree)
+    choices = ast.literal_eval(arguments['scenario']['choices'])
+    assert ast.literal_eval(arguments['scenario']['default_value']) in choices
     for scenario in choices:
         assert (SHARE / 'config' / f'seed_{scenario}.yaml').is_file()
+    # params_file defaults to <share>/config/seed_ + the scenario + .yaml.
+    (folder, scenario_name, suffix) = arguments['params_file']['default_value'].elts
+    assert ast.dump(folder) == ast.dump(ast.parse("os.path.join(config, 'seed_')").body[0].value)
+    assert _configurations(scenario_name).popitem()[1] == 'scenario'
+    assert ast.literal_eval(suffix) == '.yaml'
 
     xml = ElementTree.parse(SHARE / 'launch' / 'linkage.launch.xml').getroot()
-    (node,) = xml.iter('node')
-    assert (node.get('pkg'), node.get('exec')) == ('linkage_kinematics', 'linkage_node')
-    (argument,) = xml.iter('arg')
+    xml_arguments = {argument.get('name'): argument for argument in xml.iter('arg')}
     # A misspelt scenario fails at launch, as in the Python file, instead of running defaults.
-    assert [choice.get('value') for choice in argument.iter('choice')] == choices
-    assert argument.get('default') in choices
-    (parameters,) = node.iter('param')
+    assert [choice.get('value') for choice in xml_arguments['scenario'].iter('choice')] == choices
+    default_file = xml_arguments['params_file'].get('default')
+    assert not re.search(r'\$\((?!find-pkg-share |var )', default_file)
     for scenario in choices:
-        path = parameters.get('from').replace(
-            '$(find-pkg-share linkage_kinematics)', str(SHARE)
-        ).replace('$(var scenario)', scenario)
-        assert Path(path).is_file()
-    assert not re.search(r'\$\((?!find-pkg-share |var )', parameters.get('from'))
+        path = default_file.replace('$(find-pkg-share linkage_kinematics)', str(SHARE)).replace(
+            '$(var scenario)', scenario)
+        assert Path(path) == SHARE / 'config' / f'seed_{scenario}.yaml'
 
 
-def test_mechanism_namespaces_come_from_the_parameters_file(tmp_path: Path) -> None:
-    assert mechanism_namespaces(SHARE / 'config' / 'two_mechanisms.yaml') == ['/left', '/right']
+def test_mechanism_entries_come_from_the_parameters_file(tmp_path: Path) -> None:
+    entries = mechanism_entries(SHARE / 'config' / 'two_mechanisms.yaml')
+    assert list(entries) == ['/left', '/right']
+    assert (entries['/left']['frame_prefix'], entries['/right']['log.folder']) == (
+        'left/', 'bags/right')
     for text, problem in (('/**/linkage_node:\n  ros__parameters: {}\n', '/**/linkage_node'),
                           ('/left/other_node:\n  ros__parameters: {}\n', '/left/other_node'),
+                          ('/left/linkage_node:\n  gain: 1\n', 'no ros__parameters'),
                           ('', 'has no'), ('[unclosed', 'cannot read')):
         bad = tmp_path / 'bad.yaml'
         bad.write_text(text)
         with pytest.raises(ValueError, match=re.escape(problem)):
-            mechanism_namespaces(bad)
+            mechanism_entries(bad)
 
 
 def _run_to_end(tmp_path: Path, parameters_file: Path, namespace: str, **overrides) -> Path:

@@ -400,7 +400,7 @@ def test_bounce_plays_the_pass_backwards_with_negated_rates():
 
 
 def test_stop_ends_exactly_at_alpha_end_or_not_at_all_at_a_dead_point():
-    config = _configuration()
+    config = _configuration(end_behavior='stop')
     final = sample_at_time(config, 10.0)
     assert final.final and final.alpha == math.pi / 2.0
     assert final.motion_time == config.segment_duration
@@ -409,7 +409,7 @@ def test_stop_ends_exactly_at_alpha_end_or_not_at_all_at_a_dead_point():
     assert config.step_count == 180
     assert sample_at_step(config, 179).alpha == 179 * math.radians(0.5)
 
-    blocked = _configuration(omega0=-1.0, alpha_end=-0.5)
+    blocked = _configuration(end_behavior='stop', omega0=-1.0, alpha_end=-0.5)
     assert blocked.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
     assert sample_at_time(blocked, blocked.segment_duration) is None
     assert sample_at_step(blocked, blocked.step_count) is None

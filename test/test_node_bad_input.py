@@ -106,6 +106,7 @@ ACCEPTED = {
     'measured.timeout': set(),               # in (0, 3600] s
     'measured.max_jump': set(),              # in (0, π] rad
     'measured.acceleration_time_constant': {'zero'},  # 0 is the raw difference
+    'autostart': set(),
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).
 ACCEPTED_IN_CONTEXT = [{'ground_x': 0.0, 'ground_y': -1.3}, {'ground_x': 0, 'ground_y': -1.3}]

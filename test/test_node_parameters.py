@@ -21,6 +21,7 @@ from linkage_kinematics.parameters import (
     ConfigurationError,
     PARAMETER_NAMES,
     parameter_specs,
+    unknown_parameters,
 )
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
@@ -94,12 +95,13 @@ def test_build_configuration_names_the_bad_parameter(case):
     assert str(raised.value).startswith(raised.value.parameter + ': ')
 
 
-def test_defaults_are_the_seed_run():
+def test_defaults_are_the_seed_run_swinging_until_stopped():
     config = build_configuration(configuration_values())
     assert config.linkage == PAPER
     assert config.drive == DriveLaw(2.0, 0.0)
     assert (config.alpha_start, config.alpha_end, config.end_behavior, config.mode) == (
-        0.0, math.pi / 2.0, 'stop', 'real_time')
+        0.0, math.pi / 2.0, 'bounce', 'real_time')
+    assert config.autostart
     assert config.blocked_at is None
     assert config.segment_duration == math.pi / 4.0
     assert set(configuration_values()) == set(PARAMETER_NAMES)
@@ -151,6 +153,37 @@ def test_unwritable_log_folder_is_a_start_up_error(tmp_path):
     assert status == 2, output
     assert 'invalid parameter log.folder' in output
     assert blocker.read_text() == ''
+
+
+def test_unknown_parameters_are_named_with_the_closest_known_name():
+    declared = [*PARAMETER_NAMES, 'use_sim_time']
+    assert unknown_parameters(['rate', 'omega0', 'use_sim_time', 'log.enable', 'xyzzy'],
+                              declared) == [
+        "unknown parameter 'log.enable' ignored: linkage_node has no such parameter; did you "
+        "mean 'log.enabled'?",
+        "unknown parameter 'rate' ignored: linkage_node has no such parameter; did you mean "
+        "'rate_hz'?",
+        "unknown parameter 'xyzzy' ignored: linkage_node has no such parameter",
+    ]
+    assert unknown_parameters(declared, declared) == []
+
+
+def test_an_unknown_parameter_gets_a_warning_and_the_node_runs_on(tmp_path):
+    # A misspelt -p, and a wildcard entry of a parameters file shared with other nodes.
+    shared = tmp_path / 'shared.yaml'
+    shared.write_text('/**:\n  ros__parameters:\n    use_sim_time: false\n    gain: 0.5\n'
+                      '/other_node:\n  ros__parameters:\n    rate: 7\n')
+    status, output = run_node(
+        {'rate': 50, 'end_behavior': 'stop', 'log.enabled': False}, DOMAIN_ID,
+        tmp_path / 'node.log', ros_arguments=['--params-file', str(shared)])
+    assert status == 0, output
+    warnings = [line for line in output.splitlines() if '[WARN]' in line]
+    assert len(warnings) == 2, output
+    assert warnings[0].endswith(
+        "unknown parameter 'gain' ignored: linkage_node has no such parameter")
+    assert warnings[1].endswith(
+        "unknown parameter 'rate' ignored: linkage_node has no such parameter; did you mean "
+        "'rate_hz'?")
 
 
 def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):

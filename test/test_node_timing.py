@@ -50,7 +50,7 @@ def run(request, tmp_path_factory) -> tuple[DriveLaw, dict[str, list[tuple[int, 
     folder = tmp_path_factory.mktemp(f'{mode}_{law}')
     status, output = run_node(
         {'mode': mode, 'omega0': drive.omega0, 'k': drive.k, 'alpha_start': ALPHA_START,
-         'alpha_end': ALPHA_END, 'alpha_step': math.radians(2.0),
+         'alpha_end': ALPHA_END, 'alpha_step': math.radians(2.0), 'end_behavior': 'stop',
          'log.folder': str(folder / 'bags')},
         DOMAIN_ID, folder / 'node.log')
     assert status == 0, output

@@ -281,7 +281,8 @@ def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_pa
         (bag / 'metadata.yaml').write_text(f'old run {name}\n')
         taken[name] = {p.name: p.read_bytes() for p in bag.iterdir()}
     status, output = run_node(
-        {'log.folder': str(folder), 'rate_hz': 200.0, 'omega0': 10.0}, 38, tmp_path / 'node.log'
+        {'log.folder': str(folder), 'rate_hz': 200.0, 'omega0': 10.0, 'end_behavior': 'stop'}, 38,
+        tmp_path / 'node.log'
     )
     assert status == 0, output
 
