@@ -43,11 +43,13 @@ from node_process import (
     stop_process,
 )
 import pytest
+from rclpy.qos import QoSProfile
 from reference import reference_rocker_driven, reference_state
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
+from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 import yaml
@@ -511,3 +513,55 @@ def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(
         assert math.remainder(positions[0] - lab_angle, TWO_PI) == pytest.approx(0.0, abs=1e-12)
         values = {names[0]: lab_angle, **dict(zip(stream.names, positions[stream.published]))}
         assert chain_end(urdf, values, end[0]) == pytest.approx(end[1], abs=TOLERANCE)
+
+
+def test_the_services_pause_and_resume_following_and_autostart_false_waits(context, tmp_path):
+    """
+    With autostart false nothing is followed until ~/resume; ~/pause ignores samples.
+
+    Each sample is published only after the service's answer came back, so the node has acted
+    on the call before the sample arrives.
+    """
+    with measured_node(context, tmp_path, {'autostart': False, 'log.enabled': False,
+                                           'measured.timeout': PROCESS_TIMEOUT}) as (
+            listener, process):
+        clients = {name: listener.node.create_client(Trigger, f'/linkage_node/{name}')
+                   for name in ('pause', 'resume', 'reset')}
+        for client in clients.values():
+            assert client.wait_for_service(timeout_sec=PROCESS_TIMEOUT)
+
+        def call(name: str) -> Trigger.Response:
+            return listener.result_of(clients[name].call_async(Trigger.Request()))
+
+        encoder = listener.node.create_publisher(JointState, '/measured_joint_states',
+                                                 QoSProfile(depth=10))
+        assert listener.spin_until(lambda: encoder.get_subscription_count() > 0)
+
+        def publish(stamp: int, angle: float) -> None:
+            message = JointState(name=['crank_joint'], position=[angle], velocity=[1.0])
+            message.header.stamp.sec, message.header.stamp.nanosec = divmod(
+                stamp, 1_000_000_000)
+            encoder.publish(message)
+
+        states = listener.received['/linkage/state']
+        assert not call('pause').success  # autostart false: paused already
+        resumed = call('resume')
+        assert (resumed.success, resumed.message) == (
+            True, 'following crank_joint again from its next sample')
+        publish(1_000_000, 0.1)
+        assert listener.spin_until(lambda: len(states) == 1)
+        assert call('pause').success
+        publish(2_000_000, 0.2)  # ignored
+        assert call('resume').success
+        publish(3_000_000, 0.3)
+        assert listener.spin_until(lambda: len(states) == 2)
+        reset = call('reset')
+        assert (reset.success, reset.message) == (
+            True, 'the motion starts afresh at the next valid sample')
+        publish(4_000_000, 0.4)
+        assert listener.spin_until(lambda: len(states) == 3)
+        assert [stamp_ns(state) for state in states] == [1_000_000, 3_000_000, 4_000_000]
+        # After the reset the motion started afresh: its time counts from that sample.
+        assert states[2].points[0].time_from_start.sec == 0
+        assert states[2].points[0].time_from_start.nanosec == 0
+        assert process.poll() is None
