@@ -192,10 +192,15 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: 
 
 
 def test_a_node_splits_its_bag_by_size(tmp_path: Path) -> None:
-    """A looping node in files of at least 1024 bytes: split at each flushed chunk."""
+    """
+    A looping node in files of 4 KiB: split at each flushed chunk.
+
+    Not the 1 KiB minimum: a file's preamble (schemas, channels and the run's parameters) is
+    above 1 KiB, so there every message would start a file before the status was logged once.
+    """
     folder = tmp_path / 'bags'
     process = start_node(
-        {'log.folder': str(folder), 'log.max_bag_size': MIN_SPLIT_SIZE, 'rate_hz': 200.0,
+        {'log.folder': str(folder), 'log.max_bag_size': 4 * MIN_SPLIT_SIZE, 'rate_hz': 200.0,
          'end_behavior': 'loop'}, DOMAIN_ID + 1, tmp_path / 'node.log')
     try:
         deadline = time.monotonic() + PROCESS_TIMEOUT
