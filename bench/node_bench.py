@@ -225,7 +225,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             def encode() -> int:
                 for _ in range(count):
                     nanoseconds = clock.now().nanoseconds
-                    joint_state_encoder.encode(state, nanoseconds, positions)
+                    joint_state_encoder.encode(nanoseconds, positions, velocities)
                     state_encoder.encode(state, nanoseconds, 0.0)
                 return count
 
@@ -243,7 +243,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
 
             def tick(node: LinkageNode) -> int:
                 for _ in range(count):
-                    node._tick()
+                    node._source.tick()
                 return count
 
             def bare() -> int:
@@ -257,15 +257,15 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
                 "encode: the node's encoders of both messages, with clock.now()": encode,
                 'publish: both encoded messages': publish,
                 'log: Recorder.record of both encoded messages': record,
-                'whole tick, logging on (LinkageNode._tick)': lambda: tick(logging_node),
-                'whole tick, logging off (LinkageNode._tick)': lambda: tick(quiet_node),
+                'whole tick, logging on (DriveLawTimer.tick)': lambda: tick(logging_node),
+                'whole tick, logging off (DriveLawTimer.tick)': lambda: tick(quiet_node),
                 'bare rclpy publish of the same JointState': bare,
             }
             times = interleaved_medians(parts, repetitions)
         finally:
             for node in nodes:
                 if isinstance(node, LinkageNode):
-                    node.close_log()
+                    node.outputs.close_log()
                 node.destroy_node()
             rclpy.try_shutdown()
     stop(listener)
@@ -369,9 +369,9 @@ def rate_text(rate: float | None) -> str:
 def run(quick: bool, repetitions: int, domain_base: int) -> str:
     """Return the node section as markdown."""
     split, times = tick_split(quick, repetitions, domain_base)
-    with_logging = times['whole tick, logging on (LinkageNode._tick)']
+    with_logging = times['whole tick, logging on (DriveLawTimer.tick)']
     ratio = with_logging / times['bare rclpy publish of the same JointState']
-    logging_share = with_logging / times['whole tick, logging off (LinkageNode._tick)']
+    logging_share = with_logging / times['whole tick, logging off (DriveLawTimer.tick)']
     lines = ['Cost per tick (one process; a listener in another process subscribes to '
              '/joint_states and the bare topic):', '', split, '',
              f'- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: '
