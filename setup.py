@@ -18,6 +18,8 @@ setup(
         ('share/' + package_name + '/config', glob('config/*.yaml')),
         ('share/' + package_name + '/urdf', glob('urdf/*.urdf')),
         ('share/' + package_name + '/foxglove', glob('foxglove/*.json')),
+        ('share/' + package_name + '/interfaces/tf2_msgs/msg',
+         glob('interfaces/tf2_msgs/msg/*')),
     ],
     install_requires=['setuptools', 'numpy'],
     # The test suite's own dependencies (requirements.txt pins them; package.xml names them for

@@ -21,12 +21,14 @@ import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point
+from geometry_msgs.msg import Point, TransformStamped
 from linkage_kinematics import scene
-from linkage_kinematics.bag.cdr import FixedShapeEncoder
+from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder
 from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState, unwrap_near
+from linkage_kinematics.robot_transforms import RobotTransforms, Transform
+from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
@@ -229,3 +231,105 @@ def diagnostic_array(
     array = DiagnosticArray(status=[status])
     array.header.stamp = stamp
     return array
+
+
+class TFMessage:
+    """
+    tf2_msgs/msg/TFMessage for ``encode_cdr`` and ``FixedShapeEncoder``.
+
+    tf2_msgs has no Python package on PyPI, so rclpy's generated class cannot be imported
+    everywhere the node runs. This class has what the encoders and the recorder read of a
+    generated one: its field, the field's rosidl type and the module name ``tf2_msgs.msg`` by
+    which ``recording.ros_type_name`` names the type. Its .msg text and RIHS01 hash are shipped
+    with the package (``interfaces/tf2_msgs``). The node logs /tf and /tf_static but never
+    publishes them (robot_state_publisher does that live), so no type support is needed.
+    """
+
+    __module__ = 'tf2_msgs.msg'
+    __slots__ = ('transforms',)
+    SLOT_TYPES = (UnboundedSequence(NamespacedType(['geometry_msgs', 'msg'], 'TransformStamped')),)
+
+    def __init__(self, transforms: Sequence[TransformStamped] = ()) -> None:
+        self.transforms = list(transforms)
+
+    @classmethod
+    def get_fields_and_field_types(cls) -> dict[str, str]:
+        return {'transforms': 'sequence<geometry_msgs/TransformStamped>'}
+
+
+def tf_message(transforms: Sequence[Transform], stamp_ns: int) -> TFMessage:
+    """/tf or /tf_static: ``transforms``, each stamped ``stamp_ns``."""
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    message = TFMessage()
+    for transform in transforms:
+        stamped = TransformStamped(child_frame_id=transform.child_frame)
+        stamped.header.stamp = Time(sec=sec, nanosec=nanosec)
+        stamped.header.frame_id = transform.parent_frame
+        translation = stamped.transform.translation
+        translation.x, translation.y, translation.z = transform.translation
+        rotation = stamped.transform.rotation
+        rotation.x, rotation.y, rotation.z, rotation.w = transform.rotation
+        message.transforms.append(stamped)
+    return message
+
+
+class TFMessageEncoder:
+    """
+    The bytes of ``tf_message`` (encode_cdr) for one list of parent and child frames.
+
+    Straight from the transforms.
+    """
+
+    def __init__(self, frames: Sequence[tuple[str, str]]) -> None:
+        self.frames = tuple(frames)
+        template = tf_message(
+            [Transform(parent, child, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+             for parent, child in self.frames],
+            0,
+        )
+        varying = []
+        for index in range(len(self.frames)):
+            varying += _stamp_paths(f'transforms[{index}].')
+            varying += [f'transforms[{index}].transform.{part}.{axis}'
+                        for part, axes in (('translation', 'xyz'), ('rotation', 'xyzw'))
+                        for axis in axes]
+        self._encoder = FixedShapeEncoder(template, varying)
+
+    def encode(self, transforms: Sequence[Transform], stamp_ns: int) -> bytes:
+        """Return the message of ``transforms`` (between ``frames``, in that order)."""
+        stamp = divmod(stamp_ns, 1_000_000_000)
+        values: list[float] = []
+        for (parent, child), transform in zip(self.frames, transforms, strict=True):
+            if (transform.parent_frame, transform.child_frame) != (parent, child):
+                raise ValueError(f'{transform.parent_frame} → {transform.child_frame} is not '
+                                 f'the encoder’s {parent} → {child}')
+            values += (*stamp, *transform.translation, *transform.rotation)
+        return self._encoder.encode(tuple(values))
+
+
+class RobotStateTransforms:
+    """
+    The /tf_static and /tf messages robot_state_publisher publishes for one URDF, as bytes.
+
+    With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
+    robot_transforms.UrdfError for a URDF it cannot read.
+    """
+
+    def __init__(self, urdf: str, frame_prefix: str) -> None:
+        self._robot = RobotTransforms(urdf, frame_prefix)
+        moving = self._robot.moving_transforms(
+            {name: 0.0 for name, joint in self._robot.joints.items() if joint.movable})
+        self._encoder = TFMessageEncoder(
+            [(transform.parent_frame, transform.child_frame) for transform in moving])
+
+    def static_message(self, stamp_ns: int) -> bytes:
+        """Return /tf_static: the fixed joints, stamped ``stamp_ns``."""
+        return encode_cdr(tf_message(self._robot.fixed_transforms(), stamp_ns))
+
+    def message(self, positions: Mapping[str, float], stamp_ns: int) -> bytes:
+        """
+        Return /tf for a joint state of every movable joint, stamped ``stamp_ns``.
+
+        ``positions`` maps each movable joint's name to its position (rad or m).
+        """
+        return self._encoder.encode(self._robot.moving_transforms(positions), stamp_ns)

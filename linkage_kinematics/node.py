@@ -25,14 +25,14 @@ import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import messages
+from linkage_kinematics import diagnostics, messages
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.bag.writer_process import set_process_affinity
 from linkage_kinematics.geometry import FourBar, GeometryError, UnreachableError
-from linkage_kinematics.kinematics import DeadPointError, LinkageState, loop_closure_residual
+from linkage_kinematics.kinematics import DeadPointError, LinkageState
 from linkage_kinematics.motion import (
     blocked_note,
     dead_point_problem,
@@ -89,6 +89,14 @@ EXIT_FAILED = 1  # the crank met a dead point before alpha_end, or the log could
 EXIT_CONFIGURATION = 2
 
 DATA_QOS = QoSProfile(depth=10)
+# TF is logged, never published (see docs/logging.md), with tf2_ros's broadcaster QoS: the
+# static one keeps the last message for late subscribers, as robot_state_publisher's does.
+TF_TOPIC = '/tf'
+TF_STATIC_TOPIC = '/tf_static'
+TF_QOS = QoSProfile(depth=100)
+TF_STATIC_QOS = QoSProfile(
+    depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
+)
 # robot_state_publisher's convention: late joiners get the latest description.
 ROBOT_DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
@@ -196,6 +204,7 @@ class LinkageNode(Node):
         self._activity = 'starting'
         self._recording_error: str | None = None
         self._described_linkage: FourBar | None = None
+        self._robot_transforms: messages.RobotStateTransforms | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = self.config.frame_prefix + self.config.frame_id
         # The per-tick messages and the scene are encoded straight from the state; the
@@ -205,9 +214,8 @@ class LinkageNode(Node):
         self._encoded_linkage: FourBar | None = None
         self._state_encoder: messages.LinkageStateEncoder | None = None
         self._marker_encoder: messages.MarkerArrayEncoder | None = None
-        self._window_start: Time | None = None
-        self._window_ticks = 0
-        self._achieved_rate = 0.0
+        self._rate_meter = diagnostics.RateMeter()
+        self._status_schedule = diagnostics.StatusSchedule()
         self._missed_deadlines = 0
         self._missed_before_restart = 0
         self._restart_motion()
@@ -409,6 +417,9 @@ class LinkageNode(Node):
              True if topic == self._diagnostics_topic else None)
             for topic, publisher in self._topic_publishers.items()
         ]
+        # and the TF robot_state_publisher would publish, logged only (docs/logging.md)
+        topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
+                   (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         try:
             return Recorder(
                 self.config.log_folder, topics=topics, metadata=metadata,
@@ -430,6 +441,9 @@ class LinkageNode(Node):
         (or an encoder equal to it) and log it: subscribers get the very bytes that are logged.
         """
         self._topic_publishers[topic].publish(data)
+        self._record(topic, data, log_time_ns)
+
+    def _record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         if self._recorder is None or self._recording_error is not None:
             return
         try:
@@ -542,7 +556,7 @@ class LinkageNode(Node):
             published += 1
             self._step += 1
             self._ticks += 1
-            self._window_ticks += 1
+            self._rate_meter.tick()
             self._publish_sample(sample, due)
 
     def _motion_time(self, seconds: float) -> Time:
@@ -573,7 +587,7 @@ class LinkageNode(Node):
         self._missed_deadlines = max(
             self._missed_deadlines, self._missed_before_restart + due - self._ticks
         )
-        self._window_ticks += 1
+        self._rate_meter.tick()
 
     def _publish_state(self, state: LinkageState, motion_time: float, at: Time) -> None:
         """
@@ -601,11 +615,20 @@ class LinkageNode(Node):
             self._joint_state_encoder.encode(state, nanoseconds, self._joint_positions),
             nanoseconds,
         )
+        if self._robot_transforms is not None:
+            self._record(
+                TF_TOPIC,
+                self._robot_transforms.message(
+                    dict(zip(messages.JOINT_NAMES, self._joint_positions)), nanoseconds),
+                nanoseconds,
+            )
         self._send(
             self._state_topic,
             self._state_encoder.encode(state, nanoseconds, motion_time),
             nanoseconds,
         )
+        if self._status_schedule.due(nanoseconds):
+            self._publish_diagnostics()
 
     def _wait_at_alpha_start(self, now: Time) -> None:
         """
@@ -680,6 +703,7 @@ class LinkageNode(Node):
         )
         self.get_logger().info(self._activity)
         self._publish_markers()
+        self._flush_log()
         self._publish_diagnostics()
         self.exit_code = EXIT_OK
 
@@ -691,6 +715,7 @@ class LinkageNode(Node):
             problem = f'the crank cannot go on: {detail}'
         self._problem = problem
         self.get_logger().error(problem)
+        self._flush_log()
         self._publish_diagnostics()
         self.exit_code = EXIT_FAILED
 
@@ -700,6 +725,12 @@ class LinkageNode(Node):
         self._described_linkage = self.config.linkage
         message = String(data=urdf_text(self.config.linkage, self.config.frame_id))
         self._publish(self._description_topic, message, at.nanoseconds)
+        if self._recorder is not None:
+            # What robot_state_publisher publishes for this description, for the bag only.
+            self._robot_transforms = messages.RobotStateTransforms(
+                message.data, self.config.frame_prefix)
+            self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(at.nanoseconds),
+                         at.nanoseconds)
 
     def _publish_markers(self) -> None:
         """Return the scene of the latest state, stamped with that state's time."""
@@ -721,12 +752,8 @@ class LinkageNode(Node):
         now = self.get_clock().now()
         if at is None:
             at = self._state_time if self._state_time is not None else now
-        if self._window_start is not None:
-            window = (now - self._window_start).nanoseconds * 1e-9
-            if window > 0.0:
-                self._achieved_rate = self._window_ticks / window
-        self._window_start = now
-        self._window_ticks = 0
+        self._rate_meter.update(now.nanoseconds)
+        self._status_schedule.sent(at.nanoseconds)
         problem = event or self._problem or self._recording_error
         level, text = assess(self.config, self._state, problem, self._activity)
         message = messages.diagnostic_array(
@@ -740,40 +767,27 @@ class LinkageNode(Node):
         self._publish(self._diagnostics_topic, message, at.nanoseconds)
 
     def _diagnostic_values(self) -> dict[str, str]:
-        config = self.config
-        values = {
-            'run state': self._control.state.value,
-            'end behavior': config.end_behavior.value,
-            'mode': config.mode.value,
-            'achieved rate (Hz)': f'{self._achieved_rate:.1f}',
-            'rate_hz': f'{config.rate_hz:g}',
-            'missed deadlines': str(self._missed_deadlines),
-        }
-        state = self._state
-        if state is not None:
-            reachability = config.linkage.reachability
-            distance = reachability.dead_point_distance(state.alpha)
-            change_distance = reachability.change_point_distance(state.alpha)
-            residual = float(loop_closure_residual(config.linkage, state))
-            values.update({
-                'alpha (rad)': repr(state.alpha),
-                'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
-                'dead point distance (deg)': (
-                    'none (full rotation)' if distance is None
-                    else f'{math.degrees(distance):.6f}'
-                ),
-                'change point distance (deg)': (
-                    'none' if change_distance is None else f'{math.degrees(change_distance):.6f}'
-                ),
-                'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
-                'loop closure residual': f'{residual:.3g}',
-            })
-        if self._recorder is None:
-            values['log file'] = 'disabled'
-        else:
-            values['log file'] = str(self._recorder.bag_path)
-            values['log size (bytes)'] = str(self._recorder.size_bytes)
-        return values
+        recorder = self._recorder
+        return diagnostics.key_values(
+            self.config, self._control.state, self._state, self._rate_meter.rate,
+            self._missed_deadlines,
+            None if recorder is None else str(recorder.bag_path),
+            None if recorder is None else recorder.size_bytes,
+        )
+
+    def _flush_log(self) -> None:
+        """
+        Have the bag writer write out what it holds before the run's last status.
+
+        So that its log size is the bag's.
+        """
+        if self._recorder is None or self._recording_error is not None:
+            return
+        try:
+            self._recorder.flush()
+        except OSError as error:
+            self._recording_error = f'recording stopped: {error}'
+            self.get_logger().error(self._recording_error)
 
 
 # --- process ------------------------------------------------------------------------------

@@ -6,13 +6,16 @@
 
 Republish a logged run for labs without rosbag2, or recover a killed one.
 
-    linkage-replay BAG [--rate FACTOR] [--loop] [--topics TOPIC ...] [--delay SECONDS]
+    linkage-replay BAG [--rate FACTOR] [--loop] [--topics TOPIC ...]
+                       [--exclude-topics TOPIC ...] [--delay SECONDS]
     linkage-replay --recover BAG
 
 Replaying publishes each message's logged CDR bytes unchanged on its logged topic, with its
 logged type and QoS (from the bag's metadata.yaml; without one, reliable depth 10, and transient
 local for ``/robot_description`` as the node offers it), at the logged log-time spacing divided
 by ``--rate``. Topics whose message type is not installed here are skipped with a warning.
+``--exclude-topics /tf /tf_static`` leaves out the bag's TF where a robot_state_publisher
+publishes it from the replayed joint states (as ``ros2 bag play --exclude-topics``).
 ``--recover`` rewrites a bag whose recorder was killed into a complete one (see
 docs/logging.md).
 """
@@ -44,6 +47,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     parser.add_argument('--loop', action='store_true', help='start over at the end, until Ctrl-C')
     parser.add_argument('--topics', nargs='+', metavar='TOPIC', help='replay only these topics')
+    parser.add_argument(
+        '--exclude-topics', nargs='+', metavar='TOPIC', default=[],
+        help='do not replay these topics, e.g. /tf /tf_static where a robot_state_publisher '
+        'publishes TF from the replayed joint states',
+    )
     parser.add_argument(
         '--delay',
         type=_non_negative_seconds,
@@ -79,7 +87,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 f'killed); run `linkage-replay --recover {bag}` first', file=sys.stderr,
             )
             return 1
-        plans = player.plan_topics(bag, arguments.topics)
+        plans = player.plan_topics(bag, arguments.topics, arguments.exclude_topics)
         published = player.replay(
             bag, plans, arguments.rate, arguments.loop, arguments.delay)
     except OSError as error:

@@ -40,9 +40,10 @@ from std_msgs.msg import String
 from test_bag_writer import only_bag
 
 DOMAIN_ID = 86
-LATCHED = ('/robot_description', '/diagnostics')
-NODE_TOPICS = ('/joint_states', '/linkage/state', '/robot_description', '/linkage/markers',
-               '/diagnostics')
+LATCHED = ('/robot_description', '/tf_static', '/diagnostics')
+# the node's topics and the TF robot_state_publisher would publish (logged only)
+LOGGED_TOPICS = ('/joint_states', '/linkage/state', '/robot_description', '/linkage/markers',
+                 '/diagnostics', '/tf', '/tf_static')
 
 
 def read_file_alone(path: Path) -> list[tuple[str, int, bytes]]:
@@ -178,8 +179,8 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: 
         assert log_times == sorted(log_times)
         assert log_times[-1] - log_times[0] <= 200_000_000
         topics = Counter(topic for topic, _, _ in logged)
-        assert set(topics) == set(NODE_TOPICS), topics
-        assert topics['/robot_description'] == 1
+        assert set(topics) == set(LOGGED_TOPICS), topics
+        assert topics['/robot_description'] == topics['/tf_static'] == 1
         assert [raw for topic, _, raw in logged if topic == '/robot_description'] == [
             description]
     # the states of all files are the run's, once each, in order

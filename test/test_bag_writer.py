@@ -31,7 +31,7 @@ from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from linkage_kinematics import messages, scene
-from linkage_kinematics.bag import reader as bag_reader
+from linkage_kinematics.bag import player, reader as bag_reader
 from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
 from linkage_kinematics.bag.definitions import DEFINITION_SEPARATOR, message_definition
 from linkage_kinematics.bag.errors import BagExistsError
@@ -80,6 +80,8 @@ NODE_TOPICS = {
     '/linkage/markers': MarkerArray,
     '/diagnostics': DiagnosticArray,
 }
+# The node logs TF too, as robot_state_publisher would publish it, without publishing it.
+LOGGED_TOPICS = {**NODE_TOPICS, '/tf_static': messages.TFMessage, '/tf': messages.TFMessage}
 DATA_TOPICS = ('/joint_states', '/linkage/state', '/linkage/markers', '/diagnostics')
 RATE_HZ = 200.0
 # 90° at this constant ω takes 0.3 s: a short run.
@@ -528,6 +530,28 @@ def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: i
     assert information['duration']['nanoseconds'] == 4_000
 
 
+@pytest.mark.parametrize('flushes', [0, 1, 7])
+def test_finished_size_is_the_size_of_the_bag_closed_then(tmp_path: Path, flushes: int) -> None:
+    writer = BagWriter(tmp_path / 'sized', metadata={'run': 'x'}, flush_interval=3600.0)
+    channels = [
+        writer.add_topic(topic, type_name, message_definition(type_name),
+                         offered_qos_profiles_for(QoSProfile(depth=10)))
+        for topic, type_name in (('/a', 'std_msgs/msg/String'),
+                                 ('/tf', 'tf2_msgs/msg/TFMessage'))
+    ]
+    for index in range(700):
+        writer.write(channels[0], encode_cdr(String(data=f'message {index}')), index, index)
+        if flushes and index % (700 // flushes) == 0:
+            writer.flush()
+    writer.flush()
+    projected = writer.finished_size()
+    writer.close()
+    # to a few bytes per chunk: its index counted with an offset for every channel
+    with open(writer.mcap_path, 'rb') as stream:
+        chunks = len(make_reader(stream).get_summary().chunk_indexes)
+    assert 0 <= projected - writer.mcap_path.stat().st_size <= 10 * (chunks + 3)
+
+
 def test_bag_writer_refuses_an_existing_bag_folder(tmp_path: Path) -> None:
     bag = tmp_path / 'taken'
     bag.mkdir()
@@ -579,10 +603,10 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 def test_every_published_topic_is_logged_with_its_type(node_run: dict[str, Any]) -> None:
     logged = read_with_rosbags(node_run['bag'])
-    assert set(logged) == set(NODE_TOPICS)
+    assert set(logged) == set(LOGGED_TOPICS)
     with Reader(node_run['bag']) as reader:
         types = {connection.topic: connection.msgtype for connection in reader.connections}
-    assert types == {topic: ros_type_name(msg_type) for topic, msg_type in NODE_TOPICS.items()}
+    assert types == {topic: ros_type_name(msg_type) for topic, msg_type in LOGGED_TOPICS.items()}
     assert len(logged['/linkage/state']) == len(logged['/joint_states']) >= 2
     assert len(logged['/robot_description']) == 1
 
@@ -649,7 +673,7 @@ def test_log_times_are_monotonic_and_every_message_has_its_exact_cdr_length(
     log_times = [message.log_time_ns for message in bag_reader.iter_messages(bag)]
     assert log_times == sorted(log_times)
     for topic, entries in read_with_rosbags(bag).items():
-        type_name = ros_type_name(NODE_TOPICS[topic])
+        type_name = ros_type_name(LOGGED_TOPICS[topic])
         for _, decoded, raw in entries:
             assert len(raw) == len(TYPESTORE.serialize_cdr(decoded, type_name)), topic
 
@@ -662,7 +686,7 @@ def test_mcap_ros2_decodes_every_message_with_the_logged_schemas(node_run: dict[
         counts[decoded.channel.topic] += 1
         assert decoded.schema.encoding == 'ros2msg'
         assert decoded.channel.message_encoding == 'cdr'
-        assert decoded.schema.name == ros_type_name(NODE_TOPICS[decoded.channel.topic])
+        assert decoded.schema.name == ros_type_name(LOGGED_TOPICS[decoded.channel.topic])
         assert 'offered_qos_profiles' in decoded.channel.metadata
     assert dict(counts) == topic_counts(bag_information(bag))
 
@@ -709,7 +733,8 @@ def test_metadata_yaml_is_rosbag2_jazzy_format(node_run: dict[str, Any]) -> None
             'liveliness', 'liveliness_lease_duration', 'avoid_ros_namespace_conventions',
         }
         expected_durability = (
-            'transient_local' if topic['name'] == '/robot_description' else 'volatile'
+            'transient_local' if topic['name'] in ('/robot_description', '/tf_static')
+            else 'volatile'
         )
         assert (profile['reliability'], profile['durability']) == ('reliable', expected_durability)
         assert entry['message_count'] == len(logged[topic['name']])
@@ -791,6 +816,22 @@ def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path
     assert alphas.count(alphas[0]) >= 2  # the run started over
 
 
+def test_replay_leaves_out_excluded_topics_such_as_the_bags_tf(
+    node_run: dict[str, Any], capsys: pytest.CaptureFixture[str],
+) -> None:
+    bag = node_run['bag']
+    everything = player.plan_topics(bag, None)
+    # tf2_msgs is not installed here: its topics are skipped, with a warning
+    assert {plan.topic for plan in everything} == set(NODE_TOPICS)
+    assert 'skipping /tf' in capsys.readouterr().err
+    # beside a robot_state_publisher the bag's TF is left out, and nothing is said about it
+    without_tf = player.plan_topics(bag, None, ['/tf', '/tf_static'])
+    assert [plan.topic for plan in without_tf] == [plan.topic for plan in everything]
+    assert capsys.readouterr().err == ''
+    only_states = player.plan_topics(bag, ['/linkage/state', '/joint_states'], ['/joint_states'])
+    assert [plan.topic for plan in only_states] == ['/linkage/state']
+
+
 def test_replay_rejects_bad_input_with_a_clear_message(
     tmp_path: Path, node_run: dict[str, Any], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -819,6 +860,9 @@ def test_replay_rejects_bad_input_with_a_clear_message(
 
     assert replay_main([str(node_run['bag']), '--topics', '/nope']) == 1
     assert '/nope' in capsys.readouterr().err
+    every_topic = list(LOGGED_TOPICS)
+    assert replay_main([str(node_run['bag']), '--exclude-topics', *every_topic]) == 1
+    assert 'every topic is excluded' in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_info:
         replay_main([str(node_run['bag']), '--rate', '-2'])
     assert exit_info.value.code == 2

@@ -129,7 +129,9 @@ def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: 
     assert executable.is_file() and os.access(executable, os.X_OK)
     share = install / 'linkage_kinematics' / 'share' / 'linkage_kinematics'
     for installed in ('launch/linkage.launch.py', 'config/seed_constant.yaml',
-                      'config/seed_variable.yaml', 'urdf/linkage.urdf'):
+                      'config/seed_variable.yaml', 'urdf/linkage.urdf',
+                      'interfaces/tf2_msgs/msg/TFMessage.msg',
+                      'interfaces/tf2_msgs/msg/TFMessage.json'):
         assert (share / installed).is_file(), installed
 
     environment = _colcon_environment(install, ros_environment(DOMAIN_ID))

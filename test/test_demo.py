@@ -5,7 +5,8 @@
 `linkage-demo` end to end.
 
 The real node runs both seed scenarios, logs them, and the tables printed from the logs carry the
-exact values (the seed's Table 1/2 rows and ω = 3.713 at 90°).
+exact values (the seed's Table 1/2 rows and ω = 3.713 at 90°); the diagnostics in its bags move
+with the mechanism.
 """
 
 import math
@@ -14,12 +15,15 @@ from pathlib import Path
 import subprocess
 import sys
 
+from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.bag.metadata import BagMetadata
-from linkage_kinematics.bag.reader import read_states
+from linkage_kinematics.bag.reader import iter_messages, read_states
+from linkage_kinematics.diagnostics import STATUS_PERIOD
 from linkage_kinematics.drive import DriveLaw
 import matplotlib.image
 import numpy as np
 import pytest
+from rclpy.serialization import deserialize_message
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -51,6 +55,8 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
             round(drive.time_to(0.0, alpha) * 1e9) for alpha in states.alpha]
     assert [round(BagMetadata.read(bag).duration_ns * 1e-6) for bag in bags] == [
         785, 1571]
+    for bag in bags:
+        check_diagnostics_follow_the_run(bag)
     constant, variable = completed.stdout.split('Variable law')
     # Table 1 and 2, α = 0 and 90° rows (constant law)
     for value in ('-6.667', '-57.78', '192.6', '0.1800', '5.200'):
@@ -58,6 +64,38 @@ def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
     # exact variable law: ω = 0.1 at 0°, 3.713 at 90°, α̈ = 2.3·ω
     for value in ('0.1000', '3.713', '-0.3333', '0.0856', '-0.2852'):
         assert value in variable
+
+
+def check_diagnostics_follow_the_run(bag: Path) -> None:
+    """
+    Check a status at least every STATUS_PERIOD of mechanism time, with right key values.
+
+    From the first state to the last; the last one's log size within 10 % of the bag's.
+    """
+    statuses, state_times = [], []
+    for message in iter_messages(bag, topics={'/diagnostics', '/linkage/state'}):
+        if message.topic == '/linkage/state':
+            state_times.append(message.log_time_ns)
+            continue
+        (status,) = deserialize_message(message.data, DiagnosticArray).status
+        statuses.append((message.log_time_ns, {kv.key: kv.value for kv in status.values}))
+    times = [time for time, _ in statuses]
+    assert times[0] <= state_times[0] and times[-1] >= state_times[-1]
+    within_run = [time for time in times if state_times[0] <= time <= state_times[-1]]
+    gaps = np.diff([state_times[0], *within_run, state_times[-1]])
+    assert gaps.max() <= STATUS_PERIOD * 1e9, bag
+    assert len(within_run) >= (state_times[-1] - state_times[0]) / (STATUS_PERIOD * 1e9)
+    (mcap_file,) = bag.glob('*.mcap')
+    final = statuses[-1][1]
+    assert abs(int(final['log size (bytes)']) - mcap_file.stat().st_size) <= (
+        0.1 * mcap_file.stat().st_size)
+    for _, values in statuses:
+        # fixed_step paces by the drive law: no rate_hz, which it does not use
+        assert values['mode'] == 'fixed_step' and 'rate_hz' not in values
+        assert values['alpha_step (deg)'] == '0.5'
+        assert values['missed deadlines'].isdigit() and values['log size (bytes)'].isdigit()
+    residual = final['loop closure residual']
+    assert 'e' in residual and float(residual) < 1e-12
 
 
 @pytest.mark.parametrize(

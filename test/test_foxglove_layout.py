@@ -37,6 +37,14 @@ TITLE_KEYS = ('foxglovePanelTitle', 'lichtblickPanelTitle')
 PAPER = preset('paper').geometry
 SEED_VARIABLE = DriveLaw(0.1, 2.3)
 ALPHA_PATH = '/linkage/state.points[0].positions[0]'
+# The α tab's x axis: crank_joint's position, α, in /joint_states, one message per state with the
+# state's stamp. Lichtblick's Plot takes every message of the x axis's topic for x values only,
+# so x must come from another topic than the plotted y values (docs/logging.md).
+X_ALPHA_PATH = '/joint_states.position[0]'
+# The least width per height of the 3D panel the framing is checked for: the layout's is about
+# 2 on a 16:10 screen (42 % of the width, 40 % of the height less the toolbars), and wider
+# panels see more.
+SCENE_ASPECT = 1.2
 # A message path without filters, slices or math modifiers: a topic, then fields with at most
 # one constant index each, e.g. /linkage/state.points[0].velocities[7].
 MESSAGE_PATH = re.compile(r'(?P<topic>/[A-Za-z0-9_/]+)(?P<fields>(?:\.[A-Za-z_]\w*(?:\[\d+\])?)+)')
@@ -138,9 +146,11 @@ def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         schema_of_topic = {channel.topic: summary.schemas[channel.schema_id]
                            for channel in summary.channels.values()}
         decoded: dict[str, list[Any]] = {topic: [] for topic in schema_of_topic}
-        for _, channel, _, message in reader.iter_decoded_messages():
+        log_times: dict[str, list[int]] = {topic: [] for topic in schema_of_topic}
+        for _, channel, record, message in reader.iter_decoded_messages():
             decoded[channel.topic].append(message)
-    return {'schemas': schema_of_topic, 'messages': decoded}
+            log_times[channel.topic].append(record.log_time)
+    return {'schemas': schema_of_topic, 'messages': decoded, 'log_times': log_times}
 
 
 # --- the layout on its own -----------------------------------------------------------------------
@@ -199,7 +209,7 @@ def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_a
     assert labels(over_time) == {'α', 'β', 'γ', 'ω', 'ω_AB', 'ω_BC', 'ω̇', 'ω̇_AB', 'ω̇_BC',
                                  'V_A', 'V_B'}
     assert all(config['xAxisVal'] == 'custom' and config['xAxisPath']
-               == {'value': ALPHA_PATH, 'enabled': True} for config in against_alpha)
+               == {'value': X_ALPHA_PATH, 'enabled': True} for config in against_alpha)
     assert labels(against_alpha) == {'β', 'γ', 'ω_AB', 'ω_BC', 'ω̇_AB', 'ω̇_BC', 'V_A', 'V_B'}
 
 
@@ -207,8 +217,8 @@ def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
     """
     Return the disk (radius OA about O) and every place pin B can reach.
 
-    (radius BC about C) lie inside the grid and inside the 2D camera's view of a square panel
-    (wider panels see more).
+    (radius BC about C) lie inside the grid and inside the 2D camera's view of the layout's panel
+    (SCENE_ASPECT; wider panels see more).
     """
     [three_d] = [config for key, config in load_layout()['configById'].items()
                  if key.startswith('3D!')]
@@ -223,9 +233,10 @@ def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
     # whose view is ``distance`` high and distance × (width/height) wide.
     assert (camera['perspective'], camera['phi'], camera['thetaOffset']) == (False, 0, 0)
     centre_x, centre_y, _ = camera['targetOffset']
-    half_view = camera['distance'] / 2
-    assert centre_x - half_view <= low_x - margin and high_x + margin <= centre_x + half_view
-    assert centre_y - half_view <= -high_y - margin and high_y + margin <= centre_y + half_view
+    half_height = camera['distance'] / 2
+    half_width = half_height * SCENE_ASPECT
+    assert centre_x - half_width <= low_x - margin and high_x + margin <= centre_x + half_width
+    assert centre_y - half_height <= -high_y - margin and high_y + margin <= centre_y + half_height
 
     grid = three_d['layers']['grid']
     grid_x, grid_y, grid_z = grid['position']
@@ -233,10 +244,27 @@ def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
     assert grid_x - half_grid <= low_x - margin and high_x + margin <= grid_x + half_grid
     assert grid_y - half_grid <= -high_y - margin and high_y + margin <= grid_y + half_grid
     assert grid_z < 0.0  # below the disk and the bars
-    assert three_d['scene']['transforms']['showLabel'] is False
-    # The URDF needs /tf (robot_state_publisher on a live system), which a bag does not hold.
+    # The grid fills a panel twice as wide as the layout's, around the mechanism.
+    assert half_grid >= 2 * SCENE_ASPECT * half_height
+    # Frame labels off, the frames' axes a quarter of their 0.2 m, TF preloaded so that a seek
+    # finds every frame.
+    assert three_d['scene']['transforms'] == {
+        'showLabel': False, 'labelSize': 0.05, 'axisScale': 0.25, 'lineWidth': 1,
+        'enablePreloading': True}
+    # The URDF is posed by the bag's /tf (robot_state_publisher on a live system), under the
+    # markers, which coincide with it.
     assert three_d['topics'] == {'/linkage/markers': {'visible': True},
-                                 '/robot_description': {'visible': False}}
+                                 '/robot_description': {'visible': True}}
+
+
+def test_legends_sit_beside_the_plots_and_tab_names_fit_their_tabs() -> None:
+    layout = load_layout()
+    for key, config in plots(layout).items():
+        assert (config['showLegend'], config['legendDisplay']) == (True, 'left'), key
+    [tab_panel] = [config for key, config in layout['configById'].items()
+                   if key.startswith('Tab!')]
+    # Lichtblick's tabs are at most 120 px wide (panels/Tab/ToolbarTab.tsx): about 14 letters.
+    assert [tab['title'] for tab in tab_panel['tabs']] == ['Over time', 'Against α']
 
 
 # --- the layout against a real node bag ----------------------------------------------------------
@@ -282,12 +310,37 @@ def test_layout_names_only_topics_and_frames_the_node_logs(node_bag: dict[str, A
     diagnostics = [config for key, config in panels.items() if key.startswith('Diagnostic')]
     assert len(diagnostics) == 2
     named |= {config['topicToRender'] for config in diagnostics}
-    assert named == {'/linkage/state', '/linkage/markers', '/robot_description', '/diagnostics'}
+    assert named == {'/linkage/state', '/joint_states', '/linkage/markers', '/robot_description',
+                     '/diagnostics'}
     assert named <= set(node_bag['schemas'])
 
     frames = {marker.header.frame_id for array in node_bag['messages']['/linkage/markers']
               for marker in array.markers}
     assert frames == {three_d['followTf']} == {three_d['layers']['grid']['frameId']}
+
+
+def test_custom_x_and_y_come_from_other_topics_with_equal_counts_and_stamps(
+    node_bag: dict[str, Any],
+) -> None:
+    """
+    Pair x and y values by index (Lichtblick's and Foxglove's custom x axis).
+
+    So each plotted y stream and its x stream have one message per state with the same stamps;
+    and x comes from another topic than y: Lichtblick reads the x topic's messages for x only.
+    """
+    custom = [config for config in plots(load_layout()).values() if config['xAxisVal'] == 'custom']
+    assert len(custom) == 4
+    for config in custom:
+        x_topic, _ = split_path(config['xAxisPath']['value'])
+        for series in config['paths']:
+            y_topic, _ = split_path(series['value'])
+            assert y_topic != x_topic, series['value']
+            x_times, y_times = node_bag['log_times'][x_topic], node_bag['log_times'][y_topic]
+            assert len(x_times) == len(y_times) > 100
+            assert x_times == y_times
+            stamps = [[message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
+                       for message in node_bag['messages'][topic]] for topic in (x_topic, y_topic)]
+            assert stamps[0] == stamps[1] == x_times
 
 
 def test_diagnostics_detail_panel_shows_the_status_the_node_logs(node_bag: dict[str, Any]) -> None:
@@ -308,11 +361,11 @@ def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
     def read(label_or_path: str) -> list[float]:
         path = by_label.get(label_or_path, label_or_path)
         topic, fields = split_path(path)
-        assert topic == '/linkage/state'
-        return [evaluate(message, fields, path) for message in states]
+        return [evaluate(message, fields, path) for message in node_bag['messages'][topic]]
 
     alphas = read(ALPHA_PATH)
     assert alphas[0] == 0.0 and alphas[-1] == math.pi / 2
+    assert read(X_ALPHA_PATH) == alphas  # the α tab's x values are the states' α
     library = [solve(PAPER, alpha, SEED_VARIABLE) for alpha in alphas]
     omega_bc = read('ω_BC')
     assert max(omega_bc) < 0.0  # clockwise over the whole turn, as in the seed's Table 3

@@ -294,7 +294,8 @@ def test_signal_ends_a_logging_run_cleanly(listener, tmp_path, signal_number):
         for _, channel, _, message in reader.iter_decoded_messages():
             recorded.setdefault(channel.topic, []).append(message)
         run_metadata = {record.name: record.metadata for record in reader.iter_metadata()}
-    assert set(recorded) == {*DATA_TOPICS, '/robot_description'}
+    # and the TF robot_state_publisher would publish (test_bag_transforms.py)
+    assert set(recorded) == {*DATA_TOPICS, '/robot_description', '/tf', '/tf_static'}
     assert recorded['/robot_description'][0].data == urdf_text(PAPER)
     assert sum(map(len, recorded.values())) == metadata['message_count']
     parameters = next(

@@ -97,7 +97,8 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
         (description,) = listener.received[_topic(namespace, 'robot_description')]
         assert description.data == urdf_text(geometry)
 
-    # Three bags, each holding only its own node's resolved topics (and /diagnostics).
+    # Three bags, each holding only its own node's resolved topics (and /diagnostics, /tf and
+    # /tf_static, whose frames carry the node's prefix).
     logs = {namespace: (tmp_path / f"node{namespace.replace('/', '_')}.log").read_text()
             for namespace in MECHANISMS}
     seen = set()
@@ -112,5 +113,5 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
             topics = {connection.topic for connection in reader.connections}
         assert topics == {_topic(namespace, name) for name in (
             'joint_states', 'linkage/state', 'robot_description', 'linkage/markers')} | {
-            '/diagnostics'}
+            '/diagnostics', '/tf', '/tf_static'}
     assert len(list(bags.iterdir())) == 3

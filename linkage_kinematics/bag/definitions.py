@@ -7,7 +7,8 @@ Message definitions and type hashes as rosbag2 stores them, read from the ament 
 ``message_definition`` is the ``ros2msg`` schema text of a type with every type it uses;
 ``type_description_hash`` is the RIHS01 hash rosidl generated for it. Both read the installed
 interface files (``share/<package>/msg/<Name>.msg`` and ``.json``) of the packages on
-AMENT_PREFIX_PATH. Plain Python (no rclpy).
+AMENT_PREFIX_PATH, and for tf2_msgs, which is not on PyPI, the copies this package ships
+(``share/linkage_kinematics/interfaces/``). Plain Python (no rclpy).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ from pathlib import Path
 
 from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
 from linkage_kinematics.bag.errors import MessageDefinitionError
+from linkage_kinematics.bag.metadata import PACKAGE_NAME
 
 SCHEMA_ENCODING = 'ros2msg'
 DEFINITION_SEPARATOR = '=' * 80
@@ -28,10 +30,20 @@ _PRIMITIVE_TYPES = frozenset(
 
 
 def _interface_file(package: str, name: str, suffix: str) -> Path | None:
+    """
+    Return the installed ``<package>/msg/<name><suffix>``.
+
+    From the package in the ament index, or where that package is not installed, from the copies
+    this package ships of the types it logs without publishing them (tf2_msgs, which has no
+    package on PyPI; see interfaces/README.md).
+    """
     try:
         share = Path(get_package_share_directory(package))
     except PackageNotFoundError:
-        return None
+        try:
+            share = Path(get_package_share_directory(PACKAGE_NAME)) / 'interfaces' / package
+        except PackageNotFoundError:
+            return None
     except OSError as error:  # ament_index_python's EnvironmentError: no ament index at all
         raise MessageDefinitionError(
             f'cannot look up {package}/msg/{name}{suffix}: {error} (source the ROS 2 setup '

@@ -69,8 +69,10 @@ def _logged_topics(bag: Path) -> dict[str, tuple[str, dict[str, Any] | None]]:
     return found
 
 
-def plan_topics(bag: Path, wanted: Sequence[str] | None) -> list[TopicPlan]:
-    """Return what to republish of ``bag`` (only ``wanted`` topics, if given)."""
+def plan_topics(
+    bag: Path, wanted: Sequence[str] | None, excluded: Sequence[str] = ()
+) -> list[TopicPlan]:
+    """Return what to republish of ``bag``: only ``wanted`` topics, if given, less ``excluded``."""
     logged = _logged_topics(bag)
     if wanted:
         missing = sorted(set(wanted) - set(logged))
@@ -79,6 +81,10 @@ def plan_topics(bag: Path, wanted: Sequence[str] | None) -> list[TopicPlan]:
                 f"{bag} has no topic {', '.join(missing)}; it has {', '.join(sorted(logged))}"
             )
         logged = {topic: logged[topic] for topic in wanted}
+    # Like rosbag2, an excluded topic the bag does not hold is no error (an older bag has no TF).
+    logged = {topic: entry for topic, entry in logged.items() if topic not in excluded}
+    if not logged:
+        raise BagError(f'nothing to replay in {bag}: every topic is excluded')
     plans = []
     for topic, (type_name, offered_qos) in logged.items():
         msg_type = _import_message_type(type_name)

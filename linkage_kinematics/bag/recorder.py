@@ -69,7 +69,11 @@ class Recorder:
 
     @property
     def size_bytes(self) -> int:
-        """Return the MCAP file's size as the writer last reported it (every 0.25 s at most)."""
+        """
+        Return the size the finished MCAP file will have, as the writer last reported it.
+
+        Counting what it has written out: it reports at most every 0.25 s and after ``flush``.
+        """
         return self._writer.size_bytes
 
     def add_topic(
@@ -96,6 +100,10 @@ class Recorder:
     def record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         """Log ``data``, a message of ``topic`` encoded as the node publishes it."""
         self._writer.write(self._channels[topic], data, log_time_ns, log_time_ns)
+
+    def flush(self) -> None:
+        """Wait until the writer has written out everything it was given (``size_bytes`` too)."""
+        self._writer.flush()
 
     def close(self) -> None:
         """Finish the bag: wait until its writer has written everything it was given."""

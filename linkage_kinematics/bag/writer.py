@@ -31,7 +31,7 @@ This module is plain Python (no rclpy): bytes in, files out.
 """
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 import os
 from pathlib import Path
 import time
@@ -49,7 +49,21 @@ from linkage_kinematics.bag.metadata import (
     qos_profiles_yaml,
     TopicInfo,
 )
-from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, Writer
+from mcap.data_stream import RecordBuilder
+from mcap.opcode import Opcode
+from mcap.records import (
+    Channel,
+    ChunkIndex,
+    DataEnd,
+    Footer,
+    McapRecord,
+    Metadata,
+    MetadataIndex,
+    Schema,
+    Statistics,
+    SummaryOffset,
+)
+from mcap.writer import CompressionType, LIBRARY_IDENTIFIER, MCAP0_MAGIC, Writer
 
 METADATA_RECORD_NAME = PACKAGE_NAME
 ROSBAG2_METADATA_RECORD_NAME = 'rosbag2'
@@ -64,6 +78,16 @@ NO_SPLIT = 0
 _COMPRESSION = {
     'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4, 'none': CompressionType.NONE
 }
+# The compression a chunk (index) names, as mcap writes it.
+_CHUNK_COMPRESSION = {CompressionType.ZSTD: 'zstd', CompressionType.LZ4: 'lz4',
+                      CompressionType.NONE: ''}
+
+
+def _record_size(record: McapRecord) -> int:
+    """Return the bytes mcap writes for ``record``."""
+    builder = RecordBuilder()
+    record.write(builder)
+    return builder.count
 
 
 def _check_options(metadata: Mapping[str, str], compression: str, chunk_size: int,
@@ -127,6 +151,11 @@ class _McapFile:
         self.flushed = _Span()
         self.pending = _Span()
         self.new_messages = 0  # besides the repeated ones it starts with
+        self._compression = _CHUNK_COMPRESSION[compression]
+        # Bytes of the schema and channel records, which the summary repeats, and the chunks
+        # written so far (each gets a chunk index in the summary).
+        self._registered_size = 0
+        self._chunk_count = 0
         self.stream: BinaryIO = open(path, 'wb')
         self.writer = Writer(self.stream, chunk_size=chunk_size, compression=compression)
         self.writer.start(
@@ -141,14 +170,19 @@ class _McapFile:
         """Add the channel (and if new, the schema) of a topic; its channel id."""
         schema_id = self._schema_ids.get(info.type_name)
         if schema_id is None:
-            schema_id = self.writer.register_schema(
-                info.type_name, SCHEMA_ENCODING, definition.encode('utf-8'))
+            data = definition.encode('utf-8')
+            schema_id = self.writer.register_schema(info.type_name, SCHEMA_ENCODING, data)
             self._schema_ids[info.type_name] = schema_id
-        return self.writer.register_channel(
-            info.name, MESSAGE_ENCODING, schema_id,
-            {'offered_qos_profiles': qos_profiles_yaml(info.offered_qos_profiles),
-             'topic_type_hash': info.type_hash},
-        )
+            self._registered_size += _record_size(
+                Schema(id=schema_id, data=data, encoding=SCHEMA_ENCODING, name=info.type_name))
+        channel_metadata = {'offered_qos_profiles': qos_profiles_yaml(info.offered_qos_profiles),
+                            'topic_type_hash': info.type_hash}
+        channel_id = self.writer.register_channel(
+            info.name, MESSAGE_ENCODING, schema_id, channel_metadata)
+        self._registered_size += _record_size(Channel(
+            id=channel_id, topic=info.name, message_encoding=MESSAGE_ENCODING,
+            metadata=channel_metadata, schema_id=schema_id))
+        return channel_id
 
     def ends_before(self, log_time_ns: int, max_size: int, max_duration_ns: int) -> bool:
         """
@@ -169,7 +203,42 @@ class _McapFile:
 
     def flush(self) -> None:
         self.writer.flush()
+        if self.stream.tell() > self.durable_size:
+            self._chunk_count += 1
         self.durable_size = self.stream.tell()
+
+    def finished_size(self, serialized_metadata: str, channel_ids: Collection[int]) -> int:
+        """
+        Return the size the file would have if it were finished now.
+
+        What is written out (``flush`` first, to count the open chunk) and what ``finish`` adds
+        to it: the rosbag2 metadata record, the data end, and the summary, which repeats the
+        schema and channel records and holds the statistics, a chunk index per chunk, the
+        metadata indexes, the group offsets and the footer; each measured as mcap writes it (a
+        chunk index as if every channel had messages in its chunk, so at most 10 bytes per
+        channel and chunk too many).
+        """
+        channel_counts = {channel_id: 0 for channel_id in channel_ids}
+        tail = [
+            Metadata(name=ROSBAG2_METADATA_RECORD_NAME,
+                     metadata={'serialized_metadata': serialized_metadata}),
+            DataEnd(data_section_crc=0),
+            Statistics(attachment_count=0, channel_count=len(channel_counts),
+                       channel_message_counts=channel_counts, chunk_count=0, message_count=0,
+                       message_end_time=0, message_start_time=0, metadata_count=0,
+                       schema_count=0),
+            *[ChunkIndex(chunk_length=0, chunk_start_offset=0, compression=self._compression,
+                         compressed_size=0, message_end_time=0, message_index_length=0,
+                         message_index_offsets=channel_counts, message_start_time=0,
+                         uncompressed_size=0)] * self._chunk_count,
+            *[MetadataIndex(offset=0, length=0, name=name)
+              for name in (METADATA_RECORD_NAME, ROSBAG2_METADATA_RECORD_NAME)],
+            # schemas, channels, statistics, chunk, attachment and metadata indexes
+            *[SummaryOffset(group_opcode=Opcode.SCHEMA, group_start=0, group_length=0)] * 6,
+            Footer(summary_start=0, summary_offset_start=0, summary_crc=0),
+        ]
+        return (self.stream.tell() + self._registered_size + sum(map(_record_size, tail))
+                + len(MCAP0_MAGIC))
 
     def finish(self, serialized_metadata: str) -> None:
         """Write the rosbag2 record (rosbag2's ``update_metadata``) and the summary."""
@@ -312,6 +381,18 @@ class BagWriter:
         except OSError as error:
             raise self._fail(error) from None
         self._last_flush = time.monotonic()
+
+    def finished_size(self) -> int:
+        """
+        Return the size the bag's MCAP files would have if the bag were finished now.
+
+        Those finished, and the open one's ``finished_size`` (``flush`` first, to count its
+        open chunk).
+        """
+        if self._failure is not None or self._closed:
+            return self.size_bytes
+        return self._finished_size + self._file.finished_size(
+            self._bag_metadata().serialized(), self._topics)
 
     def close(self) -> None:
         """

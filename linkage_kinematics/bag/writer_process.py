@@ -19,9 +19,10 @@ metadata.yaml, then exits. It runs in a session of its own, so a Ctrl-C meant fo
 Frames on the child's stdin: one kind byte, a uint32 length, the payload. ``S`` (JSON:
 folder, metadata, split) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
 (JSON) adds a topic; ``M`` holds messages, each a ``<HqqI`` header (channel id, log time,
-publish time, length) and its bytes. The child answers on stdout with JSON lines: ``bag`` or
-``channel`` for S and T, ``size`` now and then, ``error`` when the bag cannot go on, and
-``closed`` when it is done.
+publish time, length) and its bytes; ``F`` (empty) asks the child to write out everything it
+holds. The child answers on stdout with JSON lines: ``bag`` or ``channel`` for S and T,
+``size`` (the size the finished bag would have, ``BagWriter.finished_size``) now and then and
+with ``flushed`` for F, ``error`` when the bag cannot go on, and ``closed`` when it is done.
 
 Plain Python (no rclpy), as ``writer``.
 """
@@ -43,7 +44,7 @@ from linkage_kinematics.bag.writer import BagWriter, NO_SPLIT, WRITE_BATCH
 
 _FRAME = struct.Struct('<cI')
 _MESSAGE = struct.Struct('<HqqI')
-START, TOPIC, MESSAGES = b'S', b'T', b'M'
+START, TOPIC, MESSAGES, FLUSH = b'S', b'T', b'M', b'F'
 # The pipe holds a batch for at most this long (s), so that a node killed outright loses at
 # most its last batch of this age, even at low rates.
 BATCH_AGE = 0.05
@@ -140,6 +141,36 @@ class BagWriterProcess:
                 or time.monotonic() - self._batch_started >= BATCH_AGE):
             self._send_queued()
 
+    def flush(self) -> None:
+        """
+        Hand over what is queued and wait until the child has written it all out.
+
+        ``size_bytes`` is then the size of the finished bag with everything handed over so far.
+        """
+        if self._failure is not None or self._closed:
+            raise BagError(self._failure or f'bag {self.bag_path} is closed')
+        if self._queued:
+            self._send_queued()
+        self._send(FLUSH, b'')
+        descriptor = self._process.stdout.fileno()
+        os.set_blocking(descriptor, True)
+        try:
+            while True:
+                replies = self._take_replies()
+                for reply in replies:
+                    self._note(reply)
+                if any('flushed' in reply for reply in replies):
+                    break
+                chunk = os.read(descriptor, 65536)
+                if not chunk:
+                    raise BagError(f'the bag writer ended with status '
+                                   f'{self._process.wait()} before answering')
+                self._replies += chunk
+        finally:
+            os.set_blocking(descriptor, False)
+        if self._failure is not None:
+            raise BagError(self._failure)
+
     def close(self) -> None:
         """
         Hand over what is queued, lets the child finish the bag and waits for it.
@@ -222,10 +253,14 @@ class BagWriterProcess:
         except BlockingIOError:
             pass
         for reply in self._take_replies():
-            if 'error' in reply and self._failure is None:
-                self._failure = reply['error']
-            if 'size' in reply:
-                self.size_bytes = reply['size']
+            self._note(reply)
+
+    def _note(self, reply: dict[str, Any]) -> None:
+        """Take note of an unrequested reply: an error or a size."""
+        if 'error' in reply and self._failure is None:
+            self._failure = reply['error']
+        if 'size' in reply:
+            self.size_bytes = reply['size']
 
     def _take_replies(self) -> list[dict[str, Any]]:
         *lines, self._replies = self._replies.split(b'\n')
@@ -273,6 +308,8 @@ class _Child:
                 self._start(json.loads(payload))
             elif kind == TOPIC:
                 self._add_topic(json.loads(payload))
+            elif kind == FLUSH:
+                self._flush()
         self._close()
 
     def _read_frame(self) -> tuple[bytes, bytes] | None:
@@ -332,7 +369,16 @@ class _Child:
         if size != self._reported_size and now - self._last_report >= SIZE_REPORT_INTERVAL:
             self._reported_size = size
             self._last_report = now
-            self._reply(size=size)
+            self._reply(size=self._writer.finished_size())
+
+    def _flush(self) -> None:
+        if not self._failed:
+            try:
+                self._writer.flush()
+            except BagError as error:
+                self._failed = True
+                self._reply(error=str(error))
+        self._reply(size=self._writer.finished_size(), flushed=True)
 
     def _close(self) -> None:
         if self._writer is None:
