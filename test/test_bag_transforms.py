@@ -225,7 +225,8 @@ def namespaced_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     run_folder = tmp_path_factory.mktemp('tf_run')
     folder = run_folder / 'bags'
     process = start_node(
-        {'frame_prefix': FRAME_PREFIX, 'end_behavior': 'stop', 'log.folder': str(folder)}, DOMAIN_ID,
+        {'frame_prefix': FRAME_PREFIX, 'end_behavior': 'stop', 'log.folder': str(folder)},
+        DOMAIN_ID,
         run_folder / 'node.log', ros_arguments=['-r', f'__ns:={NAMESPACE}'],
     )
     try:
