@@ -26,6 +26,7 @@ from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
 from linkage_kinematics.measured import Estimate, Rejection
 from linkage_kinematics.motion import blocked_note
 from linkage_kinematics.parameters import MotionMode, RunConfiguration, Source
+from linkage_kinematics.run_control import RunState
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
 RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured
@@ -91,6 +92,7 @@ class RateMeter:
 
 def key_values(
     config: RunConfiguration,
+    run_state: RunState,
     state: LinkageState | None,
     achieved_rate: float | None,
     missed_deadlines: int,
@@ -102,9 +104,10 @@ def key_values(
     """
     Return the status's key values (README, "Diagnostics") as diagnostic_msgs/KeyValue strings.
 
-    ``achieved_rate`` None means not measured yet (the first status); ``log_file`` None means
-    logging is disabled; ``log_size`` is the bag's size in bytes. ``health`` is the measured
-    source's (None under the drive law), whose values replace the drive law's pace and settings.
+    ``run_state`` says whether the motion runs or is paused; ``achieved_rate`` None means not
+    measured yet (the first status); ``log_file`` None means logging is disabled; ``log_size`` is
+    the bag's size in bytes. ``health`` is the measured source's (None under the drive law),
+    whose values replace the drive law's pace and settings.
     """
     # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
     # the values that change at the top.
@@ -137,6 +140,7 @@ def key_values(
         if log_file is not None and log_size is not None:
             values['log size (bytes)'] = str(int(log_size))
         values['log file'] = LOG_DISABLED if log_file is None else log_file
+        values['run state'] = run_state.value
         return values
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
@@ -148,6 +152,7 @@ def key_values(
     if log_file is not None and log_size is not None:
         values['log size (bytes)'] = str(int(log_size))
     values['log file'] = LOG_DISABLED if log_file is None else log_file
+    values['run state'] = run_state.value
     values['mode'] = config.mode.value
     values['end behavior'] = config.end_behavior.value
     return values
@@ -212,6 +217,7 @@ def assess(
 
 def report(
     config: RunConfiguration,
+    run_state: RunState,
     state: LinkageState | None,
     problem: str | None,
     activity: str,
@@ -233,8 +239,8 @@ def report(
         warnings = health.take_warnings()
         driver_name = config.joints[Link(config.driver.value)].name
         problem = problem or health.problem(now_ns, config.measured_timeout, driver_name)
-    values = key_values(config, state, achieved_rate, missed_deadlines, log_file, log_size,
-                        health, now_ns)
+    values = key_values(config, run_state, state, achieved_rate, missed_deadlines, log_file,
+                        log_size, health, now_ns)
     level, text = assess(config, state, problem, activity, warnings)
     return level, text, values
 

@@ -263,11 +263,11 @@ class LinkageNode(Node):
         self._status_schedule.sent(at_ns)
         recorder = self.outputs.recorder
         level, text, values = report(
-            self.config, self._state, event or self.problem or self.outputs.recording_error,
-            self.activity, self._source.health, now_ns, self._rate_meter.rate,
-            self._source.missed_deadlines, None if recorder is None else str(recorder.bag_path),
+            self.config, self.control.state, self._state,
+            event or self.problem or self.outputs.recording_error, self.activity,
+            self._source.health, now_ns, self._rate_meter.rate, self._source.missed_deadlines,
+            None if recorder is None else str(recorder.bag_path),
             None if recorder is None else recorder.size_bytes)
-        values = {'run state': self.control.state.value, **values}
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

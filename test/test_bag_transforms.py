@@ -225,8 +225,9 @@ def namespaced_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
     run_folder = tmp_path_factory.mktemp('tf_run')
     folder = run_folder / 'bags'
     process = start_node(
-        {'frame_prefix': FRAME_PREFIX, 'log.folder': str(folder), 'end_behavior': 'stop'},
-        DOMAIN_ID, run_folder / 'node.log', ros_arguments=['-r', f'__ns:={NAMESPACE}'],
+        {'frame_prefix': FRAME_PREFIX, 'end_behavior': 'stop', 'log.folder': str(folder)},
+        DOMAIN_ID,
+        run_folder / 'node.log', ros_arguments=['-r', f'__ns:={NAMESPACE}'],
     )
     try:
         status = process.wait(timeout=PROCESS_TIMEOUT)

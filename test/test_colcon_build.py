@@ -33,10 +33,6 @@ import pytest
 from sensor_msgs.msg import JointState
 
 DOMAIN_ID = 12
-PACKAGE_ENTRIES = (
-    'package.xml', 'setup.py', 'setup.cfg', 'resource', 'linkage_kinematics', 'launch', 'config',
-    'urdf', 'foxglove', 'interfaces',
-)
 # What the nested `colcon test` runs in full: quick tests that need the test dependencies
 # (hypothesis, and mpmath through test/reference.py). Naming them keeps the nested suite from
 # running this module again, and so from nesting for ever.

@@ -18,6 +18,7 @@ from linkage_kinematics.diagnostics import (
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.parameters import build_configuration, parameter_specs
+from linkage_kinematics.run_control import RunState
 import pytest
 
 PERIOD_NS = round(STATUS_PERIOD * 1e9)
@@ -91,21 +92,23 @@ def test_rate_is_measured_over_the_last_window() -> None:
 
 def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
     config = configuration(mode='fixed_step', alpha_step=math.radians(0.25))
-    values = key_values(config, solve(config.linkage, 0.3, DriveLaw(2.0)), 231.26, 3,
-                        'bags/run', 101_588)
+    state = solve(config.linkage, 0.3, DriveLaw(2.0))
+    values = key_values(config, RunState.RUNNING, state, 231.26, 3, 'bags/run', 101_588)
     assert 'rate_hz' not in values
     assert values['alpha_step (deg)'] == '0.25'
     assert (values['achieved rate (Hz)'], values['missed deadlines']) == ('231.3', '3')
     assert values['log size (bytes)'] == '101588'
-    assert key_values(config, None, None, 0, None, None)['achieved rate (Hz)'] == (
-        'not measured yet')
-    real_time = key_values(configuration(), None, 99.95, 0, None, None)
+    first = key_values(config, RunState.PAUSED, None, None, 0, None, None)
+    assert (first['achieved rate (Hz)'], first['run state']) == ('not measured yet', 'paused')
+    real_time = key_values(configuration(), RunState.RUNNING, None, 99.95, 0, None, None)
     assert (real_time['rate_hz'], real_time['log file']) == ('100', 'disabled')
+    assert real_time['run state'] == 'running'
     assert 'alpha_step (deg)' not in real_time and 'log size (bytes)' not in real_time
 
 
 def test_residual_reads_in_scientific_notation() -> None:
     config = configuration()
-    values = key_values(config, solve(config.linkage, 0.7, DriveLaw(2.0)), 0.0, 0, None, None)
+    values = key_values(
+        config, RunState.RUNNING, solve(config.linkage, 0.7, DriveLaw(2.0)), 0.0, 0, None, None)
     residual = values['loop closure residual']
     assert re.fullmatch(r'\d\.\d\de[+-]\d\d', residual) and float(residual) < 1e-12

@@ -265,6 +265,59 @@ class _McapFile:
                         self.flushed.count)
 
 
+class _BagListing:
+    """
+    What metadata.yaml lists of a bag being written: its topics, its files and their span.
+
+    Only flushed messages count, so that metadata.yaml never lists one a killed run lost: the
+    writer counts the messages of the open chunk in ``pending_counts``, and ``count_flushed``
+    adds them once the chunk is flushed. Finished files are listed with what they hold, the open
+    one (passed in) with what it has flushed.
+    """
+
+    def __init__(self, folder: Path, custom_data: dict[str, str]) -> None:
+        self.folder = folder
+        self.custom_data = custom_data
+        self.topics: dict[int, TopicInfo] = {}  # by channel id, with their flushed counts
+        self.pending_counts: dict[int, int] = {}
+        self.finished: list[FileInfo] = []
+        self.finished_size = 0  # bytes of the finished files
+        self._span = _Span()  # flushed messages of every file
+
+    def count_flushed(self, flushed: _Span) -> None:
+        """Add the chunk just flushed (``pending_counts``, ``flushed``) to the bag's counts."""
+        for channel_id, count in self.pending_counts.items():
+            self.topics[channel_id].message_count += count
+        self.pending_counts.clear()
+        self._span.absorb(flushed)
+
+    def add_finished(self, mcap_file: _McapFile) -> None:
+        self.finished.append(mcap_file.info())
+        self.finished_size += mcap_file.durable_size
+
+    def take_back_finished(self, mcap_file: _McapFile) -> None:
+        """Undo ``add_finished`` of ``mcap_file``, the last one: it stays the open file."""
+        self.finished.pop()
+        self.finished_size -= mcap_file.durable_size
+
+    def metadata(self, open_file: _McapFile) -> BagMetadata:
+        """Return the bag's metadata, with ``open_file`` as its last file."""
+        files = [*self.finished, open_file.info()]
+        return BagMetadata(
+            relative_file_paths=[file.path for file in files],
+            topics=list(self.topics.values()),
+            files=files,
+            custom_data=dict(self.custom_data),
+            starting_time_ns=self._span.start_ns or 0,
+            duration_ns=self._span.duration_ns,
+            message_count=sum(topic.message_count for topic in self.topics.values()),
+        )
+
+    def write_metadata_yaml(self, open_file: _McapFile) -> None:
+        """Write metadata.yaml, with ``open_file`` as the bag's last file."""
+        self.metadata(open_file).write(self.folder)
+
+
 class BagWriter:
     """
     Writes one rosbag2 MCAP bag folder; see the module docstring for the layout.
@@ -296,14 +349,10 @@ class BagWriter:
         self._max_size = max_bag_size
         self._max_duration_ns = max_bag_duration_ns
         self._splits = max_bag_size != NO_SPLIT or max_bag_duration_ns != NO_SPLIT
-        self._topics: dict[int, TopicInfo] = {}
+        self._listing = _BagListing(self.bag_path, self.custom_data)
         self._definitions: dict[str, str] = {}
         self._repeated: set[int] = set()
         self._latest: dict[int, tuple[bytes, int]] = {}
-        self._finished: list[FileInfo] = []
-        self._finished_size = 0
-        self._bag_span = _Span()  # flushed messages of every file
-        self._pending_counts: dict[int, int] = {}
         self._queued: list[tuple[int, int, bytes, int]] = []
         self._last_flush = time.monotonic()
         self._failure: BagError | None = None
@@ -321,7 +370,7 @@ class BagWriter:
         self.mcap_path = self._file_path(0)
         try:
             self._file = self._open_file()
-            self._write_metadata_yaml()
+            self._listing.write_metadata_yaml(self._file)
         except OSError as error:
             raise BagError(f'cannot write bag {self.mcap_path}: {error.strerror}') from None
 
@@ -329,8 +378,8 @@ class BagWriter:
     def size_bytes(self) -> int:
         """Bytes of the bag's MCAP files written so far (what a reader sees after a flush)."""
         if self._failure is not None or self._closed:
-            return self._finished_size + self._file.durable_size
-        return self._finished_size + self._file.stream.tell()
+            return self._listing.finished_size + self._file.durable_size
+        return self._listing.finished_size + self._file.stream.tell()
 
     def add_topic(
         self, topic: str, type_name: str, message_definition: str,
@@ -345,17 +394,17 @@ class BagWriter:
         message.
         """
         self._check_writable()
-        if any(existing.name == topic for existing in self._topics.values()):
+        if any(existing.name == topic for existing in self._listing.topics.values()):
             raise ValueError(f'topic {topic} is already in bag {self.bag_path}')
         info = TopicInfo(topic, type_name, list(offered_qos_profiles),
                          type_description_hash(type_name))
         self._definitions.setdefault(type_name, message_definition)
         try:
             channel_id = self._file.register(info, self._definitions[type_name])
-            self._topics[channel_id] = info
+            self._listing.topics[channel_id] = info
             if repeat_latest:
                 self._repeated.add(channel_id)
-            self._write_metadata_yaml()
+            self._listing.write_metadata_yaml(self._file)
         except OSError as error:
             raise self._fail(error) from None
         return channel_id
@@ -363,7 +412,7 @@ class BagWriter:
     def write(self, channel_id: int, data: bytes, log_time_ns: int, publish_time_ns: int) -> None:
         """Append one serialized (CDR) message; raises BagError if the disk refuses it."""
         self._check_writable()
-        if channel_id not in self._topics:
+        if channel_id not in self._listing.topics:
             raise ValueError(f'unknown channel id {channel_id} in bag {self.bag_path}')
         self._queued.append((channel_id, log_time_ns, data, publish_time_ns))
         if len(self._queued) >= WRITE_BATCH:
@@ -391,8 +440,8 @@ class BagWriter:
         """
         if self._failure is not None or self._closed:
             return self.size_bytes
-        return self._finished_size + self._file.finished_size(
-            self._bag_metadata().serialized(), self._topics)
+        return self._listing.finished_size + self._file.finished_size(
+            self._listing.metadata(self._file).serialized(), self._listing.topics)
 
     def close(self) -> None:
         """
@@ -408,12 +457,12 @@ class BagWriter:
         if self._failure is None:
             try:
                 self.flush()
-                self._file.finish(self._bag_metadata().serialized())
+                self._file.finish(self._listing.metadata(self._file).serialized())
             except OSError as error:
                 failure_in_close = error if isinstance(error, BagError) else self._fail(error)
         self._closed = True
         try:
-            self._write_metadata_yaml()
+            self._listing.write_metadata_yaml(self._file)
         except OSError as error:
             if failure_in_close is None and self._failure is None:
                 failure_in_close = BagError(
@@ -428,7 +477,7 @@ class BagWriter:
     def _open_file(self) -> _McapFile:
         """Start ``mcap_path`` with every topic registered (in order: same channel ids)."""
         mcap_file = _McapFile(self.mcap_path, self.custom_data, *self._file_options)
-        for info in self._topics.values():
+        for info in self._listing.topics.values():
             mcap_file.register(info, self._definitions[info.type_name])
         return mcap_file
 
@@ -441,7 +490,7 @@ class BagWriter:
         starts the next file.
         """
         queued, self._queued = self._queued, []
-        counts = self._pending_counts
+        counts = self._listing.pending_counts
         try:
             if not self._splits:
                 add_message = self._file.writer.add_message
@@ -465,32 +514,28 @@ class BagWriter:
     def _split(self, log_time_ns: int) -> None:
         """Finish the open file and open the next, which starts with the repeated messages."""
         self._flush_file()
-        self._file.finish(self._bag_metadata().serialized())
-        self._finished.append(self._file.info())
-        self._finished_size += self._file.durable_size
-        self.mcap_path = self._file_path(len(self._finished))
+        self._file.finish(self._listing.metadata(self._file).serialized())
+        self._listing.add_finished(self._file)
+        self.mcap_path = self._file_path(len(self._listing.finished))
         try:
             self._file = self._open_file()
         except OSError:
             self.mcap_path.unlink(missing_ok=True)
             self.mcap_path = self._file.path  # the finished file, which stays as it is
-            self._finished.pop()
-            self._finished_size -= self._file.durable_size
+            self._listing.take_back_finished(self._file)
             raise
+        counts = self._listing.pending_counts
         for channel_id, (data, publish_time_ns) in self._latest.items():
             self._file.writer.add_message(channel_id, log_time_ns, data, publish_time_ns)
-            self._pending_counts[channel_id] = self._pending_counts.get(channel_id, 0) + 1
+            counts[channel_id] = counts.get(channel_id, 0) + 1
             self._file.pending.add([log_time_ns])
-        self._write_metadata_yaml()
+        self._listing.write_metadata_yaml(self._file)
 
     def _flush_file(self) -> None:
         """Flush the open file and count what it flushed."""
         self._file.flush()
-        for channel_id, count in self._pending_counts.items():
-            self._topics[channel_id].message_count += count
-        self._pending_counts.clear()
+        self._listing.count_flushed(self._file.pending)
         self._file.flushed.absorb(self._file.pending)
-        self._bag_span.absorb(self._file.pending)
         self._file.pending = _Span()
 
     def _check_writable(self) -> None:
@@ -508,22 +553,7 @@ class BagWriter:
             f'the file keeps the {self._file.durable_size} bytes flushed before'
         )
         self._file.cut_back()
-        self._pending_counts.clear()
+        self._listing.pending_counts.clear()
         self._file.pending = _Span()
         self._queued.clear()
         return self._failure
-
-    def _bag_metadata(self) -> BagMetadata:
-        files = [*self._finished, self._file.info()]
-        return BagMetadata(
-            relative_file_paths=[file.path for file in files],
-            topics=list(self._topics.values()),
-            files=files,
-            custom_data=dict(self.custom_data),
-            starting_time_ns=self._bag_span.start_ns or 0,
-            duration_ns=self._bag_span.duration_ns,
-            message_count=sum(topic.message_count for topic in self._topics.values()),
-        )
-
-    def _write_metadata_yaml(self) -> None:
-        self._bag_metadata().write(self.bag_path)
