@@ -13,12 +13,15 @@ what it holds.
 from __future__ import annotations
 
 from collections import Counter
+import errno
+import os
 from pathlib import Path
 import signal
 import time
 
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition
+from linkage_kinematics.bag.errors import BagError
 from linkage_kinematics.bag.metadata import (
     BagMetadata,
     offered_qos_profiles_for,
@@ -34,6 +37,7 @@ from node_process import (
     stop_process,
     TYPESTORE,
 )
+import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosbags.rosbag2 import Reader
 from std_msgs.msg import String
@@ -139,6 +143,39 @@ def test_a_bag_split_by_size_ends_each_file_once_it_reached_the_size(tmp_path: P
     # every file but the open one had reached the size when the next one began
     assert all(size >= MIN_SPLIT_SIZE for size in sizes_before_close[:-1])
     assert [raw for logged in files for _, _, raw in logged] == written
+
+
+def test_a_next_file_that_cannot_be_opened_ends_the_bag_with_the_finished_file(
+        tmp_path: Path) -> None:
+    """
+    Something already has the next file's name: the bag stops there and loses nothing.
+
+    A directory in its place makes the open fail for root too. The file before it stays
+    complete and is listed once, with what it holds; the error names the next file and why.
+    """
+    writer = BagWriter(tmp_path / 'run', metadata={}, max_bag_duration_ns=100)
+    latched = string_topic(writer, '/latched', latched=True)
+    data = string_topic(writer, '/data', latched=False)
+    blocker = writer.bag_path / 'run_1.mcap'
+    blocker.mkdir()
+    writer.write(latched, encode_cdr(String(data='first')), 1_000, 1_000)
+    for index in range(10):
+        writer.write(data, encode_cdr(String(data=f'd{index}')), 1_000 + 50 * index, 7)
+    with pytest.raises(BagError) as raised:
+        writer.flush()  # the message at 1_150 starts the next file
+    assert str(raised.value) == (
+        f'cannot open {blocker}, the next file of bag {writer.bag_path} '
+        f'({os.strerror(errno.EEXIST)}); the bag ends with run_0.mcap, complete')
+    with pytest.raises(BagError, match='stopped at an earlier error: cannot open .*run_1.mcap'):
+        writer.write(data, encode_cdr(String(data='later')), 2_000, 7)
+    writer.close()
+    finished = writer.bag_path / 'run_0.mcap'
+    assert writer.size_bytes == writer.finished_size() == finished.stat().st_size
+    assert blocker.is_dir() and not any(blocker.iterdir())  # not written into, not deleted
+    blocker.rmdir()
+    (logged,) = assert_metadata_lists_every_file(writer.bag_path)
+    assert [(topic, log_time) for topic, log_time, _ in logged] == [
+        ('/latched', 1_000), ('/data', 1_000), ('/data', 1_050), ('/data', 1_100)]
 
 
 def test_recovery_completes_every_file_of_a_split_bag(tmp_path: Path) -> None:

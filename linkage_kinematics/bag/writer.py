@@ -31,7 +31,7 @@ This module is plain Python (no rclpy): bytes in, files out.
 """
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping
+from collections.abc import Collection, Iterable, Mapping
 import os
 from pathlib import Path
 import time
@@ -144,8 +144,15 @@ class _McapFile:
     in the open chunk since.
     """
 
-    def __init__(self, path: Path, custom_data: dict[str, str], chunk_size: int,
+    def __init__(self, path: Path, custom_data: dict[str, str],
+                 topics: Iterable[tuple[TopicInfo, str]], chunk_size: int,
                  compression: CompressionType) -> None:
+        """
+        Create ``path`` and start it with every topic of ``topics`` (info, definition).
+
+        The file must not exist: the writer never overwrites anything. If it cannot be started,
+        the half-made file is deleted (it is this writer's own) and the error raised.
+        """
         self.path = path
         self.durable_size = 0
         self.flushed = _Span()
@@ -156,15 +163,22 @@ class _McapFile:
         # written so far (each gets a chunk index in the summary).
         self._registered_size = 0
         self._chunk_count = 0
-        self.stream: BinaryIO = open(path, 'wb')
-        self.writer = Writer(self.stream, chunk_size=chunk_size, compression=compression)
-        self.writer.start(
-            profile=PROFILE, library=f'{PACKAGE_NAME}/{package_version()} {LIBRARY_IDENTIFIER}'
-        )
-        self.writer.add_metadata(METADATA_RECORD_NAME, custom_data)
-        self.stream.flush()
-        self.durable_size = self.stream.tell()
         self._schema_ids: dict[str, int] = {}
+        self.stream: BinaryIO = open(path, 'xb')
+        try:
+            self.writer = Writer(self.stream, chunk_size=chunk_size, compression=compression)
+            self.writer.start(
+                profile=PROFILE,
+                library=f'{PACKAGE_NAME}/{package_version()} {LIBRARY_IDENTIFIER}',
+            )
+            self.writer.add_metadata(METADATA_RECORD_NAME, custom_data)
+            self.stream.flush()
+            self.durable_size = self.stream.tell()
+            for info, definition in topics:
+                self.register(info, definition)
+        except OSError:
+            self._delete()
+            raise
 
     def register(self, info: TopicInfo, definition: str) -> int:
         """Add the channel (and if new, the schema) of a topic; its channel id."""
@@ -259,6 +273,17 @@ class _McapFile:
         except OSError:
             pass
 
+    def _delete(self) -> None:
+        """Close and delete the file; the error that made it useless is the one to report."""
+        try:
+            self.stream.close()
+        except OSError:
+            pass  # the buffered rest is what failed; the file goes anyway
+        try:
+            self.path.unlink()
+        except OSError:
+            pass  # it stays, unlisted in metadata.yaml, beside the error that is raised
+
     def info(self) -> FileInfo:
         """Return the file's entry in metadata.yaml (its flushed messages)."""
         return FileInfo(self.path.name, self.flushed.start_ns or 0, self.flushed.duration_ns,
@@ -294,11 +319,6 @@ class _BagListing:
     def add_finished(self, mcap_file: _McapFile) -> None:
         self.finished.append(mcap_file.info())
         self.finished_size += mcap_file.durable_size
-
-    def take_back_finished(self, mcap_file: _McapFile) -> None:
-        """Undo ``add_finished`` of ``mcap_file``, the last one: it stays the open file."""
-        self.finished.pop()
-        self.finished_size -= mcap_file.durable_size
 
     def metadata(self, open_file: _McapFile) -> BagMetadata:
         """Return the bag's metadata, with ``open_file`` as its last file."""
@@ -369,7 +389,7 @@ class BagWriter:
             ) from None
         self.mcap_path = self._file_path(0)
         try:
-            self._file = self._open_file()
+            self._file = self._open_file(self.mcap_path)
             self._listing.write_metadata_yaml(self._file)
         except OSError as error:
             raise BagError(f'cannot write bag {self.mcap_path}: {error.strerror}') from None
@@ -474,12 +494,11 @@ class BagWriter:
     def _file_path(self, index: int) -> Path:
         return self.bag_path / f'{self.bag_path.name}_{index}.mcap'
 
-    def _open_file(self) -> _McapFile:
-        """Start ``mcap_path`` with every topic registered (in order: same channel ids)."""
-        mcap_file = _McapFile(self.mcap_path, self.custom_data, *self._file_options)
-        for info in self._listing.topics.values():
-            mcap_file.register(info, self._definitions[info.type_name])
-        return mcap_file
+    def _open_file(self, path: Path) -> _McapFile:
+        """Start ``path`` with every topic registered (in order: same channel ids)."""
+        topics = [(info, self._definitions[info.type_name])
+                  for info in self._listing.topics.values()]
+        return _McapFile(path, self.custom_data, topics, *self._file_options)
 
     def _add_queued(self) -> None:
         """
@@ -508,22 +527,31 @@ class BagWriter:
                 self._file.new_messages += 1
                 if channel_id in self._repeated:
                     self._latest[channel_id] = (data, publish_time_ns)
+        except BagError:
+            raise  # the next file could not be opened (_split); the bag has stopped
         except OSError as error:
             raise self._fail(error) from None
 
     def _split(self, log_time_ns: int) -> None:
-        """Finish the open file and open the next, which starts with the repeated messages."""
+        """
+        Finish the open file and open the next, which starts with the repeated messages.
+
+        The finished file is listed as finished only once the next one is open. If that cannot
+        be opened, the finished file, complete, stays the bag's last and the bag stops.
+        """
         self._flush_file()
         self._file.finish(self._listing.metadata(self._file).serialized())
-        self._listing.add_finished(self._file)
-        self.mcap_path = self._file_path(len(self._listing.finished))
+        next_path = self._file_path(len(self._listing.finished) + 1)
         try:
-            self._file = self._open_file()
-        except OSError:
-            self.mcap_path.unlink(missing_ok=True)
-            self.mcap_path = self._file.path  # the finished file, which stays as it is
-            self._listing.take_back_finished(self._file)
-            raise
+            next_file = self._open_file(next_path)
+        except OSError as error:
+            raise self._stop(BagError(
+                f'cannot open {next_path}, the next file of bag {self.bag_path} '
+                f'({error.strerror or error}); the bag ends with {self.mcap_path.name}, complete'
+            )) from None
+        self._listing.add_finished(self._file)
+        self._file = next_file
+        self.mcap_path = next_path
         counts = self._listing.pending_counts
         for channel_id, (data, publish_time_ns) in self._latest.items():
             self._file.writer.add_message(channel_id, log_time_ns, data, publish_time_ns)
@@ -548,12 +576,16 @@ class BagWriter:
 
     def _fail(self, error: OSError) -> BagError:
         """Cut the open file back to its last flush so what was written stays readable."""
-        self._failure = BagError(
+        self._file.cut_back()
+        return self._stop(BagError(
             f'writing bag {self.mcap_path} failed ({error.strerror or error}); '
             f'the file keeps the {self._file.durable_size} bytes flushed before'
-        )
-        self._file.cut_back()
+        ))
+
+    def _stop(self, failure: BagError) -> BagError:
+        """Refuse every later write with ``failure``; drop the messages not written out."""
+        self._failure = failure
         self._listing.pending_counts.clear()
         self._file.pending = _Span()
         self._queued.clear()
-        return self._failure
+        return failure
