@@ -94,8 +94,7 @@ def missed_share(
             {'rate_hz': f'{rate:.1f}', 'end_behavior': 'bounce', 'log.folder': folder,
              **placement},
             seconds, domain_base + node_bench.DOMAIN_RATE, topics=[])
-    windows = [float(d['achieved rate (Hz)']) for d in data['diagnostics']
-               if 'achieved rate (Hz)' in d][1:]
+    windows = node_bench.achieved_rates(data)
     if not windows:
         raise RuntimeError(f'no /diagnostics windows from the node at {rate:g} Hz')
     return max(0.0, 1.0 - statistics.mean(windows) / rate)

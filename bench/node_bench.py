@@ -23,6 +23,7 @@ import tempfile
 import time
 from typing import Any
 
+from linkage_kinematics.diagnostics import NOT_MEASURED
 from timing import format_seconds, interleaved_medians, markdown_table
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -302,6 +303,17 @@ def observe(parameters: dict[str, str], seconds: float, domain: int,
     return data
 
 
+def achieved_rates(data: dict[str, Any]) -> list[float]:
+    """
+    Return the achieved rates the node's statuses report, after the first one measured.
+
+    The first may still hold the listener's start-up; a status before any measurement says
+    ``not measured yet``.
+    """
+    return [float(d['achieved rate (Hz)']) for d in data['diagnostics']
+            if d.get('achieved rate (Hz)', NOT_MEASURED) != NOT_MEASURED][1:]
+
+
 def sustained_rate(
     rate: float, logging: bool, seconds: float, domain_base: int
 ) -> tuple[float, int]:
@@ -314,9 +326,7 @@ def sustained_rate(
     with tempfile.TemporaryDirectory(prefix='linkage_bench_rate_') as folder:
         data = observe({'rate_hz': f'{rate:.1f}', 'log.enabled': str(logging).lower(),
                         'log.folder': folder}, seconds, domain_base + DOMAIN_RATE)
-    # the first window may still hold the listener's start-up
-    windows = [float(d['achieved rate (Hz)']) for d in data['diagnostics']
-               if 'achieved rate (Hz)' in d][1:]
+    windows = achieved_rates(data)
     missed = max((int(d['missed deadlines']) for d in data['diagnostics']
                   if 'missed deadlines' in d), default=-1)
     if not windows:
