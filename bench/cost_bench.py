@@ -84,10 +84,11 @@ def missed_share(
     rate: float, seconds: float, domain_base: int, placement: dict[str, str]
 ) -> float:
     """
-    Share of ticks the node.
+    Return the share of ticks the node missed.
 
-    (logging on, ``placement`` its cpu_affinity, nothing but /diagnostics subscribed) missed: 1 −
-    its achieved rate over its /diagnostics windows after the first ÷ ``rate``.
+    The node logs, runs with ``placement`` as its cpu_affinity and has nothing but /diagnostics
+    subscribed; the share is 1 − its achieved rate over its /diagnostics windows after the first
+    ÷ ``rate``.
     """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_cost_rate_') as folder:
         data = node_bench.observe(

@@ -313,9 +313,10 @@ def _library_branches(angle_set: AngleSet) -> list[int]:
 
 def _seed_states(angle_set: AngleSet, drive: DriveLaw) -> States:
     """
-    Return the seed's equations hold for its own mechanism only.
+    Return the seed's equations' states, for its own mechanism only.
 
-    (OA = BC, C level with O, the α = 0 start): no result for another linkage.
+    They hold only there (OA = BC, C level with O, the α = 0 start): no result for another
+    linkage.
     """
     if angle_set.linkage != preset('paper').geometry:
         return {name: [math.nan] * len(angle_set.alphas) for name in QUANTITIES}

@@ -318,10 +318,9 @@ def sustained_rate(
     rate: float, logging: bool, seconds: float, domain_base: int
 ) -> tuple[float, int]:
     """
-    Fraction of ticks missed.
+    Return the fraction of ticks missed and the node's missed-deadline count.
 
-    (1 − achieved/requested over the node's diagnostics windows after the first) and the node's
-    missed-deadline count.
+    The fraction is 1 − achieved/requested over the node's diagnostics windows after the first.
     """
     with tempfile.TemporaryDirectory(prefix='linkage_bench_rate_') as folder:
         data = observe({'rate_hz': f'{rate:.1f}', 'log.enabled': str(logging).lower(),

@@ -23,10 +23,10 @@ def number(
     rule: str = '',
 ) -> Callable[[str], float]:
     """
-    Return a type converting text to a finite ``kind``.
+    Return a type converting text to a finite ``kind`` (float or int) within a bound.
 
-    (float or int) greater than ``above`` or at least ``at_least`` when given; ``rule`` says the
-    bound in the error message.
+    The value must be greater than ``above`` or at least ``at_least`` when given; ``rule`` says
+    the bound in the error message.
     """
     noun = 'a whole number' if kind is int else 'a number'
 

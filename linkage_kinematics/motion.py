@@ -170,10 +170,10 @@ def blocked_note(config: RunConfiguration) -> str | None:
 
 def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: int) -> bool:
     """
-    Whether the crank met the dead point that cuts a pass short.
+    Tell whether the crank met the dead point that cuts a pass short (``blocked_at``).
 
-    (``blocked_at``) between a sample of pass ``previous_pass`` and one of pass ``current_pass``:
-    'loop' meets it at the end of every pass, 'bounce' at the end of every forward (even) pass.
+    That is, between a sample of pass ``previous_pass`` and one of pass ``current_pass``: 'loop'
+    meets it at the end of every pass, 'bounce' at the end of every forward (even) pass.
     """
     if config.blocked_at is None or current_pass <= previous_pass:
         return False

@@ -174,9 +174,9 @@ class Listener:
 
     def heard_every_topic(self, count: int = 1) -> bool:
         """
-        Whether at least ``count`` messages.
+        Tell whether at least ``count`` messages arrived on every subscribed topic.
 
-        (one on a transient-local topic) arrived on every subscribed topic.
+        On a transient-local topic one is enough.
         """
         return all(
             len(messages) >= (1 if topic in self.latched else count)
@@ -231,7 +231,7 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
     """
     Set simulated time to ``clock_ns`` and wait for the node's state of that instant.
 
-    (a lost /clock message is sent again; the same time again makes no tick).
+    A lost /clock message is sent again; the same time again makes no tick.
     """
     message = Clock(clock=time_msg(clock_ns))
 

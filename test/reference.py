@@ -245,10 +245,10 @@ def continued_sides(
     max_step: float = 0.01,
 ) -> list[int]:
     """
-    Return the assembly.
+    Return the assembly at each of ``alphas`` of a smooth motion.
 
-    (``branch`` argument of ``reference_state``) at each of ``alphas`` for the motion that starts
-    at ``alpha_start`` on ``branch`` and turns smoothly through them.
+    The assembly is ``reference_state``'s ``branch`` argument; the motion starts at
+    ``alpha_start`` on ``branch`` and turns smoothly through ``alphas``.
 
     ``alphas`` must run monotonically away from ``alpha_start``. Independent of the library's
     rule (change points flip the side): this follows the motion in steps of at most

@@ -157,9 +157,9 @@ def write_bag_folder(folder: Path, state: LinkageState, foreign: bool = True) ->
 
 def assert_states_equal(actual: LinkageState, expected: LinkageState, count: int) -> None:
     """
-    Every field except transmission_angle.
+    Check every field but transmission_angle equal to the first ``count`` rows.
 
-    (not on the wire) equal to the first ``count`` rows.
+    transmission_angle is not on the wire.
     """
     for name in LinkageState.__dataclass_fields__:
         if name == 'transmission_angle':

@@ -114,9 +114,9 @@ def only_bag(folder: Path) -> Path:
 
 def read_with_rosbags(bag: Path) -> dict[str, list[tuple[int, Any, bytes]]]:
     """
-    Topic -> [(log time ns, decoded message, raw CDR)] read with rosbags.
+    Return topic -> [(log time ns, decoded message, raw CDR)], read with rosbags.
 
-    (needs the summary).
+    rosbags needs the file's summary.
     """
     logged: dict[str, list[tuple[int, Any, bytes]]] = defaultdict(list)
     with Reader(bag) as reader:

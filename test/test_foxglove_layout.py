@@ -215,10 +215,10 @@ def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_a
 
 def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
     """
-    Return the disk (radius OA about O) and every place pin B can reach.
+    Check that the disk and every place pin B can reach lie inside the grid and the view.
 
-    (radius BC about C) lie inside the grid and inside the 2D camera's view of the layout's panel
-    (SCENE_ASPECT; wider panels see more).
+    The disk has radius OA about O, pin B's places radius BC about C; the view is the 2D
+    camera's of the layout's panel (SCENE_ASPECT; wider panels see more).
     """
     [three_d] = [config for key, config in load_layout()['configById'].items()
                  if key.startswith('3D!')]

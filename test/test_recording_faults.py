@@ -93,10 +93,10 @@ def wait_for_bag(folder: Path, process: subprocess.Popen, timeout: float = 20.0)
 
 def stream_records(mcap_path: Path) -> tuple[dict[int, str], list[Message]]:
     """
-    Channel topics by id and the messages that an mcap streaming reader.
+    Return channel topics by id and the messages an mcap streaming reader gets from the file.
 
-    (no summary needed) gets from the file as it is: a running or killed recorder's file ends after
-    its last complete chunk, without footer.
+    The streaming reader needs no summary and reads the file as it is: a running or killed
+    recorder's file ends after its last complete chunk, without footer.
     """
     topics: dict[int, str] = {}
     messages: list[Message] = []

@@ -97,10 +97,10 @@ def _fixed_leaves(msg_type: type) -> tuple[tuple[str, str, int], ...] | None:
 
 def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tuple], tuple]:
     """
-    Return the getter of a run of fixed-size leaves.
+    Return the getter of a run of fixed-size leaves and its struct codes and byte lengths.
 
-    (a tuple of their values) and its struct codes and byte length for each start offset mod 8 (the
-    padding depends on nothing else).
+    The getter returns a tuple of their values; there is a struct code and byte length for each
+    start offset mod 8 (the padding depends on nothing else).
     """
     layouts = []
     for phase in range(8):

@@ -56,7 +56,7 @@ def set_process_affinity(pid: int, cpus: Set[int]) -> None:
     """
     Let every thread of process ``pid`` run only on ``cpus``.
 
-    (threads it starts later inherit their starter's CPUs). A process that has ended meanwhile is
+    Threads it starts later inherit their starter's CPUs. A process that has ended meanwhile is
     left alone: whoever waits for it learns how it ended.
     """
     try:
