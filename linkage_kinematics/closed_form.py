@@ -36,8 +36,7 @@ from dataclasses import dataclass, fields
 import math
 from typing import Callable
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.geometry import FourBar, LoopClosure
 from linkage_kinematics.singular_points import (
     array_factors,
     exact_factors,
@@ -139,13 +138,12 @@ ARRAY_MATH: MathFunctions = (np.sin, np.cos, np.sqrt, np.arctan2)
 
 def evaluate(
     linkage: FourBar, branch: int | np.ndarray, alpha: FloatOrArray,
-    drive: DriveLaw | CrankRates | None, xp: MathFunctions,
+    omega: FloatOrArray | None, omega_dot: FloatOrArray | None, xp: MathFunctions,
 ) -> tuple[LinkageState | LinkagePose, LoopCheck | None]:
     """
-    Return the state at ``alpha`` (a LinkagePose if ``drive`` is None) and its LoopCheck.
+    Return the state at ``alpha`` (crank rates ``omega``, ``omega_dot``) and its LoopCheck.
 
-    The crank's rates come from ``drive``: a drive law's ω = ω0 + k·α and ω̇ = k·ω at α, or
-    ``CrankRates`` as they are.
+    A LinkagePose if ``omega`` is None. The callers take the crank's rates from their drive.
     """
     sin, cos, sqrt, atan2 = xp
     closure = linkage.closure
@@ -168,10 +166,9 @@ def evaluate(
         stretched *= reach + distance
         folded *= distance + difference
         check = None
-    elif plain_where_far and xp is ARRAY_MATH:
-        stretched, folded, check = array_factors(closure, alpha, distance, stretched, folded)
     else:
-        stretched, folded, check = exact_factors(closure, alpha, distance, sin)
+        stretched, folded, check = _factors_near_zeros(
+            closure, alpha, distance, stretched, folded, xp)
     two_distance = 2.0 * distance
     u_x = to_c_x / distance
     u_y = to_c_y / distance
@@ -188,20 +185,14 @@ def evaluate(
     e_bc_x = rocker_x / rocker
     e_bc_y = rocker_y / rocker
     transmission_angle = atan2(abs(sine), e_ab_x * e_bc_x + e_ab_y * e_bc_y)
-    if drive is None:
-        return LinkagePose(
-            alpha=alpha, beta=atan2(rocker_y, -rocker_x), gamma=atan2(coupler_y, coupler_x),
-            pin_a_x=pin_a_x, pin_a_y=pin_a_y, pin_b_x=ground_x + rocker_x,
-            pin_b_y=ground_y + rocker_y, transmission_angle=transmission_angle), check
+    if omega is None:
+        return _pose(linkage, alpha, pin_a_x, pin_a_y, coupler_x, coupler_y, rocker_x, rocker_y,
+                     transmission_angle, atan2), check
     # Filled by name, field by field (LinkageState says why not through its __init__).
     state = object.__new__(LinkageState)
     state.alpha = alpha
-    if type(drive) is CrankRates:
-        state.omega = omega = drive.omega
-        state.omega_dot = omega_dot = drive.omega_dot
-    else:
-        state.omega = omega = drive.omega0 + drive.k * alpha
-        state.omega_dot = omega_dot = drive.k * omega
+    state.omega = omega
+    state.omega_dot = omega_dot
     # v_A = OA·ω·(cos α, sin α); a_A = OA·ω̇·(cos α, sin α) − OA·ω²·(sin α, −cos α)
     crank_omega = crank * omega
     omega_squared = omega * omega
@@ -245,6 +236,34 @@ def evaluate(
     state.acceleration_b_y = rocker_tangential * e_bc_x - rocker_centripetal * e_bc_y
     state.transmission_angle = transmission_angle
     return state, check
+
+
+def _factors_near_zeros(
+    closure: LoopClosure, alpha: FloatOrArray, distance: FloatOrArray, stretched: FloatOrArray,
+    folded: FloatOrArray, xp: MathFunctions,
+) -> tuple[FloatOrArray, FloatOrArray, LoopCheck | None]:
+    """
+    Return Heron's two factors and the LoopCheck where the cheap product from d may not do.
+
+    Arrays of a linkage without change points keep that product where it is far from the
+    factors' zeros (``array_factors``); floats near them, and any linkage with change points,
+    take the exact factors (``exact_factors``).
+    """
+    if xp is ARRAY_MATH and not closure.change_points:
+        return array_factors(closure, alpha, distance, stretched, folded)
+    return exact_factors(closure, alpha, distance, xp[0])
+
+
+def _pose(
+    linkage: FourBar, alpha: float, pin_a_x: float, pin_a_y: float, coupler_x: float,
+    coupler_y: float, rocker_x: float, rocker_y: float, transmission_angle: float,
+    atan2: Callable,
+) -> LinkagePose:
+    """Return the pose from pin A and the links' vectors B − A and B − C."""
+    return LinkagePose(
+        alpha=alpha, beta=atan2(rocker_y, -rocker_x), gamma=atan2(coupler_y, coupler_x),
+        pin_a_x=pin_a_x, pin_a_y=pin_a_y, pin_b_x=linkage.ground_x + rocker_x,
+        pin_b_y=linkage.ground_y + rocker_y, transmission_angle=transmission_angle)
 
 
 def _smooth_rate_terms(

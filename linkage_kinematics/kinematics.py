@@ -133,8 +133,16 @@ def solve(
     """
     if branch != 1 and branch != -1:
         check_branch(branch)
+    # The crank's rates here, not through DriveLaw's methods as solve_many takes them: a call
+    # costs this hot path more than their arithmetic.
+    if type(drive) is CrankRates:
+        omega = drive.omega
+        omega_dot = drive.omega_dot
+    else:
+        omega = drive.omega0 + drive.k * alpha
+        omega_dot = drive.k * omega
     try:
-        state, check = evaluate(linkage, branch, alpha, drive, SCALAR_MATH)
+        state, check = evaluate(linkage, branch, alpha, omega, omega_dot, SCALAR_MATH)
     except ZeroDivisionError:
         # S = 0: past or on a dead point (the loop does not close), or pin A on the pivot C.
         raise _refuse(linkage, alpha) from None
@@ -157,7 +165,7 @@ def solve_pose(linkage: FourBar, alpha: float, branch: int = 1) -> LinkagePose:
     check_branch(branch)
     if linkage.closure.passes_through_pivot:
         _check_pivot_passage(linkage, alpha)
-    pose, check = evaluate(linkage, branch, alpha, None, SCALAR_MATH)
+    pose, check = evaluate(linkage, branch, alpha, None, None, SCALAR_MATH)
     if check is not None and not check.closes:
         # On the interval end (within its tolerance) the positions are the dead point's.
         linkage.reachability.require(alpha)
@@ -191,9 +199,12 @@ def solve_many(
         for start in range(0, flat_alpha.size, _CHUNK):
             piece = slice(start, start + _CHUNK)
             piece_branch = flat_branch[piece] if isinstance(branch, np.ndarray) else branch
-            state, check = evaluate(linkage, piece_branch, flat_alpha[piece], drive, ARRAY_MATH)
+            piece_alpha = flat_alpha[piece]
+            state, check = evaluate(
+                linkage, piece_branch, piece_alpha, drive.angular_velocity(piece_alpha),
+                drive.angular_acceleration(piece_alpha), ARRAY_MATH)
             if check is not None:
-                _raise_at_first_refusal(linkage, flat_alpha[piece], check)
+                _raise_at_first_refusal(linkage, piece_alpha, check)
             for name in computed:
                 columns[name][piece] = getattr(state, name)
     return LinkageState(

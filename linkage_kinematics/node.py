@@ -39,14 +39,13 @@ from linkage_kinematics.node_sources import (
     EXIT_OK,
     MeasuredSubscription,
 )
+from linkage_kinematics.parameter_specs import PARAMETER_NAMES, unknown_parameters
 from linkage_kinematics.parameters import (
     build_configuration,
     ConfigurationError,
     NODE_NAME,
-    PARAMETER_NAMES,
     RunConfiguration,
     Source,
-    unknown_parameters,
 )
 from linkage_kinematics.placement import CpuPlacement
 from linkage_kinematics.run_control import RunControl, ServiceAnswer

@@ -4,8 +4,9 @@
 """
 The node's parameters on the ROS side: declared with descriptors, whole numbers kept real.
 
-``parameters`` owns what each parameter is and how values are validated; this module only
-declares them on a node so that ``ros2 param describe`` shows their meaning, unit and range.
+``parameter_specs`` owns what each parameter is and ``parameters`` how values are validated;
+this module only declares them on a node so that ``ros2 param describe`` shows their meaning,
+unit and range.
 """
 
 from __future__ import annotations
@@ -13,14 +14,13 @@ from __future__ import annotations
 from typing import Any
 
 from linkage_kinematics.geometry import GeometryError
-from linkage_kinematics.parameters import (
-    ConfigurationError,
-    describe_value,
+from linkage_kinematics.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
     ParameterSpec,
     REAL_PARAMETERS,
 )
+from linkage_kinematics.parameters import ConfigurationError, describe_value
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter

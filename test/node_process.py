@@ -23,7 +23,7 @@ from typing import Any
 from builtin_interfaces.msg import Time
 from linkage_kinematics.geometry import FourBar
 from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.parameters import parameter_specs
+from linkage_kinematics.parameter_specs import parameter_specs
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node

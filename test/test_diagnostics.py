@@ -17,7 +17,8 @@ from linkage_kinematics.diagnostics import (
 )
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics import solve
-from linkage_kinematics.parameters import build_configuration, parameter_specs
+from linkage_kinematics.parameter_specs import parameter_specs
+from linkage_kinematics.parameters import build_configuration
 from linkage_kinematics.run_control import RunState
 import pytest
 

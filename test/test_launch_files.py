@@ -23,7 +23,8 @@ import xml.etree.ElementTree as ElementTree
 from ament_index_python.packages import get_package_share_directory
 from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.parameters import mechanism_entries, PARAMETER_NAMES
+from linkage_kinematics.parameter_specs import PARAMETER_NAMES
+from linkage_kinematics.parameters import mechanism_entries
 from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
 import pytest
 from rosbags.rosbag2 import Reader

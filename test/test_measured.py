@@ -30,7 +30,8 @@ from linkage_kinematics.geometry import FourBar, preset, TWO_PI
 from linkage_kinematics.joints import Driver, JointStream, Link, TREE_ORDER
 from linkage_kinematics.kinematics import CrankRates
 from linkage_kinematics.measured import MeasuredFollower, Rejection
-from linkage_kinematics.parameters import build_configuration, parameter_specs, Source
+from linkage_kinematics.parameter_specs import parameter_specs
+from linkage_kinematics.parameters import build_configuration, Source
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
     Listener,

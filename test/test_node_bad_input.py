@@ -29,12 +29,8 @@ from linkage_kinematics.motion import (
     sample_at_step,
     sample_at_time,
 )
-from linkage_kinematics.parameters import (
-    build_configuration,
-    ConfigurationError,
-    PARAMETER_NAMES,
-    parameter_specs,
-)
+from linkage_kinematics.parameter_specs import PARAMETER_NAMES, parameter_specs
+from linkage_kinematics.parameters import build_configuration, ConfigurationError
 from node_process import (
     configuration_values,
     expected_state_point,

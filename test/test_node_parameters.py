@@ -16,13 +16,12 @@ from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics import solve
 from linkage_kinematics.messages import DISK_ID, PIN_A_ID
-from linkage_kinematics.parameters import (
-    build_configuration,
-    ConfigurationError,
+from linkage_kinematics.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
     unknown_parameters,
 )
+from linkage_kinematics.parameters import build_configuration, ConfigurationError
 from linkage_kinematics.urdf import urdf_text
 from node_process import (
     configuration_values,

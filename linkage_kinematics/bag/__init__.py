@@ -10,6 +10,7 @@ Logging every run as a rosbag2 MCAP bag, and reading it back; one module per con
 - ``metadata``: metadata.yaml (``BagMetadata``) and the QoS profiles in it;
 - ``errors``: ``BagError``, an ``OSError``, and its kinds;
 - ``writer``: ``BagWriter``, the MCAP file and metadata.yaml of one bag (plain Python);
+- ``repeated``: the latest message of each ``repeat_latest`` topic, for a split bag's next file;
 - ``writer_process``: a ``BagWriter`` in a process of its own, fed through a pipe;
 - ``recorder``: the node's side, ``Recorder`` (topics by rclpy class and QoS, encoded bytes);
 - ``reader``: the messages and states of a bag, also of a killed run's;

@@ -49,6 +49,7 @@ from linkage_kinematics.bag.metadata import (
     qos_profiles_yaml,
     TopicInfo,
 )
+from linkage_kinematics.bag.repeated import RepeatedTopics
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import (
@@ -371,8 +372,7 @@ class BagWriter:
         self._splits = max_bag_size != NO_SPLIT or max_bag_duration_ns != NO_SPLIT
         self._listing = _BagListing(self.bag_path, self.custom_data)
         self._definitions: dict[str, str] = {}
-        self._repeated: set[int] = set()
-        self._latest: dict[int, tuple[bytes, int]] = {}
+        self._repeated = RepeatedTopics()
         self._queued: list[tuple[int, int, bytes, int]] = []
         self._last_flush = time.monotonic()
         self._failure: BagError | None = None
@@ -525,8 +525,7 @@ class BagWriter:
                 counts[channel_id] = counts.get(channel_id, 0) + 1
                 self._file.pending.add([log_time_ns])
                 self._file.new_messages += 1
-                if channel_id in self._repeated:
-                    self._latest[channel_id] = (data, publish_time_ns)
+                self._repeated.remember(channel_id, data, publish_time_ns)
         except BagError:
             raise  # the next file could not be opened (_split); the bag has stopped
         except OSError as error:
@@ -553,7 +552,7 @@ class BagWriter:
         self._file = next_file
         self.mcap_path = next_path
         counts = self._listing.pending_counts
-        for channel_id, (data, publish_time_ns) in self._latest.items():
+        for channel_id, data, publish_time_ns in self._repeated.latest():
             self._file.writer.add_message(channel_id, log_time_ns, data, publish_time_ns)
             counts[channel_id] = counts.get(channel_id, 0) + 1
             self._file.pending.add([log_time_ns])
