@@ -53,6 +53,21 @@ from test_bag_writer import (
 )
 
 LOOP_PARAMETERS = {'rate_hz': 200.0, 'end_behavior': 'loop'}
+
+
+@pytest.fixture(autouse=True)
+def udp_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    """
+    Run this module's nodes and listeners over UDP only.
+
+    These tests kill processes on purpose; Fast DDS's shared-memory transport can crash a peer
+    that tears down after another was killed (eProsima/Fast-DDS#5469, #6501 and others; seen
+    once here as a segfault in the listener's destroy_node), so the killed processes and their
+    peers keep out of shared memory. What is tested, the bag, does not depend on the transport.
+    """
+    monkeypatch.setenv('FASTDDS_BUILTIN_TRANSPORTS', 'UDPv4')
+
+
 # The bag writer's flush interval (1 s) plus one tick and scheduling slack.
 MAX_LOSS_AT_KILL_NS = 1_500_000_000
 # The node's last batch (16 messages, at most 50 ms old) plus scheduling slack.
