@@ -2,12 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-``linkage-demo``: the seed's numerical experiments, run through the real node and logged.
+``linkage-demo``: the paper's numerical experiments, run through the real node and logged.
 
 Runs ``linkage_node`` once per drive law of the paper (constant ω = 2 rad/s, and
-ω = 0.10 + 2.3·α) over the 90° turn in the seed's fixed steps of 0.5°, each step published when
+ω = 0.10 + 2.3·α) over the 90° turn in the paper's fixed steps of 0.5°, each step published when
 the drive law reaches it (the turns last 0.785 s and 1.571 s), each run logged to a new bag
-under the log folder, then reads every bag back and prints the head and tail of the seed's
+under the log folder, then reads every bag back and prints the head and tail of the paper's
 Tables 1–4 from what was logged, and draws the four-panel figure beside each bag.
 """
 
@@ -24,8 +24,8 @@ from linkage_kinematics.cli_types import number
 from linkage_kinematics.sweep import format_tables, write_plot
 
 SCENARIOS = (
-    ('seed_constant.yaml', "Constant law, ω = 2 rad/s (the seed's Tables 1 and 2)"),
-    ('seed_variable.yaml', "Variable law, ω = 0.10 + 2.3·α rad/s (the seed's Tables 3 and 4)"),
+    ('seed_constant.yaml', "Constant law, ω = 2 rad/s (the paper's Tables 1 and 2)"),
+    ('seed_variable.yaml', "Variable law, ω = 0.10 + 2.3·α rad/s (the paper's Tables 3 and 4)"),
 )
 
 
