@@ -234,6 +234,12 @@ def drive_sim_clock(listener: Listener, clock: Any, states: list, clock_ns: int)
     A lost /clock message is sent again; the same time again makes no tick.
     """
     message = Clock(clock=time_msg(clock_ns))
+    # A state lost to a subscription that has not matched the node's writer yet would never come
+    # again (the same time makes no second tick): step the clock only once every subscription
+    # here has matched its publisher (the node publishes nothing before its first tick).
+    assert listener.spin_until(lambda: all(
+        subscription.get_publisher_count() > 0 for subscription in listener.node.subscriptions
+    )), 'a subscription never matched the node'
 
     def ticked() -> bool:
         return bool(states) and stamp_ns(states[-1]) == clock_ns
