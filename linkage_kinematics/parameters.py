@@ -398,13 +398,6 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
             raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
         step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     autostart = _flag(values, 'autostart')
-    blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
-    segment_end = alpha_end if blocked_at is None else blocked_at
-    travel = abs(segment_end - alpha_start)
-    steps = travel / alpha_step
-    if not math.isfinite(steps):
-        raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
-    step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
     return RunConfiguration(
         preset=preset_name,
         linkage=linkage,

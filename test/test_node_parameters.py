@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.drive import DriveLaw
 from linkage_kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics import solve
@@ -118,6 +119,47 @@ def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
     assert config.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
     assert config.segment_end == config.blocked_at
     assert config.segment_duration == DriveLaw(-1.0).time_to(0.0, config.blocked_at)
+
+
+# A lab's linkage whose crank can reach neither 0 nor 90° (only about 135°–315°): the drive
+# law's defaults (alpha_start 0, alpha_end 90°) are outside its reach.
+BEYOND_DEFAULTS = {'preset': '', 'crank_length': 0.3, 'coupler_length': 1.0,
+                   'rocker_length': 0.3, 'ground_x': -0.9, 'ground_y': 0.9}
+
+
+@pytest.mark.parametrize('overrides', [
+    {'omega0': 0.0},  # a drive law that cannot move the crank
+    {'alpha_end': 0.0},  # an empty pass
+    {'omega0': -1.0, 'alpha_end': 2.0},  # a pass the drive law never ends
+    BEYOND_DEFAULTS,
+], ids=['crank at rest', 'empty pass', 'pass never ends', 'crank cannot reach 0-90°'])
+def test_measured_mode_does_not_check_the_drive_law(overrides):
+    values = configuration_values(source='measured', **overrides)
+    config = build_configuration(values)
+    assert config.source == 'measured'
+    assert (config.blocked_at, config.segment_duration, config.step_count) == (None, 0.0, 1)
+    # The same values with the drive law are refused: the guard decides, not the values.
+    with pytest.raises(ConfigurationError):
+        build_configuration({**values, 'source': 'drive_law'})
+
+
+def test_the_measured_node_starts_where_the_drive_laws_defaults_cannot(tmp_path):
+    """A lab whose crank cannot reach alpha_start … alpha_end follows its encoder at once."""
+    with ros_context(DOMAIN_ID) as context:
+        listener = Listener('measured_start_listener', context)
+        listener.subscribe('/diagnostics', DiagnosticArray)
+        process = start_node({'source': 'measured', 'omega0': 0.0, 'log.enabled': False,
+                              **BEYOND_DEFAULTS}, DOMAIN_ID, tmp_path / 'node.log')
+        try:
+            statuses = listener.received['/diagnostics']
+            assert listener.spin_until(lambda: any(
+                status.message.startswith('no valid sample of crank_joint received yet')
+                for array in statuses for status in array.status)), (
+                tmp_path / 'node.log').read_text()
+            assert process.poll() is None
+        finally:
+            stop_process(process)
+            listener.destroy()
 
 
 def test_only_motion_changes_restart_the_motion():
