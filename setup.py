@@ -37,10 +37,10 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'linkage_node = linkage_kinematics.node:main',
-            'linkage-sweep = linkage_kinematics.sweep:main',
-            'linkage-replay = linkage_kinematics.replay:main',
-            'linkage-demo = linkage_kinematics.demo:main',
+            'linkage_node = linkage_kinematics.ros.node:main',
+            'linkage-sweep = linkage_kinematics.cli.sweep:main',
+            'linkage-replay = linkage_kinematics.cli.replay:main',
+            'linkage-demo = linkage_kinematics.cli.demo:main',
         ],
     },
 )

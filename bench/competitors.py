@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 from math import atan2, cos, sin, sqrt
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import continued_branch, solve_many
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import continued_branch, solve_many
 import numpy as np
 import scipy.optimize
 

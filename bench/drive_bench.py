@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from linkage_kinematics.drive import DriveError, DriveLaw
+from linkage_kinematics.kinematics.drive import DriveError, DriveLaw
 from mpmath import mp, mpf
 from timing import format_seconds, interleaved_medians, markdown_table
 

@@ -11,9 +11,9 @@ from typing import Callable
 
 import competitors
 from competitors import QUANTITIES, States
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import continued_branch, solve, solve_many
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar, preset
+from linkage_kinematics.kinematics.solver import continued_branch, solve, solve_many
 from mpmath import mp, mpf
 import numpy as np
 from reference import continued_sides, reference_state

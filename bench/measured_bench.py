@@ -47,7 +47,7 @@ def one_run(seconds: float, domain: int) -> dict[str, dict[str, float]]:
     with tempfile.TemporaryDirectory(prefix='linkage_bench_measured_') as folder:
         sent_file = pathlib.Path(folder) / 'sent.json'
         node = subprocess.Popen(
-            [sys.executable, '-m', 'linkage_kinematics.node', '--ros-args',
+            [sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args',
              '-r', '__ns:=/completer', '-r', 'measured_joint_states:=/encoder/joint_states',
              '-p', 'source:=measured', '-p', 'preset:=grashof_crank_rocker',
              '-p', f'log.folder:={folder}/bags'],

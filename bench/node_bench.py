@@ -4,7 +4,7 @@
 """
 Section 3: the node: cost per tick, sustained rate, jitter, latency, log size, memory.
 
-Nodes run as the tests run them (``python -m linkage_kinematics.node --ros-args ...`` in their
+Nodes run as the tests run them (``python -m linkage_kinematics.ros.node --ros-args ...`` in their
 own process, real Fast DDS over loopback, real MCAP logs); the cost split runs the node's own
 objects in this process so each part can be timed alone, next to a bare rclpy publisher.
 """
@@ -23,7 +23,7 @@ import tempfile
 import time
 from typing import Any
 
-from linkage_kinematics.diagnostics import NOT_MEASURED
+from linkage_kinematics.run.diagnostics import NOT_MEASURED
 from timing import format_seconds, interleaved_medians, markdown_table
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
@@ -45,7 +45,7 @@ def ros_environment(domain: int) -> dict[str, str]:
 
 
 def start_node(parameters: dict[str, str], domain: int) -> subprocess.Popen:
-    arguments = [sys.executable, '-m', 'linkage_kinematics.node', '--ros-args']
+    arguments = [sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args']
     for name, value in parameters.items():
         arguments += ['-p', f'{name}:={value}']
     return subprocess.Popen(arguments, cwd=ROOT, env=ros_environment(domain),
@@ -166,11 +166,11 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     topic, so both publishes really send over loopback.
     """
     os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
-    from linkage_kinematics import messages
-    from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
-    from linkage_kinematics.kinematics import solve
-    from linkage_kinematics.motion import sample_at_time, solve_sample
-    from linkage_kinematics.node import LinkageNode
+    from linkage_kinematics.kinematics.solver import solve
+    from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
+    from linkage_kinematics.ros import messages
+    from linkage_kinematics.ros.node import LinkageNode
+    from linkage_kinematics.run.motion import sample_at_time, solve_sample
     import rclpy
     from rclpy.parameter import Parameter
     from rclpy.serialization import deserialize_message

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar
 
 # Eq. (6c): the paper's constant angular acceleration of the disk under the variable law.
 SEED_VARIABLE_OMEGA_DOT = 2.3 * 1.9

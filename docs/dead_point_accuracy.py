@@ -27,9 +27,9 @@ import sys
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'test'))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from linkage_kinematics.drive import DriveLaw  # noqa: E402
-from linkage_kinematics.geometry import FourBar, PRESETS  # noqa: E402
-from linkage_kinematics.kinematics import DeadPointError, solve  # noqa: E402
+from linkage_kinematics.kinematics.drive import DriveLaw  # noqa: E402
+from linkage_kinematics.kinematics.geometry import FourBar, PRESETS  # noqa: E402
+from linkage_kinematics.kinematics.solver import DeadPointError, solve  # noqa: E402
 from mpmath import mpf  # noqa: E402
 from reference import (  # noqa: E402
     input_floor,

@@ -18,9 +18,9 @@ import sys
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from linkage_kinematics.drive import DriveLaw  # noqa: E402
-from linkage_kinematics.geometry import PRESETS  # noqa: E402
-from linkage_kinematics.kinematics import solve  # noqa: E402
+from linkage_kinematics.kinematics.drive import DriveLaw  # noqa: E402
+from linkage_kinematics.kinematics.geometry import PRESETS  # noqa: E402
+from linkage_kinematics.kinematics.solver import solve  # noqa: E402
 
 PAPER = PRESETS['paper'].geometry
 VARIABLE = DriveLaw(0.10, 2.3)

@@ -21,7 +21,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
-from linkage_kinematics.parameters import mechanism_entries, NODE_NAME
+from linkage_kinematics.run.configuration import mechanism_entries, NODE_NAME
 
 
 def _start_mechanisms(context):

@@ -21,9 +21,9 @@ import time
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.parameter_specs import parameter_specs
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.run.parameter_specs import parameter_specs
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -74,7 +74,7 @@ def node_command(
 
     ``-r __ns:=/left``).
     """
-    command = executable or [sys.executable, '-m', 'linkage_kinematics.node']
+    command = executable or [sys.executable, '-m', 'linkage_kinematics.ros.node']
     arguments = ['--ros-args']
     for name, value in parameters.items():
         arguments += ['-p', parameter_argument(name, value)]

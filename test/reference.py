@@ -4,7 +4,7 @@
 """
 Independent high-precision reference for the four-bar kinematics (mpmath, 50 digits).
 
-Why it is independent of ``linkage_kinematics.kinematics``:
+Why it is independent of ``linkage_kinematics.kinematics.solver``:
 
 * Positions. The library intersects two circles (Heron's formula for the height of B over the
   line A→C). Here the loop closure is written as one equation in the rocker angle β alone.
@@ -39,9 +39,9 @@ from __future__ import annotations
 import math
 from typing import Callable
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import CrankRates, LinkageState
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import CrankRates, LinkageState
 from mpmath import mp, mpf
 
 # Enough digits that the reference's own error stays far below anything float64 can show, even

@@ -16,9 +16,9 @@ from ament_index_python.packages import get_package_share_directory
 from linkage_kinematics.bag.errors import BagError
 from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
 from linkage_kinematics.bag.state_layout import STATE_JOINT_NAMES, STATE_TOPIC
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.kinematics import LinkageState, solve_many
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset
+from linkage_kinematics.kinematics.solver import LinkageState, solve_many
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 from mcap_ros2.decoder import DecoderFactory

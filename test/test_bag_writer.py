@@ -30,7 +30,6 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from linkage_kinematics import messages, scene
 from linkage_kinematics.bag import player
 from linkage_kinematics.bag import reader as bag_reader
 from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
@@ -42,11 +41,18 @@ from linkage_kinematics.bag.metadata import (
 )
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values, unwrap_positions
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.replay import main as replay_main
+from linkage_kinematics.cli.replay import main as replay_main
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model import scene
+from linkage_kinematics.model.joints import (
+    DEFAULT_JOINT_NAMES,
+    Driver,
+    tree_values,
+    unwrap_positions,
+)
+from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
 from node_process import (
@@ -763,7 +769,7 @@ def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: P
             # discovers the replay late, or falls behind while the machine is busy (the logged
             # QoS keeps the last 10), hears the rest in a later round.
             replay = subprocess.Popen(
-                [sys.executable, '-m', 'linkage_kinematics.replay', str(bag), '--loop'],
+                [sys.executable, '-m', 'linkage_kinematics.cli.replay', str(bag), '--loop'],
                 cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 1), stdout=output,
                 stderr=subprocess.STDOUT,
             )
@@ -800,7 +806,7 @@ def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path
         listener.subscribe('/linkage/state', JointTrajectory)
         with open(tmp_path / 'replay.log', 'w') as output:
             replay = subprocess.Popen(
-                [sys.executable, '-m', 'linkage_kinematics.replay', str(bag), '--loop',
+                [sys.executable, '-m', 'linkage_kinematics.cli.replay', str(bag), '--loop',
                  '--rate', '4', '--topics', '/linkage/state'],
                 cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 2), stdout=output,
                 stderr=subprocess.STDOUT,

@@ -14,9 +14,9 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import (
     continued_branch,
     DeadPointError,
     LinkageState,

@@ -136,7 +136,7 @@ def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: 
 
     environment = _colcon_environment(install, ros_environment(DOMAIN_ID))
     imported = subprocess.run(
-        [sys.executable, '-c', 'import linkage_kinematics.node as n; print(n.__file__)'],
+        [sys.executable, '-c', 'import linkage_kinematics.ros.node as n; print(n.__file__)'],
         cwd=tmp_path, env=environment, capture_output=True, text=True, check=True,
     ).stdout.strip()
     assert Path(imported).is_relative_to(install), imported

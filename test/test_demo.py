@@ -18,20 +18,21 @@ import sys
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.bag.metadata import BagMetadata
 from linkage_kinematics.bag.reader import iter_messages, read_states
-from linkage_kinematics.diagnostics import STATUS_PERIOD
-from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.run.diagnostics import STATUS_PERIOD
 import matplotlib.image
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message
 
 REPO = Path(__file__).resolve().parents[1]
+DEMO = [sys.executable, '-m', 'linkage_kinematics.cli.demo']
 
 
 def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
     environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     completed = subprocess.run(
-        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(tmp_path / 'bags')],
+        [*DEMO, '--log-folder', str(tmp_path / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=300,
     )
     assert completed.returncode == 0, completed.stderr
@@ -110,7 +111,7 @@ def test_bad_arguments_get_one_line_and_no_run(
     arguments: list[str], message: str, tmp_path: Path
 ) -> None:
     completed = subprocess.run(
-        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(tmp_path / 'bags'),
+        [*DEMO, '--log-folder', str(tmp_path / 'bags'),
          *arguments],
         cwd=REPO, capture_output=True, text=True, timeout=60,
     )
@@ -125,7 +126,7 @@ def test_unwritable_log_folder_is_reported_without_a_traceback(tmp_path: Path) -
     blocker.write_text('not a folder')
     environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
     completed = subprocess.run(
-        [sys.executable, '-m', 'linkage_kinematics.demo', '--log-folder', str(blocker / 'bags')],
+        [*DEMO, '--log-folder', str(blocker / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=60,
     )
     assert completed.returncode == 1

@@ -8,18 +8,18 @@ from __future__ import annotations
 import math
 import re
 
-from linkage_kinematics.diagnostics import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.run.configuration import build_configuration
+from linkage_kinematics.run.control import RunState
+from linkage_kinematics.run.diagnostics import (
     key_values,
     RATE_WINDOW,
     RateMeter,
     STATUS_PERIOD,
     StatusSchedule,
 )
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.parameter_specs import parameter_specs
-from linkage_kinematics.parameters import build_configuration
-from linkage_kinematics.run_control import RunState
+from linkage_kinematics.run.parameter_specs import parameter_specs
 import pytest
 
 PERIOD_NS = round(STATUS_PERIOD * 1e9)

@@ -9,7 +9,7 @@ import math
 
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
-from linkage_kinematics.drive import DriveError, DriveLaw
+from linkage_kinematics.kinematics.drive import DriveError, DriveLaw
 from mpmath import mp, mpf
 import pytest
 

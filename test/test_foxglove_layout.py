@@ -19,10 +19,10 @@ import math
 import re
 from typing import Any
 
-from linkage_kinematics import messages
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.kinematics import solve
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from node_process import decode, REPOSITORY, start_node, stop_process

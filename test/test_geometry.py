@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import (
     format_interval,
     FourBar,
     GeometryError,
@@ -17,7 +17,7 @@ from linkage_kinematics.geometry import (
     UnreachableError,
     wrap_angle,
 )
-from linkage_kinematics.kinematics import solve
+from linkage_kinematics.kinematics.solver import solve
 import pytest
 from reference import reference_singular_angles
 

@@ -15,9 +15,9 @@ from __future__ import annotations
 import math
 
 from linkage_kinematics import kinematics
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, PRESETS, UnreachableError
-from linkage_kinematics.kinematics import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar, PRESETS, UnreachableError
+from linkage_kinematics.kinematics.solver import (
     DeadPointError,
     LinkageState,
     RATE_ACCURACY,

@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.geometry import FourBar, preset, TWO_PI
-from linkage_kinematics.inversion import seen_from_rocker, solve_from_rocker
-from linkage_kinematics.kinematics import continued_branch, CrankRates, DeadPointError
+from linkage_kinematics.kinematics.geometry import FourBar, preset, TWO_PI
+from linkage_kinematics.kinematics.inversion import seen_from_rocker, solve_from_rocker
+from linkage_kinematics.kinematics.solver import continued_branch, CrankRates, DeadPointError
 from mpmath import mp, mpf
 import numpy as np
 import pytest

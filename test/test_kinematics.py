@@ -9,9 +9,14 @@ import math
 
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, GeometryError, PRESETS, UnreachableError
-from linkage_kinematics.kinematics import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import (
+    FourBar,
+    GeometryError,
+    PRESETS,
+    UnreachableError,
+)
+from linkage_kinematics.kinematics.solver import (
     DeadPointError,
     LinkageState,
     loop_closure_residual,

@@ -22,9 +22,9 @@ import xml.etree.ElementTree as ElementTree
 
 from ament_index_python.packages import get_package_share_directory
 from linkage_kinematics.bag.reader import read_states
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.parameter_specs import PARAMETER_NAMES
-from linkage_kinematics.parameters import mechanism_entries
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.run.configuration import mechanism_entries
+from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES
 from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
 import pytest
 from rosbags.rosbag2 import Reader
@@ -42,7 +42,7 @@ LAUNCH_API = {
     'launch.substitutions': {'LaunchConfiguration'},
     'launch_ros.actions': {'Node'},
     'ament_index_python.packages': {'get_package_share_directory'},
-    'linkage_kinematics.parameters': {'NODE_NAME', 'mechanism_entries'},
+    'linkage_kinematics.run.configuration': {'NODE_NAME', 'mechanism_entries'},
 }
 # The arguments of robot_state_publisher's and nav2's launch files, and the bag log's: each launch
 # file declares them and passes each to the node parameter named here (None: not a parameter).

@@ -26,13 +26,13 @@ from typing import Any
 import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics.geometry import FourBar, preset, TWO_PI
-from linkage_kinematics.joints import Driver, JointStream, Link, TREE_ORDER
-from linkage_kinematics.kinematics import CrankRates
-from linkage_kinematics.measured import MeasuredFollower, Rejection
-from linkage_kinematics.parameter_specs import parameter_specs
-from linkage_kinematics.parameters import build_configuration, Source
-from linkage_kinematics.urdf import urdf_text
+from linkage_kinematics.kinematics.geometry import FourBar, preset, TWO_PI
+from linkage_kinematics.kinematics.solver import CrankRates
+from linkage_kinematics.model.joints import Driver, JointStream, Link, TREE_ORDER
+from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.run.configuration import build_configuration, Source
+from linkage_kinematics.run.measured import MeasuredFollower, Rejection
+from linkage_kinematics.run.parameter_specs import parameter_specs
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,

@@ -17,15 +17,15 @@ import signal
 import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from linkage_kinematics import messages
 from linkage_kinematics.bag.state_layout import STATE_JOINT_NAMES
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset, TWO_PI
-from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.motion import sample_at_step, sample_at_time, solve_sample
-from linkage_kinematics.parameters import build_configuration
-from linkage_kinematics.urdf import urdf_text
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset, TWO_PI
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
+from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.ros import messages
+from linkage_kinematics.run.configuration import build_configuration
+from linkage_kinematics.run.motion import sample_at_step, sample_at_time, solve_sample
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from node_process import (

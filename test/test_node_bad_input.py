@@ -20,17 +20,17 @@ import signal
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.motion import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.run.motion import (
     dead_point_problem,
     met_dead_point,
     sample_at_step,
     sample_at_time,
 )
-from linkage_kinematics.parameter_specs import PARAMETER_NAMES, parameter_specs
-from linkage_kinematics.parameters import build_configuration, ConfigurationError
+from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, parameter_specs
 from node_process import (
     configuration_values,
     expected_state_point,

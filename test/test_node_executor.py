@@ -20,7 +20,7 @@ from __future__ import annotations
 import signal
 
 from linkage_kinematics.bag import reader as bag_reader
-from linkage_kinematics.parameter_specs import PARAMETER_NAMES, parameter_specs
+from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, parameter_specs
 from node_process import (
     drive_sim_clock,
     Listener,

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset, TWO_PI
-from linkage_kinematics.kinematics import solve
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset, TWO_PI
+from linkage_kinematics.kinematics.solver import solve
 from node_process import (
     drive_sim_clock,
     Listener,

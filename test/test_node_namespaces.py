@@ -15,10 +15,10 @@ import re
 import signal
 
 from linkage_kinematics.bag.metadata import BagMetadata
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import preset
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.urdf import urdf_text
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import preset
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model.urdf import urdf_text
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,

@@ -13,17 +13,17 @@ from __future__ import annotations
 import math
 
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import solve
-from linkage_kinematics.messages import DISK_ID, PIN_A_ID
-from linkage_kinematics.parameter_specs import (
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar, preset
+from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
+from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.run.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
     unknown_parameters,
 )
-from linkage_kinematics.parameters import build_configuration, ConfigurationError
-from linkage_kinematics.urdf import urdf_text
 from node_process import (
     configuration_values,
     get_parameter,

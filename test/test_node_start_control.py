@@ -15,7 +15,7 @@ from pathlib import Path
 import signal
 
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.run_control import RunControl, RunState, ServiceAnswer
+from linkage_kinematics.run.control import RunControl, RunState, ServiceAnswer
 from node_process import (
     Listener,
     PROCESS_TIMEOUT,

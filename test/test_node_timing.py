@@ -15,7 +15,7 @@ import math
 from pathlib import Path
 
 from linkage_kinematics.bag.reader import iter_messages
-from linkage_kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.drive import DriveLaw
 from node_process import run_node
 import pytest
 from rosbags.rosbag2 import Reader

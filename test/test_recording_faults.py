@@ -135,7 +135,7 @@ def stream_topics(mcap_path: Path) -> set[str]:
 
 def recover(bag: Path) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, '-m', 'linkage_kinematics.replay', '--recover', str(bag)],
+        [sys.executable, '-m', 'linkage_kinematics.cli.replay', '--recover', str(bag)],
         cwd=REPOSITORY, env=ros_environment(35), capture_output=True, text=True, timeout=60,
     )
 

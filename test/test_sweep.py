@@ -12,10 +12,10 @@ from pathlib import Path
 import subprocess
 import sys
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.kinematics import continued_branch, LinkageState, solve_many
-from linkage_kinematics.sweep import CSV_COLUMNS, format_tables, main
+from linkage_kinematics.cli.sweep import CSV_COLUMNS, format_tables, main
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar, preset
+from linkage_kinematics.kinematics.solver import continued_branch, LinkageState, solve_many
 from matplotlib.colors import to_rgb
 from matplotlib.image import imread
 import numpy as np
@@ -31,7 +31,7 @@ PNG_SIGNATURE = b'\x89PNG\r\n\x1a\n'
 
 def run_sweep(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, '-m', 'linkage_kinematics.sweep', *args],
+        [sys.executable, '-m', 'linkage_kinematics.cli.sweep', *args],
         cwd=REPO, capture_output=True, text=True, timeout=60,
     )
 

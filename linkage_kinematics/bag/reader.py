@@ -33,7 +33,7 @@ from linkage_kinematics.bag.state_layout import (
     STATE_TOPIC,
     STATE_TYPE,
 )
-from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.kinematics.solver import LinkageState
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
 from mcap.reader import NonSeekingReader

@@ -27,8 +27,8 @@ from linkage_kinematics.bag.metadata import (
     offered_qos_profiles_for,
     TRANSIENT_LOCAL,
 )
-from linkage_kinematics.bag.writer import NO_SPLIT
 from linkage_kinematics.bag.writer_process import BagWriterProcess
+from linkage_kinematics.run.limits import NO_SPLIT
 
 # A topic to record: its resolved name, rclpy message class, QoS profile and whether its latest
 # message starts every file (None: if the QoS is transient local).

@@ -21,8 +21,8 @@ import math
 from typing import Any
 
 from linkage_kinematics.bag.errors import BagError
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import LinkageState
 import numpy as np
 
 STATE_TOPIC = '/linkage/state'

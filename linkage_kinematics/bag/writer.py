@@ -50,6 +50,7 @@ from linkage_kinematics.bag.metadata import (
     TopicInfo,
 )
 from linkage_kinematics.bag.repeated import RepeatedTopics
+from linkage_kinematics.run.limits import MIN_SPLIT_SIZE, NO_SPLIT
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import (
@@ -73,9 +74,6 @@ DEFAULT_CHUNK_SIZE = 1024 * 1024
 # Messages queued before they go into the MCAP chunk together (see BagWriter._add_queued): at
 # 5 kHz, 16 messages are 8 ticks, and adding them takes well under one tick's period.
 WRITE_BATCH = 16
-# rosbag2's smallest max_bagfile_size for its MCAP storage (get_minimum_split_file_size).
-MIN_SPLIT_SIZE = 1024
-NO_SPLIT = 0
 _COMPRESSION = {
     'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4, 'none': CompressionType.NONE
 }

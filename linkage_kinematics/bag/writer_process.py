@@ -40,7 +40,9 @@ import time
 from typing import Any, BinaryIO
 
 from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
-from linkage_kinematics.bag.writer import BagWriter, NO_SPLIT, WRITE_BATCH
+from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
+from linkage_kinematics.run.limits import NO_SPLIT
+from linkage_kinematics.run.placement import set_process_affinity
 
 _FRAME = struct.Struct('<cI')
 _MESSAGE = struct.Struct('<HqqI')
@@ -50,24 +52,6 @@ START, TOPIC, MESSAGES, FLUSH = b'S', b'T', b'M', b'F'
 BATCH_AGE = 0.05
 SIZE_REPORT_INTERVAL = 0.25  # s between the child's reports of the file size
 CLOSE_TIMEOUT = 60.0  # s for the child to write the summary once the pipe is closed
-
-
-def set_process_affinity(pid: int, cpus: Set[int]) -> None:
-    """
-    Let every thread of process ``pid`` run only on ``cpus``.
-
-    Threads it starts later inherit their starter's CPUs. A process that has ended meanwhile is
-    left alone: whoever waits for it learns how it ended.
-    """
-    try:
-        threads = os.listdir(f'/proc/{pid}/task')
-    except FileNotFoundError:
-        return
-    for thread in threads:
-        try:
-            os.sched_setaffinity(int(thread), cpus)
-        except ProcessLookupError:
-            pass  # the thread ended meanwhile
 
 
 class BagWriterProcess:

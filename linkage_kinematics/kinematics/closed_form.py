@@ -36,8 +36,8 @@ from dataclasses import dataclass, fields
 import math
 from typing import Callable
 
-from linkage_kinematics.geometry import FourBar, LoopClosure
-from linkage_kinematics.singular_points import (
+from linkage_kinematics.kinematics.geometry import FourBar, LoopClosure
+from linkage_kinematics.kinematics.singular_points import (
     array_factors,
     exact_factors,
     FAR,

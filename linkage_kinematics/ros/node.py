@@ -23,32 +23,31 @@ import signal
 import sys
 from typing import Any
 
-from linkage_kinematics.diagnostics import RateMeter, report, StatusSchedule
-from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.motion import blocked_note
-from linkage_kinematics.node_outputs import NodeOutputs, StartupError
-from linkage_kinematics.node_parameters import (
+from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.ros.exit_codes import ExitCode
+from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
+from linkage_kinematics.ros.parameters import (
     add_ranges,
     declare_parameters,
     keep_declared_types,
     parameter_values,
 )
-from linkage_kinematics.node_sources import (
+from linkage_kinematics.ros.sources import (
     DriveLawTimer,
-    EXIT_FAILED,
-    EXIT_OK,
     MeasuredSubscription,
 )
-from linkage_kinematics.parameter_specs import PARAMETER_NAMES, unknown_parameters
-from linkage_kinematics.parameters import (
+from linkage_kinematics.run.configuration import (
     build_configuration,
     ConfigurationError,
     NODE_NAME,
     RunConfiguration,
     Source,
 )
-from linkage_kinematics.placement import CpuPlacement
-from linkage_kinematics.run_control import RunControl, ServiceAnswer
+from linkage_kinematics.run.control import RunControl, ServiceAnswer
+from linkage_kinematics.run.diagnostics import RateMeter, report, StatusSchedule
+from linkage_kinematics.run.motion import blocked_note
+from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, unknown_parameters
+from linkage_kinematics.run.placement import CpuPlacement
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -60,8 +59,6 @@ from rclpy.signals import SignalHandlerOptions
 from std_srvs.srv import Trigger
 
 DIAGNOSTICS_PERIOD = 1.0  # s
-
-EXIT_CONFIGURATION = 2
 
 
 # --- the node ------------------------------------------------------------------------------
@@ -293,7 +290,7 @@ def main(args: list[str] | None = None) -> int:
         # rcl's text, without the source locations it appends ('…, at /src/rcl/x.c:352')
         _report_start_up_failure(
             'cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
-        return EXIT_CONFIGURATION
+        return ExitCode.CONFIGURATION
     received: list[int] = []
 
     def request_stop(signal_number: int, _frame: object) -> None:
@@ -306,10 +303,10 @@ def main(args: list[str] | None = None) -> int:
             node = LinkageNode()
         except ConfigurationError as error:
             _report_start_up_failure(f'invalid parameter {error}')
-            return EXIT_CONFIGURATION
+            return ExitCode.CONFIGURATION
         except StartupError as error:
             _report_start_up_failure(str(error))
-            return EXIT_CONFIGURATION
+            return ExitCode.CONFIGURATION
         # The events executor dispatches timers and services from C++ instead of rebuilding a
         # wait set in Python for every callback: at 1 kHz it halves the process's CPU
         # (docs/benchmarks.md, section 3). On simulated time rclpy 7.1.6's events executor
@@ -331,8 +328,8 @@ def main(args: list[str] | None = None) -> int:
             log_closed = node.outputs.close_log()
             executor.remove_node(node)
             node.destroy_node()
-        exit_code = EXIT_OK if received else node.exit_code
-        return exit_code if log_closed else EXIT_FAILED
+        exit_code = ExitCode.OK if received else node.exit_code
+        return exit_code if log_closed else ExitCode.FAILED
     finally:
         rclpy.try_shutdown()
 

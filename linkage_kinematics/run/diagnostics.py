@@ -21,12 +21,12 @@ import collections
 from enum import IntEnum
 import math
 
-from linkage_kinematics.joints import Driver, Link
-from linkage_kinematics.kinematics import LinkageState, loop_closure_residual
-from linkage_kinematics.measured import Estimate, Rejection
-from linkage_kinematics.motion import blocked_note
-from linkage_kinematics.parameters import MotionMode, RunConfiguration, Source
-from linkage_kinematics.run_control import RunState
+from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
+from linkage_kinematics.model.joints import Driver, Link
+from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, Source
+from linkage_kinematics.run.control import RunState
+from linkage_kinematics.run.measured import Estimate, Rejection
+from linkage_kinematics.run.motion import blocked_note
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
 RATE_WINDOW = 1.0  # s of node-clock time over which the achieved rate is measured

@@ -18,11 +18,11 @@ import difflib
 import math
 from typing import Any
 
-from linkage_kinematics.bag.writer import MIN_SPLIT_SIZE, NO_SPLIT
-from linkage_kinematics.geometry import DIMENSIONS, LINK_LENGTHS, preset, TWO_PI
-from linkage_kinematics.joints import DEFAULT_JOINT_NAMES, Driver, Link
-from linkage_kinematics.parameters import (
-    EndBehavior,
+from linkage_kinematics.kinematics.geometry import DIMENSIONS, LINK_LENGTHS, preset, TWO_PI
+from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, Link
+from linkage_kinematics.model.urdf import DEFAULT_FRAME_ID
+from linkage_kinematics.run.configuration import EndBehavior, MotionMode, NODE_NAME, Source
+from linkage_kinematics.run.limits import (
     MAX_ANGLE,
     MAX_BAG_DURATION,
     MAX_BAG_SIZE,
@@ -34,12 +34,10 @@ from linkage_kinematics.parameters import (
     MAX_RATE_HZ,
     MAX_TIME_CONSTANT,
     MAX_TIMEOUT,
-    MotionMode,
+    MIN_SPLIT_SIZE,
     NO_CPU_AFFINITY,
-    NODE_NAME,
-    Source,
+    NO_SPLIT,
 )
-from linkage_kinematics.urdf import DEFAULT_FRAME_ID
 
 
 @dataclass(frozen=True)

@@ -17,9 +17,14 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 import math
 
-from linkage_kinematics.geometry import TWO_PI, UnreachableError
-from linkage_kinematics.kinematics import continued_branch, DeadPointError, LinkageState, solve
-from linkage_kinematics.parameters import EndBehavior, MotionMode, RunConfiguration
+from linkage_kinematics.kinematics.geometry import TWO_PI, UnreachableError
+from linkage_kinematics.kinematics.solver import (
+    continued_branch,
+    DeadPointError,
+    LinkageState,
+    solve,
+)
+from linkage_kinematics.run.configuration import EndBehavior, MotionMode, RunConfiguration
 
 
 @dataclass(frozen=True)

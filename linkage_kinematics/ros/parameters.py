@@ -13,14 +13,14 @@ from __future__ import annotations
 
 from typing import Any
 
-from linkage_kinematics.geometry import GeometryError
-from linkage_kinematics.parameter_specs import (
+from linkage_kinematics.kinematics.geometry import GeometryError
+from linkage_kinematics.run.configuration import ConfigurationError, describe_value
+from linkage_kinematics.run.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
     ParameterSpec,
     REAL_PARAMETERS,
 )
-from linkage_kinematics.parameters import ConfigurationError, describe_value
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter

@@ -14,20 +14,24 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from linkage_kinematics.diagnostics import MeasuredHealth
-from linkage_kinematics.joints import Link
-from linkage_kinematics.measured import MeasuredFollower, Rejection
-from linkage_kinematics.motion import dead_point_problem, DriveLawRun, MotionSample, solve_sample
-from linkage_kinematics.parameters import EndBehavior, RunConfiguration
-from linkage_kinematics.run_control import ServiceAnswer
+from linkage_kinematics.model.joints import Link
+from linkage_kinematics.ros.exit_codes import ExitCode
+from linkage_kinematics.run.configuration import EndBehavior, RunConfiguration
+from linkage_kinematics.run.control import ServiceAnswer
+from linkage_kinematics.run.diagnostics import MeasuredHealth
+from linkage_kinematics.run.measured import MeasuredFollower, Rejection
+from linkage_kinematics.run.motion import (
+    dead_point_problem,
+    DriveLawRun,
+    MotionSample,
+    solve_sample,
+)
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 
 if TYPE_CHECKING:
-    from linkage_kinematics.node import LinkageNode
+    from linkage_kinematics.ros.node import LinkageNode
 
-EXIT_OK = 0
-EXIT_FAILED = 1  # the crank met a dead point before alpha_end, or the log could not be closed
 # Deep enough that a burst of encoder samples waiting for one slow callback is never lost.
 MEASURED_QOS = QoSProfile(depth=100)
 
@@ -138,7 +142,7 @@ class DriveLawTimer:
                 node.publish_markers()
                 node.outputs.flush_log()
                 node.publish_diagnostics()
-                node.exit_code = EXIT_OK
+                node.exit_code = ExitCode.OK
                 return
         if blocked:
             self._cannot_go_on(None)
@@ -155,7 +159,7 @@ class DriveLawTimer:
         self._node.get_logger().error(node.problem)
         node.outputs.flush_log()
         node.publish_diagnostics()
-        node.exit_code = EXIT_FAILED
+        node.exit_code = ExitCode.FAILED
 
 
 class MeasuredSubscription:

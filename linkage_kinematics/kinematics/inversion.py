@@ -20,9 +20,9 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import FourBar, wrap_angle
-from linkage_kinematics.kinematics import CrankRates, LinkageState, solve
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import FourBar, wrap_angle
+from linkage_kinematics.kinematics.solver import CrankRates, LinkageState, solve
 
 
 def seen_from_rocker(linkage: FourBar) -> FourBar:

@@ -11,10 +11,29 @@ without crossing CPUs, and the bag writer process, on the other CPUs, cannot del
 
 from __future__ import annotations
 
+from collections.abc import Set
 import os
 
-from linkage_kinematics.bag.writer_process import set_process_affinity
-from linkage_kinematics.parameters import ConfigurationError, NO_CPU_AFFINITY
+from linkage_kinematics.run.configuration import ConfigurationError
+from linkage_kinematics.run.limits import NO_CPU_AFFINITY
+
+
+def set_process_affinity(pid: int, cpus: Set[int]) -> None:
+    """
+    Let every thread of process ``pid`` run only on ``cpus``.
+
+    Threads it starts later inherit their starter's CPUs. A process that has ended meanwhile is
+    left alone: whoever waits for it learns how it ended.
+    """
+    try:
+        threads = os.listdir(f'/proc/{pid}/task')
+    except FileNotFoundError:
+        return
+    for thread in threads:
+        try:
+            os.sched_setaffinity(int(thread), cpus)
+        except ProcessLookupError:
+            pass  # the thread ended meanwhile
 
 
 class CpuPlacement:

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.closed_form import (
+from linkage_kinematics.kinematics.closed_form import (
     ARRAY_MATH,
     CrankRates,
     evaluate,
@@ -35,10 +35,15 @@ from linkage_kinematics.closed_form import (
     SCALAR_MATH,
     STATE_FIELDS,
 )
-from linkage_kinematics.continuation import check_branch, continued_branch
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import ANGLE_TOLERANCE, FourBar, TWO_PI, UnreachableError
-from linkage_kinematics.singular_points import (
+from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import (
+    ANGLE_TOLERANCE,
+    FourBar,
+    TWO_PI,
+    UnreachableError,
+)
+from linkage_kinematics.kinematics.singular_points import (
     LoopCheck,
     NEAR_DEAD,
     PIVOT_PASSAGE,

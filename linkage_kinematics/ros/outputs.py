@@ -17,17 +17,17 @@ from typing import Any
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics import messages
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
-from linkage_kinematics.diagnostics import Level
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.joints import JointMap, JointStream
-from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.parameters import ConfigurationError, RunConfiguration, Source
-from linkage_kinematics.urdf import urdf_text
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.model.joints import JointMap, JointStream
+from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.ros import messages
+from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration, Source
+from linkage_kinematics.run.diagnostics import Level
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy

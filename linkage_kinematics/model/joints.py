@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from enum import StrEnum
 import math
 
-from linkage_kinematics.kinematics import LinkageState, unwrap_near
+from linkage_kinematics.kinematics.solver import LinkageState, unwrap_near
 
 
 class Driver(StrEnum):

@@ -35,10 +35,9 @@ from dataclasses import dataclass, replace
 from enum import StrEnum
 import math
 
-from linkage_kinematics.geometry import TWO_PI, UnreachableError
-from linkage_kinematics.inversion import solve_from_rocker
-from linkage_kinematics.joints import Driver, Link, TREE_ORDER
-from linkage_kinematics.kinematics import (
+from linkage_kinematics.kinematics.geometry import TWO_PI, UnreachableError
+from linkage_kinematics.kinematics.inversion import solve_from_rocker
+from linkage_kinematics.kinematics.solver import (
     continued_branch,
     CrankRates,
     DeadPointError,
@@ -46,7 +45,8 @@ from linkage_kinematics.kinematics import (
     solve,
     unwrap_near,
 )
-from linkage_kinematics.parameters import RunConfiguration
+from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER
+from linkage_kinematics.run.configuration import RunConfiguration
 
 
 class Rejection(StrEnum):

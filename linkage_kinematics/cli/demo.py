@@ -20,8 +20,8 @@ import sys
 
 from ament_index_python.packages import get_package_share_directory, PackageNotFoundError
 from linkage_kinematics.bag.reader import read_states
-from linkage_kinematics.cli_types import number
-from linkage_kinematics.sweep import format_tables, write_plot
+from linkage_kinematics.cli.arguments import number
+from linkage_kinematics.cli.sweep import format_tables, write_plot
 
 SCENARIOS = (
     ('seed_constant.yaml', "Constant law, ω = 2 rad/s (the paper's Tables 1 and 2)"),
@@ -33,7 +33,7 @@ def _run_node(params_file: Path, log_folder: Path) -> Path:
     """Run one scenario to its end; return the bag it wrote."""
     before = set(log_folder.iterdir()) if log_folder.is_dir() else set()
     command = [
-        sys.executable, '-m', 'linkage_kinematics.node', '--ros-args',
+        sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args',
         '--params-file', str(params_file),
         '-p', 'mode:=fixed_step',
         '-p', f'log.folder:={log_folder}',

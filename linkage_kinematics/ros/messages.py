@@ -22,12 +22,12 @@ import math
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, TransformStamped
-from linkage_kinematics import scene
 from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder
 from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
-from linkage_kinematics.geometry import FourBar
-from linkage_kinematics.kinematics import LinkageState
-from linkage_kinematics.robot_transforms import RobotTransforms, Transform
+from linkage_kinematics.kinematics.geometry import FourBar
+from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.model import scene
+from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA

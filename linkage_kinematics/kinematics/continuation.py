@@ -14,8 +14,8 @@ With an odd number of change points per turn the smooth motion repeats only ever
 
 from __future__ import annotations
 
-from linkage_kinematics.geometry import FourBar, TWO_PI
-from linkage_kinematics.singular_points import FloatOrArray, offset
+from linkage_kinematics.kinematics.geometry import FourBar, TWO_PI
+from linkage_kinematics.kinematics.singular_points import FloatOrArray, offset
 import numpy as np
 
 

@@ -29,7 +29,7 @@ import sys
 from linkage_kinematics.bag import player, reader
 from linkage_kinematics.bag.errors import BagError
 from linkage_kinematics.bag.recovery import recover_bag
-from linkage_kinematics.cli_types import number
+from linkage_kinematics.cli.arguments import number
 
 _positive_rate = number(above=0.0, rule='a positive factor')
 _non_negative_seconds = number(at_least=0.0, rule='zero or more seconds')

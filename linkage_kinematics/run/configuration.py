@@ -19,9 +19,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from linkage_kinematics.bag.writer import MIN_SPLIT_SIZE, NO_SPLIT
-from linkage_kinematics.drive import DriveError, DriveLaw
-from linkage_kinematics.geometry import (
+from linkage_kinematics.kinematics.drive import DriveError, DriveLaw
+from linkage_kinematics.kinematics.geometry import (
     DIMENSIONS,
     FourBar,
     GeometryError,
@@ -31,28 +30,29 @@ from linkage_kinematics.geometry import (
     TWO_PI,
     UnreachableError,
 )
-from linkage_kinematics.inversion import seen_from_rocker
-from linkage_kinematics.joints import Driver, JointMap, JointMapping, Link
-from linkage_kinematics.kinematics import continued_branch, DeadPointError, solve
+from linkage_kinematics.kinematics.inversion import seen_from_rocker
+from linkage_kinematics.kinematics.solver import continued_branch, DeadPointError, solve
+from linkage_kinematics.model.joints import Driver, JointMap, JointMapping, Link
+from linkage_kinematics.run.limits import (
+    MAX_ANGLE,
+    MAX_BAG_DURATION,
+    MAX_BAG_SIZE,
+    MAX_CPU,
+    MAX_DISPLAY_RATE_HZ,
+    MAX_DRIVE_GAIN,
+    MAX_OMEGA0,
+    MAX_PARAMETER_LENGTH,
+    MAX_RATE_HZ,
+    MAX_TIME_CONSTANT,
+    MAX_TIMEOUT,
+    MIN_PASS_DURATION,
+    MIN_SPLIT_SIZE,
+    NO_CPU_AFFINITY,
+    NO_SPLIT,
+)
 import yaml
 
 NODE_NAME = 'linkage_node'
-MAX_RATE_HZ = 10000.0
-MAX_DISPLAY_RATE_HZ = 1000.0
-MAX_BAG_SIZE = 2**63 - 1  # bytes; the largest int64 parameter
-MAX_BAG_DURATION = 1e9  # s, about 32 years
-MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
-NO_CPU_AFFINITY = -1
-# m; the largest length and |ground coordinate| the node's parameters take, far beyond any
-# mechanism (geometry.MAX_SOLVABLE_LENGTH is what the library itself can solve)
-MAX_PARAMETER_LENGTH = 1e6
-MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
-MAX_OMEGA0 = 1e4  # rad/s
-MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
-# s; shorter passes would fall between clock ticks, and elapsed / pass duration could overflow.
-MIN_PASS_DURATION = 1e-6
-MAX_TIMEOUT = 3600.0  # s
-MAX_TIME_CONSTANT = 10.0  # s
 
 # A step count within this fraction of a step of a whole number ends exactly on the segment
 # end, so 90° in 0.5° steps is 180 steps and not 180 plus a rounding-sized 181st.

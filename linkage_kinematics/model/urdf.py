@@ -22,16 +22,16 @@ it: the joint's axis is direction·z and its origin is turned by −direction·o
 that the child frame turns by direction·(q − offset), the node's value, as above.
 
 The root link (``frame_id``, by default ``linkage_base``) shows both ground pivots.
-Regenerate the installed file with ``python -m linkage_kinematics.urdf > urdf/linkage.urdf``.
+Regenerate the installed file with ``python -m linkage_kinematics.model.urdf > urdf/linkage.urdf``.
 """
 
 from __future__ import annotations
 
 import math
 
-from linkage_kinematics.geometry import FourBar, preset
-from linkage_kinematics.joints import Driver, JointMap, JointMapping
-from linkage_kinematics.scene import (
+from linkage_kinematics.kinematics.geometry import FourBar, preset
+from linkage_kinematics.model.joints import Driver, JointMap, JointMapping
+from linkage_kinematics.model.scene import (
     BAR_HEIGHT,
     BAR_WIDTH,
     COUPLER_COLOR,

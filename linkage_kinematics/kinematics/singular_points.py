@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import math
 from typing import Callable, Union
 
-from linkage_kinematics.geometry import _PLAIN, _TOUCH, LoopClosure, TWO_PI
+from linkage_kinematics.kinematics.geometry import _PLAIN, _TOUCH, LoopClosure, TWO_PI
 import numpy as np
 
 FloatOrArray = Union[float, np.ndarray]

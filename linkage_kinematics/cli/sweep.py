@@ -27,9 +27,9 @@ import unicodedata
 
 from linkage_kinematics.bag.errors import BagError
 from linkage_kinematics.bag.reader import bag_files, read_states
-from linkage_kinematics.cli_types import number
-from linkage_kinematics.drive import DriveLaw
-from linkage_kinematics.geometry import (
+from linkage_kinematics.cli.arguments import number
+from linkage_kinematics.kinematics.drive import DriveLaw
+from linkage_kinematics.kinematics.geometry import (
     DIMENSIONS,
     FourBar,
     GeometryError,
@@ -37,7 +37,7 @@ from linkage_kinematics.geometry import (
     PRESETS,
     UnreachableError,
 )
-from linkage_kinematics.kinematics import (
+from linkage_kinematics.kinematics.solver import (
     continued_branch,
     DeadPointError,
     LinkageState,

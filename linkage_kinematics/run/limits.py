@@ -1,0 +1,30 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The limits of the node's parameters, one owner for each: validation, descriptors and the bag.
+
+``configuration`` checks values against them, ``parameter_specs`` shows them in the parameters'
+descriptors, and ``bag.writer`` enforces rosbag2's split rule with the same two numbers.
+"""
+
+MAX_RATE_HZ = 10000.0
+MAX_DISPLAY_RATE_HZ = 1000.0
+MAX_BAG_SIZE = 2**63 - 1  # bytes; the largest int64 parameter
+MAX_BAG_DURATION = 1e9  # s, about 32 years
+MAX_CPU = 1023  # Linux's CPU_SETSIZE − 1: the highest CPU number an affinity mask holds
+NO_CPU_AFFINITY = -1
+# m; the largest length and |ground coordinate| the node's parameters take, far beyond any
+# mechanism (geometry.MAX_SOLVABLE_LENGTH is what the library itself can solve)
+MAX_PARAMETER_LENGTH = 1e6
+MAX_ANGLE = 1e6  # rad; a double near 1e6 rad still resolves 1.2e-10 rad
+MAX_OMEGA0 = 1e4  # rad/s
+MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
+# s; shorter passes would fall between clock ticks, and elapsed / pass duration could overflow.
+MIN_PASS_DURATION = 1e-6
+MAX_TIMEOUT = 3600.0  # s
+MAX_TIME_CONSTANT = 10.0  # s
+# rosbag2's smallest max_bagfile_size for its MCAP storage (get_minimum_split_file_size), and
+# its value for "never split" (of both max_bagfile_size and max_bagfile_duration).
+MIN_SPLIT_SIZE = 1024
+NO_SPLIT = 0
