@@ -9,6 +9,8 @@ import math
 
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
+import linkage_kinematics.kinematics as library
+from linkage_kinematics.kinematics import geometry, solver
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import (
     FourBar,
@@ -302,3 +304,16 @@ def test_dense_sweep_is_finite_and_reachable_mask_agrees(name: str) -> None:
         assert reachable
         for field_name in LinkageState.__dataclass_fields__:
             assert math.isfinite(getattr(state, field_name)), field_name
+
+
+def test_the_librarys_public_names_keep_their_import_path():
+    """``linkage_kinematics.kinematics`` was one module; its public names are still there."""
+    for name in ('solve', 'solve_many', 'solve_pose', 'continued_branch', 'DeadPointError',
+                 'loop_closure_residual', 'unwrap_near', 'reachable_mask'):
+        assert getattr(library, name) is getattr(solver, name)
+    for name in ('FourBar', 'preset', 'PRESETS', 'UnreachableError', 'GeometryError', 'TWO_PI'):
+        assert getattr(library, name) is getattr(geometry, name)
+    assert library.DriveLaw is DriveLaw
+    assert set(library.__all__) <= set(dir(library))
+    state = library.solve(library.preset('paper').geometry, 0.0, library.DriveLaw(2.0))
+    assert state.omega_bc == pytest.approx(-6.667, abs=5e-4)  # the paper's Table 1, α = 0
