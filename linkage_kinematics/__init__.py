@@ -6,7 +6,8 @@ Exact kinematics of a planar four-bar linkage for ROS 2.
 
 The linkage is the paper's disk (crank), coupler and rocker.
 
-The kinematics (``geometry``, ``drive``, and ``kinematics`` over ``closed_form``,
-``singular_points`` and ``continuation``) is a pure library that needs only numpy; the ROS node
-and the command-line tools are thin shells around it.
+One subpackage per layer, each importing only those before it: ``kinematics`` (the pure
+library, numpy only), ``model`` (the mechanism as ROS tools see it), ``run`` (what the node
+decides, no rclpy), ``bag`` (MCAP bags), ``ros`` (the thin rclpy shell of ``linkage_node``) and
+``cli`` (the command-line tools). README.md, Architecture, shows the tree.
 """

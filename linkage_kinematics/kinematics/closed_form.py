@@ -23,11 +23,11 @@ turned by +90° and S = e_AB × e_BC (= σ·h·d/(AB·BC), the sine of the trans
 which is Cramer's rule on the 2×2 velocity and acceleration systems. For a change-point linkage
 the system is singular at its change points while the motion is smooth; there the rates come
 from an analytic form with the common factor of numerator and S taken out
-(``_smooth_slopes``), finite and exact at the change point itself.
+(``_smooth_rates``), finite and exact at the change point itself.
 
 One function (``evaluate``) serves the scalar path (``math`` on floats, the node's hot path) and
 the vectorised path (``numpy`` on arrays); it neither checks its inputs nor refuses anything:
-``kinematics`` does, from the LoopCheck it returns.
+``solver`` does, from the LoopCheck it returns.
 """
 
 from __future__ import annotations

@@ -4,9 +4,9 @@
 """
 The node's parameters on the ROS side: declared with descriptors, whole numbers kept real.
 
-``parameter_specs`` owns what each parameter is and ``parameters`` how values are validated;
-this module only declares them on a node so that ``ros2 param describe`` shows their meaning,
-unit and range.
+``run.parameter_specs`` owns what each parameter is and ``run.configuration`` how values are
+validated; this module only declares them on a node so that ``ros2 param describe`` shows their
+meaning, unit and range.
 """
 
 from __future__ import annotations
