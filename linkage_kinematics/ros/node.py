@@ -41,7 +41,7 @@ from linkage_kinematics.run.configuration import (
     ConfigurationError,
     NODE_NAME,
     RunConfiguration,
-    Source,
+    SourceKind,
 )
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
 from linkage_kinematics.run.diagnostics import RateMeter, report, StatusSchedule
@@ -108,7 +108,7 @@ class LinkageNode(Node):
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
         self._source: DriveLawTimer | MeasuredSubscription = (
-            MeasuredSubscription(self) if config.source is Source.MEASURED
+            MeasuredSubscription(self) if config.source is SourceKind.MEASURED
             else DriveLawTimer(self))
         for name, act in (('pause', self._source.pause), ('resume', self._source.resume),
                           ('reset', self._source.reset)):
@@ -226,7 +226,7 @@ class LinkageNode(Node):
         if first:
             self.publish_markers()
             self.outputs.publish_description(stamp_ns)
-            if self.config.source is Source.DRIVE_LAW:
+            if self.config.source is SourceKind.DRIVE_LAW:
                 self.activity = 'moving'
             self.publish_diagnostics()
         self.outputs.publish_state(state, stamp_ns, motion_time)

@@ -76,7 +76,7 @@ class MotionMode(StrEnum):
     FIXED_STEP = 'fixed_step'
 
 
-class Source(StrEnum):
+class SourceKind(StrEnum):
     """Where the driver's motion comes from: parameter ``source``, by its value."""
 
     DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
@@ -125,7 +125,7 @@ class RunConfiguration:
     log_max_bag_size: int
     log_max_bag_duration: float
     cpu_affinity: int
-    source: Source
+    source: SourceKind
     driver: Driver
     # The linkage as its driver turns it: ``linkage``, or seen from C for the rocker.
     driven_linkage: FourBar
@@ -375,7 +375,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     log_max_bag_size = _bag_size(values)
     log_max_bag_duration = _within(values, 'log.max_bag_duration', 0.0, MAX_BAG_DURATION, 's')
     cpu_affinity = _cpu(values)
-    source = Source(_text(values, 'source', tuple(Source)))
+    source = SourceKind(_text(values, 'source', tuple(SourceKind)))
     driver = Driver(_text(values, 'driver', tuple(Driver)))
     joints = _joints(values)
     publish_robot_description = _flag(values, 'publish_robot_description')
@@ -383,7 +383,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     max_jump = _positive(values, 'measured.max_jump', 'rad', math.pi)
     acceleration_time_constant = _within(
         values, 'measured.acceleration_time_constant', 0.0, MAX_TIME_CONSTANT, 's')
-    if source is Source.MEASURED:
+    if source is SourceKind.MEASURED:
         # No pass: the drive-law parameters are not used, so not checked against the geometry.
         blocked_at, segment_duration, segment_end, step_count = None, 0.0, alpha_end, 1
     else:
