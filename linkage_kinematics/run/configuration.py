@@ -13,7 +13,7 @@ node, the demo and the tests all validate through it. ``parameter_specs`` declar
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import StrEnum
 import math
 from pathlib import Path
@@ -81,6 +81,14 @@ class SourceKind(StrEnum):
 
     DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
     MEASURED = 'measured'  # the driver joint of each measured_joint_states message
+
+
+# The fields whose change restarts the motion from alpha_start (README: Run-time changes); a
+# field not named here (a threshold, a rate of the display, the lab's joint names) changes what
+# is reported or how, not where the crank is. The rest of the motion (segment_end, blocked_at,
+# ...) follows from these, and the read-only parameters never change at run time.
+MOTION_FIELDS = ('linkage', 'drive', 'branch', 'alpha_start', 'alpha_end', 'end_behavior', 'mode',
+                 'alpha_step', 'rate_hz')
 
 
 class ConfigurationError(ValueError):
@@ -153,18 +161,7 @@ class RunConfiguration:
 
     def restarts_motion(self, other: RunConfiguration) -> bool:
         """Whether switching from ``other`` to this configuration changes the motion itself."""
-        same_motion = replace(
-            other,
-            min_transmission_angle=self.min_transmission_angle,
-            dead_point_warning=self.dead_point_warning,
-            display_rate_hz=self.display_rate_hz,
-            cpu_affinity=self.cpu_affinity,
-            measured_timeout=self.measured_timeout,
-            max_jump=self.max_jump,
-            acceleration_time_constant=self.acceleration_time_constant,
-            joints=self.joints,
-        )
-        return same_motion != self
+        return any(getattr(self, name) != getattr(other, name) for name in MOTION_FIELDS)
 
 
 # --- validation: pure functions from parameter values to a RunConfiguration ---------------
