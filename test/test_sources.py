@@ -192,7 +192,7 @@ def test_a_dead_point_before_alpha_end_under_stop_fails_the_run():
     assert host.exit_code is ExitCode.FAILED
 
 
-def test_paused_the_source_publishes_no_state():
+def test_paused_the_source_publishes_no_state_and_a_reset_shows_alpha_start_once():
     host, source = hosted(autostart=False, alpha_start=0.25)
     (timer,) = host.timers
     source.start()
@@ -215,3 +215,14 @@ def test_paused_the_source_publishes_no_state():
     timer.callback()
     assert host.take() == []  # paused: no state
     assert timer.canceled
+
+    # A reset while paused publishes the state at alpha_start once, with its scene and status.
+    host.clock_ns += PERIOD_NS
+    answer = source.reset()
+    assert answer.message == 'back to alpha_start = 14.323945°; paused: ~/resume starts the motion'
+    assert host.take() == [('scene', 0.25), ('description',), ('status', waiting, None),
+                           ('state', 0.25, host.clock_ns, 0.0)]
+    assert timer.canceled and host.control.paused
+    host.clock_ns += PERIOD_NS
+    timer.callback()
+    assert host.take() == []

@@ -206,6 +206,8 @@ class DriveLawTimer:
         self._host = host
         self.run = DriveLawRun(host.config)
         self._timer = host.create_timer(self.run.timer_period, self.tick)
+        # A ~/reset while paused shows the state at alpha_start at the next tick that can.
+        self._reset_pose_due = False
 
     def start(self) -> None:
         """
@@ -268,9 +270,15 @@ class DriveLawTimer:
         return answer
 
     def reset(self) -> ServiceAnswer:
-        """Send the motion back to alpha_start: a running one starts again at once."""
+        """
+        Send the motion back to alpha_start: a running one starts again at once.
+
+        A paused one stays paused there, and its state at alpha_start is published once, as a
+        simulator's reset shows the initial pose, so that subscribers stop showing the held one.
+        """
         answer = self._host.control.reset(self._host.config.alpha_start)
         self._back_to_start()
+        self._reset_pose_due = self._host.control.paused
         self._timer.reset()
         self.tick()
         return answer
@@ -281,12 +289,18 @@ class DriveLawTimer:
         now_ns = host.now_ns()
         if host.finished or now_ns == 0:
             return  # finished, or use_sim_time and no /clock yet: no time to start at
+        reset_pose_due, self._reset_pose_due = self._reset_pose_due, False
         if host.control.paused:
             if host.state is None:
-                # Waiting at alpha_start (autostart false, or reset while paused): its scene.
+                # Waiting at alpha_start (autostart false, or reset while paused): its scene,
+                # and after a reset its state too.
+                config = host.config
+                at_start = solve_sample(config, MotionSample(config.alpha_start))
                 host.set_activity(host.control.activity(None))
-                host.show_waiting(
-                    solve_sample(host.config, MotionSample(host.config.alpha_start)), now_ns)
+                if reset_pose_due:
+                    host.publish_state(at_start, now_ns, 0.0)
+                else:
+                    host.show_waiting(at_start, now_ns)
             self._timer.cancel()  # ~/resume or a restart re-arms it
             return
         if self.run.start_ns is None or now_ns < self.run.start_ns:
