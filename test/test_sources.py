@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The drive_law source's tick, hosted by a fake of the node's narrow host interface.
+The node's sources, hosted by a fake of the node's narrow host interface.
 
 ``FakeHost`` is a ``SourceHost`` of our own (the interface is ours, not ROS's): a clock the
 test sets, timers the test holds, and a record, in order, of what the source had published and
@@ -18,12 +18,18 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.ros.exit_codes import ExitCode
-from linkage_kinematics.ros.sources import DriveLawTimer, RunStatus, SourceHost
+from linkage_kinematics.ros.sources import (
+    DriveLawTimer,
+    MeasuredSubscription,
+    RunStatus,
+    SourceHost,
+)
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
 from linkage_kinematics.run.control import RunControl
 from linkage_kinematics.run.motion import dead_point_problem
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import pytest
+from sensor_msgs.msg import JointState
 
 START_NS = 5_000_000_000  # the node clock's time when the motion starts
 PERIOD_NS = 10_000_000  # rate_hz 100
@@ -81,6 +87,7 @@ class FakeHost(RunStatus):
         self.motion_started = False
         self.record: list[tuple] = []
         self.timers: list[FakeTimer] = []
+        self.subscriptions: dict[str, Callable[[Any], None]] = {}
         self._logger = FakeLogger(self.record)
 
     def now_ns(self) -> int:
@@ -100,7 +107,8 @@ class FakeHost(RunStatus):
 
     def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
                             qos_profile: object) -> object:
-        raise AssertionError('the drive law subscribes to nothing')
+        self.subscriptions[topic] = callback
+        return topic
 
     def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
         if not self.motion_started:
@@ -226,3 +234,32 @@ def test_paused_the_source_publishes_no_state_and_a_reset_shows_alpha_start_once
     host.clock_ns += PERIOD_NS
     timer.callback()
     assert host.take() == []
+
+
+def joint_state(seconds: float, crank: float) -> JointState:
+    message = JointState(name=['crank_joint'], position=[crank])
+    message.header.stamp.sec = int(seconds)
+    message.header.stamp.nanosec = round((seconds % 1) * 1e9)
+    return message
+
+
+def test_the_measured_source_takes_a_new_configuration_through_its_follower():
+    host = FakeHost(configuration(source='measured', **{'measured.timeout': 1.0}))
+    source = MeasuredSubscription(host)
+    follow = host.subscriptions['measured_joint_states']
+    (freshness,) = host.timers
+    assert freshness.timer_period_ns == 250_000_000
+    follow(joint_state(1.0, 0.3))
+    assert host.take()[-1] == ('state', pytest.approx(0.3), 1_000_000_000, 0.0)
+
+    new = configuration(source='measured', **{'measured.timeout': 2.0, 'measured.max_jump': 0.1})
+    host.config = new
+    source.reconfigure(new)
+    (freshness,) = host.timers
+    assert freshness.timer_period_ns == 500_000_000
+    follow(joint_state(1.1, 0.5))  # 0.2 rad from the last: further than the new max_jump
+    assert host.take() == []
+    dropped = source.health.values(host.now_ns(), new)
+    assert dropped['dropped jumping further than measured.max_jump'] == '1'
+    follow(joint_state(1.2, 0.35))
+    assert host.take() == [('state', pytest.approx(0.35), 1_200_000_000, pytest.approx(0.2))]

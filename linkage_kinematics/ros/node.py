@@ -12,8 +12,8 @@ values into a frozen RunConfiguration; one of the two sources of ``ros.sources``
 states, over ``motion.DriveLawRun`` (the drive law on the node's timer) or
 ``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states`` message), with
 this node as its ``SourceHost``; ``run.diagnostics`` says what ``/diagnostics`` reports;
-``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are documented in
-README.md.
+``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
+documented in README.md.
 """
 
 from __future__ import annotations

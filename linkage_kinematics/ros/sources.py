@@ -46,7 +46,7 @@ class Source(Protocol):
 
     @property
     def stale(self) -> bool:
-        """Whether the measured data is stale (no valid sample within measured.timeout)."""
+        """Whether the measured data is stale: no valid sample within measured.timeout."""
 
     @property
     def missed_deadlines(self) -> int:
@@ -97,7 +97,7 @@ class SourceHost(Protocol):
 
     @property
     def control(self) -> RunControl:
-        """Return the run control (``~/pause``, ``~/resume``, ``~/reset``)."""
+        """Return the run control, which ``~/pause``, ``~/resume`` and ``~/reset`` change."""
 
     @property
     def state(self) -> LinkageState | None:
