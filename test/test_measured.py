@@ -30,7 +30,7 @@ from linkage_kinematics.kinematics.geometry import FourBar, preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
 from linkage_kinematics.model.joints import Driver, JointStream, Link, TREE_ORDER
 from linkage_kinematics.model.urdf import urdf_text
-from linkage_kinematics.run.configuration import build_configuration, Source
+from linkage_kinematics.run.configuration import build_configuration, SourceKind
 from linkage_kinematics.run.measured import MeasuredFollower, Rejection
 from linkage_kinematics.run.parameter_specs import parameter_specs
 from node_process import (
@@ -468,7 +468,7 @@ def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configur
     defaults = {spec.name: spec.default for spec in parameter_specs(values['preset'])}
     config = build_configuration({**defaults, **values})
     assert (config.source, config.driver, config.publish_robot_description) == (
-        Source.MEASURED, Driver.CRANK, False)
+        SourceKind.MEASURED, Driver.CRANK, False)
     # The README's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
     state = MeasuredFollower(config).follow(1, ['knee_motor'], [-0.1], [1.0]).state
     assert state.alpha == pytest.approx(0.5, abs=1e-15)

@@ -169,6 +169,15 @@ def test_only_motion_changes_restart_the_motion():
     faster = build_configuration(configuration_values(omega0=3.0))
     assert not display.restarts_motion(config)
     assert faster.restarts_motion(config)
+    # The motion's fields are listed, not those that leave it alone: a field outside the list
+    # (here a measured source's threshold) restarts nothing ...
+    patient = build_configuration(configuration_values(**{'measured.timeout': 5.0}))
+    assert patient != config
+    assert not patient.restarts_motion(config)
+    # ... and each kind of motion change restarts it.
+    for change in ({'ground_x': 1.01}, {'branch': -1}, {'alpha_end': 1.0},
+                   {'end_behavior': 'loop'}, {'rate_hz': 50.0}):
+        assert build_configuration(configuration_values(**change)).restarts_motion(config), change
 
 
 @pytest.mark.parametrize('case', PROCESS_CASES)

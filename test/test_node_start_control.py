@@ -25,6 +25,7 @@ from node_process import (
     stop_process,
 )
 import pytest
+from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
@@ -173,6 +174,57 @@ def test_pause_holds_the_motion_resume_goes_on_and_reset_goes_back_to_alpha_star
         assert listener.spin_until(lambda: len(states) > count)
         first = states[count].points[0]
         assert (first.positions[0], _seconds(first.time_from_start)) == (ALPHA_START, 0.0)
+    finally:
+        process.send_signal(signal.SIGINT)
+        status = process.wait(timeout=PROCESS_TIMEOUT)
+        stop_process(process)
+    assert status == 0, output.read_text()
+
+
+def test_a_reset_while_paused_publishes_the_state_at_alpha_start_once(
+    listener: Listener, tmp_path: Path
+) -> None:
+    listener.subscribe('/joint_states', JointState)
+    output = tmp_path / 'node.log'
+    process = start_node({'alpha_start': ALPHA_START, 'end_behavior': 'loop',
+                          'log.enabled': False}, DOMAIN_ID, output)
+    states = listener.received['/linkage/state']
+    joint_states = listener.received['/joint_states']
+    diagnostics = listener.received['/diagnostics']
+    try:
+        assert listener.spin_until(
+            lambda: states and _seconds(states[-1].points[0].time_from_start) > 0.1
+        ), output.read_text()
+        services = Services(listener)
+        assert services.call('pause').success
+        # Whatever was published before the pause has arrived once two more statuses have.
+        count = len(diagnostics)
+        assert listener.spin_until(lambda: len(diagnostics) >= count + 2)
+        held_alpha = states[-1].points[0].positions[0]
+        assert held_alpha != ALPHA_START
+        # Counted before the call: what the reset publishes may arrive with its answer.
+        before = len(states), len(joint_states), len(diagnostics)
+
+        answer = services.call('reset')
+        assert (answer.success, answer.message) == (
+            True, 'back to alpha_start = 14.323945°; paused: ~/resume starts the motion')
+        assert listener.spin_until(
+            lambda: len(states) > before[0] and len(joint_states) > before[1])
+        (reset_state,) = states[before[0]:]
+        assert reset_state.points[0].positions[0] == ALPHA_START
+        assert _seconds(reset_state.points[0].time_from_start) == 0.0
+        (reset_joints,) = joint_states[before[1]:]
+        assert dict(zip(reset_joints.name, reset_joints.position))['crank_joint'] == ALPHA_START
+        # The scene of it, stamped as the state, and a status that says it waits there.
+        assert listener.spin_until(lambda: any(
+            stamp_ns(markers.markers[0]) == stamp_ns(reset_state)
+            for markers in listener.received['/linkage/markers']))
+        assert any(array.status[0].message == 'paused: waiting at alpha_start for ~/resume'
+                   for array in diagnostics[before[2]:])
+        # Once: still paused, nothing more comes (here: until two more statuses have come).
+        count = len(diagnostics)
+        assert listener.spin_until(lambda: len(diagnostics) >= count + 2)
+        assert (len(states), len(joint_states)) == (before[0] + 1, before[1] + 1)
     finally:
         process.send_signal(signal.SIGINT)
         status = process.wait(timeout=PROCESS_TIMEOUT)

@@ -7,12 +7,13 @@
 Publishes the linkage's exact state as the drive law turns the crank, or as a measured joint
 moves it.
 
-A thin shell that wires pure modules to ROS: ``parameters`` validates the parameter values into
-a frozen RunConfiguration; the two sources, ``motion.DriveLawRun`` (the drive law on the node's
-timer) and ``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states``
-message), give the states; ``status`` says what ``/diagnostics`` reports; ``node_outputs``
-publishes and logs. Topics, parameters, diagnostics and exit statuses are documented in
-README.md.
+A thin shell that wires pure modules to ROS: ``run.configuration`` validates the parameter
+values into a frozen RunConfiguration; one of the two sources of ``ros.sources`` gives the
+states, over ``motion.DriveLawRun`` (the drive law on the node's timer) or
+``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states`` message), with
+this node as its ``SourceHost``; ``run.diagnostics`` says what ``/diagnostics`` reports;
+``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
+documented in README.md.
 """
 
 from __future__ import annotations
@@ -35,13 +36,15 @@ from linkage_kinematics.ros.parameters import (
 from linkage_kinematics.ros.sources import (
     DriveLawTimer,
     MeasuredSubscription,
+    RunStatus,
+    Source,
 )
 from linkage_kinematics.run.configuration import (
     build_configuration,
     ConfigurationError,
     NODE_NAME,
     RunConfiguration,
-    Source,
+    SourceKind,
 )
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
 from linkage_kinematics.run.diagnostics import RateMeter, report, StatusSchedule
@@ -64,18 +67,19 @@ DIAGNOSTICS_PERIOD = 1.0  # s
 # --- the node ------------------------------------------------------------------------------
 
 
-class LinkageNode(Node):
+class LinkageNode(RunStatus, Node):
     """
     Publishes the linkage's state as its source moves it (README: Topics, Parameters).
 
     Markers at display_rate_hz, diagnostics at 1 Hz and whenever the activity changes.
     Construction raises ConfigurationError for bad parameters before anything is published or
-    written. ``exit_code`` becomes an int when the node has finished (see README).
+    written. ``exit_code`` becomes an ExitCode when the run has ended (see README). The node is
+    its source's ``SourceHost`` and owns the run's status (``RunStatus``: activity, problem,
+    exit code), which the source changes only through it.
     """
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        self.exit_code: int | None = None
         specs = declare_parameters(self)
         # rclpy has no public accessor of the overrides given for this node; they include the
         # `-p` arguments and the /** entries of parameter files, which rcl keeps as one set.
@@ -88,8 +92,6 @@ class LinkageNode(Node):
         if blocked_note(config) is not None:
             self.get_logger().warning(blocked_note(config))
         self._pending: tuple[RunConfiguration, list[str]] | None = None
-        self.problem: str | None = None
-        self.activity = 'starting'
         self._state: LinkageState | None = None
         self._state_ns = 0
         self._motion_started = False  # a state of this motion published (not only the scene)
@@ -107,8 +109,8 @@ class LinkageNode(Node):
         self.add_pre_set_parameters_callback(keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
-        self._source: DriveLawTimer | MeasuredSubscription = (
-            MeasuredSubscription(self) if config.source is Source.MEASURED
+        self._source: Source = (
+            MeasuredSubscription(self) if config.source is SourceKind.MEASURED
             else DriveLawTimer(self))
         for name, act in (('pause', self._source.pause), ('resume', self._source.resume),
                           ('reset', self._source.reset)):
@@ -141,9 +143,8 @@ class LinkageNode(Node):
         (new, differing), self._pending = self._pending, None
         if not differing:
             return  # e.g. `ros2 param load` of the node's own dump: nothing changes
-        old, self.config = self.config, new
-        self.outputs.config = new
-        self._source.reconfigure(old, new)
+        old = self.config
+        self._apply(new)
         restarts = new.restarts_motion(old)
         self.get_logger().info(
             'parameters changed: '
@@ -167,6 +168,12 @@ class LinkageNode(Node):
             self.forget_state()
             self._source.restart()
 
+    def _apply(self, new: RunConfiguration) -> None:
+        """Swap in a new configuration: the one way every holder of it takes it."""
+        self.config = new
+        self.outputs.config = new
+        self._source.reconfigure(new)
+
     def _answer(self, act: Callable[[], ServiceAnswer]) -> Callable[..., Trigger.Response]:
         """Return a Trigger service callback (~/pause, ~/resume, ~/reset) answering as ``act``."""
         def callback(_request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
@@ -182,7 +189,7 @@ class LinkageNode(Node):
         if change is not None:
             self.get_logger().info(change)
 
-    # publishing, for the sources (node_sources)
+    # the source's host (sources.SourceHost): publishing, and the status it changes
 
     def now_ns(self) -> int:
         """Return the node clock's time (ns)."""
@@ -197,6 +204,10 @@ class LinkageNode(Node):
     def motion_started(self) -> bool:
         """Whether a state of this motion was published (not only the scene of it waiting)."""
         return self._motion_started
+
+    def flush_log(self) -> None:
+        """Have the bag writer write out what it holds (before the run's last status)."""
+        self.outputs.flush_log()
 
     def forget_state(self) -> None:
         """Make the next state a motion's first: its scene and status go out before it."""
@@ -226,8 +237,6 @@ class LinkageNode(Node):
         if first:
             self.publish_markers()
             self.outputs.publish_description(stamp_ns)
-            if self.config.source is Source.DRIVE_LAW:
-                self.activity = 'moving'
             self.publish_diagnostics()
         self.outputs.publish_state(state, stamp_ns, motion_time)
         if self._status_schedule.due(stamp_ns):

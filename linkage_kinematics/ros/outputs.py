@@ -26,7 +26,7 @@ from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros import messages
-from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration, Source
+from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration, SourceKind
 from linkage_kinematics.run.diagnostics import Level
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -145,7 +145,7 @@ class NodeOutputs:
         if self._streamed != self.config.joints:
             # A measured driver stays with its own source: only the passive joints go out.
             self._joints = JointStream(self.config.joints, self.config.driver,
-                                       include_driver=self.config.source is Source.DRIVE_LAW)
+                                       include_driver=self.config.source is SourceKind.DRIVE_LAW)
             self._joint_state_encoder = messages.JointStateEncoder(self._joints.names)
             self._streamed = self.config.joints
 

@@ -13,7 +13,7 @@ node, the demo and the tests all validate through it. ``parameter_specs`` declar
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from enum import StrEnum
 import math
 from pathlib import Path
@@ -76,11 +76,19 @@ class MotionMode(StrEnum):
     FIXED_STEP = 'fixed_step'
 
 
-class Source(StrEnum):
+class SourceKind(StrEnum):
     """Where the driver's motion comes from: parameter ``source``, by its value."""
 
     DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
     MEASURED = 'measured'  # the driver joint of each measured_joint_states message
+
+
+# The fields whose change restarts the motion from alpha_start (README: Run-time changes); a
+# field not named here (a threshold, a rate of the display, the lab's joint names) changes what
+# is reported or how, not where the crank is. The rest of the motion (segment_end, blocked_at,
+# ...) follows from these, and the read-only parameters never change at run time.
+MOTION_FIELDS = ('linkage', 'drive', 'branch', 'alpha_start', 'alpha_end', 'end_behavior', 'mode',
+                 'alpha_step', 'rate_hz')
 
 
 class ConfigurationError(ValueError):
@@ -125,7 +133,7 @@ class RunConfiguration:
     log_max_bag_size: int
     log_max_bag_duration: float
     cpu_affinity: int
-    source: Source
+    source: SourceKind
     driver: Driver
     # The linkage as its driver turns it: ``linkage``, or seen from C for the rocker.
     driven_linkage: FourBar
@@ -153,18 +161,7 @@ class RunConfiguration:
 
     def restarts_motion(self, other: RunConfiguration) -> bool:
         """Whether switching from ``other`` to this configuration changes the motion itself."""
-        same_motion = replace(
-            other,
-            min_transmission_angle=self.min_transmission_angle,
-            dead_point_warning=self.dead_point_warning,
-            display_rate_hz=self.display_rate_hz,
-            cpu_affinity=self.cpu_affinity,
-            measured_timeout=self.measured_timeout,
-            max_jump=self.max_jump,
-            acceleration_time_constant=self.acceleration_time_constant,
-            joints=self.joints,
-        )
-        return same_motion != self
+        return any(getattr(self, name) != getattr(other, name) for name in MOTION_FIELDS)
 
 
 # --- validation: pure functions from parameter values to a RunConfiguration ---------------
@@ -375,7 +372,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     log_max_bag_size = _bag_size(values)
     log_max_bag_duration = _within(values, 'log.max_bag_duration', 0.0, MAX_BAG_DURATION, 's')
     cpu_affinity = _cpu(values)
-    source = Source(_text(values, 'source', tuple(Source)))
+    source = SourceKind(_text(values, 'source', tuple(SourceKind)))
     driver = Driver(_text(values, 'driver', tuple(Driver)))
     joints = _joints(values)
     publish_robot_description = _flag(values, 'publish_robot_description')
@@ -383,7 +380,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     max_jump = _positive(values, 'measured.max_jump', 'rad', math.pi)
     acceleration_time_constant = _within(
         values, 'measured.acceleration_time_constant', 0.0, MAX_TIME_CONSTANT, 's')
-    if source is Source.MEASURED:
+    if source is SourceKind.MEASURED:
         # No pass: the drive-law parameters are not used, so not checked against the geometry.
         blocked_at, segment_duration, segment_end, step_count = None, 0.0, alpha_end, 1
     else:

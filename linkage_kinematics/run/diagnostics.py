@@ -23,7 +23,7 @@ import math
 
 from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
 from linkage_kinematics.model.joints import Driver, Link
-from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, Source
+from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, SourceKind
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.measured import Estimate, Rejection
 from linkage_kinematics.run.motion import blocked_note
@@ -207,7 +207,7 @@ def assess(
                 f'{math.degrees(distance):.3f}° from a change point (the assemblies meet; the '
                 'motion continues smoothly on its branch)'
             )
-    note = blocked_note(config) if config.source is Source.DRIVE_LAW else None
+    note = blocked_note(config) if config.source is SourceKind.DRIVE_LAW else None
     if note is not None:
         warnings.append(note)
     if warnings:

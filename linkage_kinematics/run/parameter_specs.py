@@ -21,7 +21,7 @@ from typing import Any
 from linkage_kinematics.kinematics.geometry import DIMENSIONS, LINK_LENGTHS, preset, TWO_PI
 from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, Link
 from linkage_kinematics.model.urdf import DEFAULT_FRAME_ID
-from linkage_kinematics.run.configuration import EndBehavior, MotionMode, NODE_NAME, Source
+from linkage_kinematics.run.configuration import EndBehavior, MotionMode, NODE_NAME, SourceKind
 from linkage_kinematics.run.limits import (
     MAX_ANGLE,
     MAX_BAG_DURATION,
@@ -168,7 +168,7 @@ def _logging_specs() -> tuple[ParameterSpec, ...]:
 def _joint_specs() -> tuple[ParameterSpec, ...]:
     """Return the source, its driver joint, and each joint's lab name, direction and offset."""
     return (
-        ParameterSpec('source', Source.DRIVE_LAW.value,
+        ParameterSpec('source', SourceKind.DRIVE_LAW.value,
                       'drive_law: a timer turns the crank under the drive law; measured: the '
                       'driver joint of each message on measured_joint_states',
                       read_only=True),
