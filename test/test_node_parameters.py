@@ -18,10 +18,17 @@ from linkage_kinematics.kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics.solver import solve
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
-from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.ros.parameters import parameter_descriptor
+from linkage_kinematics.run.configuration import (
+    build_configuration,
+    ConfigurationError,
+    parameter_value,
+)
 from linkage_kinematics.run.parameter_specs import (
+    Kind,
     PARAMETER_NAMES,
     parameter_specs,
+    ParameterSpec,
     unknown_parameters,
 )
 from node_process import (
@@ -55,6 +62,7 @@ BAD_VALUES = {
     'inf': ({'k': math.inf}, 'k'),
     'wrong type': ({'omega0': 'fast'}, 'omega0'),
     'wrong type int': ({'branch': 1.0}, 'branch'),
+    'direction not an integer': ({'joints.crank.direction': 1.0}, 'joints.crank.direction'),
     'branch not ±1': ({'branch': 0}, 'branch'),
     'unknown preset': ({'preset': 'paper_v2'}, 'preset'),
     'no geometry without preset': ({'preset': ''}, 'crank_length'),
@@ -93,6 +101,69 @@ def test_build_configuration_names_the_bad_parameter(case):
         build_configuration(values)
     assert parameter in raised.value.parameter
     assert str(raised.value).startswith(raised.value.parameter + ': ')
+
+
+NUMERIC_SPECS = [spec for spec in parameter_specs('paper')
+                 if spec.kind in (Kind.REAL, Kind.INTEGER, Kind.SIGN)]
+
+
+def refused(name: str, value: object) -> ConfigurationError:
+    """Return the error build_configuration raises for the defaults with ``name`` = ``value``."""
+    with pytest.raises(ConfigurationError) as raised:
+        build_configuration(configuration_values(**{name: value}))
+    assert raised.value.parameter == name
+    return raised.value
+
+
+@pytest.mark.parametrize('spec', NUMERIC_SPECS, ids=lambda spec: spec.name)
+def test_the_descriptors_range_is_the_one_validated(spec):
+    """Just outside the range ros2 param describe shows is refused, its ends are accepted."""
+    descriptor = parameter_descriptor(spec)
+    if spec.kind is Kind.REAL:
+        (interval,) = descriptor.floating_point_range
+        low, high = interval.from_value, interval.to_value
+        # The descriptor cannot show an open end: its description says it (README, Parameters).
+        open_low = 'greater than' in descriptor.description
+        assert spec.interval.open_low == open_low
+        bounds = (f'greater than {low:g} {spec.unit} and at most {high:g} {spec.unit}' if open_low
+                  else f'in [{low:g}, {high:g}] {spec.unit}')
+        assert bounds in str(refused(spec.name, math.nextafter(high, math.inf)))
+        assert bounds in str(refused(spec.name, math.nextafter(low, -math.inf)))
+        inside = [high, math.nextafter(low, math.inf) if open_low else low]
+        if open_low:
+            assert bounds in str(refused(spec.name, low))
+    else:
+        (interval,) = descriptor.integer_range
+        low, high, step = interval.from_value, interval.to_value, interval.step
+        assert f'{high}' in str(refused(spec.name, high + 1))
+        assert f'{low}' in str(refused(spec.name, low - 1))
+        if step > 1:
+            refused(spec.name, low + 1)
+        inside = [low, high]
+    for value in inside:
+        assert parameter_value({spec.name: value}, spec.name) == value
+
+
+def test_an_integer_parameter_refuses_what_lies_between_its_off_value_and_its_range():
+    (spec,) = [spec for spec in NUMERIC_SPECS if spec.name == 'log.max_bag_size']
+    assert spec.off.value + 1 < spec.interval.low
+    assert str(refused(spec.name, spec.interval.low - 1)) == (
+        f'log.max_bag_size: must be 0 (no split) or a size in [1024, {2**63 - 1}] bytes, got '
+        'int 1023')
+
+
+@pytest.mark.parametrize('preset_name', ['', 'paper', 'paper_full_turn', 'grashof_crank_rocker'])
+def test_every_default_passes_its_own_check(preset_name):
+    for spec in parameter_specs(preset_name):
+        if spec.default is not None:
+            assert parameter_value({spec.name: spec.default}, spec.name) == spec.default
+
+
+def test_a_spec_without_what_its_kind_needs_is_refused():
+    with pytest.raises(TypeError, match='real parameter rate_hz needs interval'):
+        ParameterSpec('rate_hz', 100.0, 'rate', Kind.REAL, unit='Hz')
+    with pytest.raises(TypeError, match='choice parameter mode needs choices'):
+        ParameterSpec('mode', 'real_time', 'mode', Kind.CHOICE)
 
 
 def test_defaults_are_the_seed_run_swinging_until_stopped():
