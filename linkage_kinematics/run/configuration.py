@@ -38,9 +38,9 @@ from linkage_kinematics.run.parameter_specs import (
     Kind,
     MotionMode,
     NODE_NAME,
-    parameter_specs,
     ParameterSpec,
     Source,
+    SPECS,
 )
 import yaml
 
@@ -215,9 +215,6 @@ _CHECKS = {
     Kind.TEXT: _text,
     Kind.CHOICE: _choice,
 }
-# The contract of every parameter; the geometry's defaults, which depend on the preset, are not
-# part of it.
-_SPECS = {spec.name: spec for spec in parameter_specs('')}
 
 
 def parameter_value(values: Mapping[str, Any], name: str) -> Any:
@@ -228,7 +225,7 @@ def parameter_value(values: Mapping[str, Any], name: str) -> Any:
     Raises ConfigurationError naming the parameter and what its spec asks for (a missing value
     is refused as ``no value``).
     """
-    spec = _SPECS[name]
+    spec = SPECS[name]
     return _CHECKS[spec.kind](spec, values.get(name))
 
 
@@ -339,7 +336,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     rejected.
     """
     preset_name, linkage = _geometry(values)
-    checked = {name: parameter_value(values, name) for name in _SPECS}
+    checked = {name: parameter_value(values, name) for name in SPECS}
     joints = _joints(checked)
     drive = DriveLaw(checked['omega0'], checked['k'])
     blocked_at, segment_duration, segment_end, step_count = _pass(checked, linkage, drive)

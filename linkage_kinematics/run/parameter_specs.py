@@ -335,8 +335,11 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
     )
 
 
-PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(''))
-REAL_PARAMETERS = frozenset(spec.name for spec in parameter_specs('') if spec.kind is Kind.REAL)
+# Every parameter's spec by name, in declaration order: the contract values are checked against
+# (the geometry's defaults, which depend on the preset, are not part of it).
+SPECS = {spec.name: spec for spec in parameter_specs('')}
+PARAMETER_NAMES = tuple(SPECS)
+REAL_PARAMETERS = frozenset(name for name, spec in SPECS.items() if spec.kind is Kind.REAL)
 
 
 def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[str]:
