@@ -11,11 +11,13 @@ nothing written) and at run time over the parameter services.
 from __future__ import annotations
 
 import math
+import re
 
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model.joints import Link
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
 from linkage_kinematics.ros.parameters import parameter_descriptor
@@ -36,6 +38,7 @@ from node_process import (
     get_parameter,
     Listener,
     PROCESS_TIMEOUT,
+    REPOSITORY,
     ros_context,
     run_node,
     set_parameter,
@@ -150,6 +153,42 @@ def test_an_integer_parameter_refuses_what_lies_between_its_off_value_and_its_ra
     assert str(refused(spec.name, spec.interval.low - 1)) == (
         f'log.max_bag_size: must be 0 (no split) or a size in [1024, {2**63 - 1}] bytes, got '
         'int 1023')
+
+
+SUPERSCRIPTS = str.maketrans('⁰¹²³⁴⁵⁶⁷⁸⁹', '0123456789')
+
+
+def readme_number(text: str) -> float:
+    """Return a bound as README writes it: 0, 10000, −10⁶, π/2, 2π."""
+    sign, text = (-1.0, text[1:]) if text.startswith('−') else (1.0, text)
+    power = re.fullmatch(r'10([⁰-⁹]+)', text)
+    if power:
+        return sign * 10.0 ** int(power[1].translate(SUPERSCRIPTS))
+    factor, pi, divisor = re.fullmatch(r'(\d*)(π?)(?:/(\d+))?', text).groups()
+    value = float(factor or 1) * (math.pi if pi else 1.0) / float(divisor or 1)
+    return sign * value
+
+
+def test_readme_states_each_real_parameters_range_as_validated():
+    """The README's Parameters table gives each real parameter's range as its spec has it."""
+    readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
+    table = readme[readme.index('## Parameters'):readme.index('**Geometry.**')]
+    stated = {}
+    for row in table.splitlines():
+        cells = row.split('|')
+        interval = re.search(r'in ([\[(])([^,]+), ([^\]]+)\]', row)
+        if len(cells) < 4 or interval is None:
+            continue
+        for name in re.findall(r'`([^`]+)`', cells[1]):
+            for link in Link:
+                stated[name.replace('<joint>', link.value)] = (
+                    readme_number(interval[2]), readme_number(interval[3]), interval[1] == '(')
+    reals = {spec.name: spec for spec in parameter_specs('') if spec.kind is Kind.REAL}
+    assert set(reals) <= set(stated)
+    for name, spec in reals.items():
+        low, high, open_low = stated[name]
+        assert (low, high) == pytest.approx((spec.interval.low, spec.interval.high)), name
+        assert open_low == spec.interval.open_low, name
 
 
 @pytest.mark.parametrize('preset_name', ['', 'paper', 'paper_full_turn', 'grashof_crank_rocker'])
