@@ -232,8 +232,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
 
             def publish() -> int:
                 for _ in range(count):
-                    publishers['/joint_states'].publish(joint_state_data)
-                    publishers['/linkage/state'].publish(trajectory_data)
+                    publishers.joint_states.publish(joint_state_data)
+                    publishers.state.publish(trajectory_data)
                 return count
 
             def record() -> int:

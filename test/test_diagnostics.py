@@ -17,12 +17,20 @@ from linkage_kinematics.run.diagnostics import (
     RATE_WINDOW,
     RateMeter,
     STATUS_PERIOD,
+    StatusInputs,
     StatusSchedule,
 )
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import pytest
 
 PERIOD_NS = round(STATUS_PERIOD * 1e9)
+
+
+def drive_law_values(**inputs: object) -> dict[str, str]:
+    """Return the key values of a drive-law status: no deadline missed, no log, unless given."""
+    return key_values(StatusInputs(**{
+        'activity': 'moving', 'missed_deadlines': 0, 'log_file': None, 'log_size': None,
+        **inputs}))
 
 
 def configuration(**changes: object):
@@ -94,14 +102,18 @@ def test_rate_is_measured_over_the_last_window() -> None:
 def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
     config = configuration(mode='fixed_step', alpha_step=math.radians(0.25))
     state = solve(config.linkage, 0.3, DriveLaw(2.0))
-    values = key_values(config, RunState.RUNNING, state, 231.26, 3, 'bags/run', 101_588)
+    values = drive_law_values(config=config, run_state=RunState.RUNNING, state=state,
+                              achieved_rate=231.26, missed_deadlines=3, log_file='bags/run',
+                              log_size=101_588)
     assert 'rate_hz' not in values
     assert values['alpha_step (deg)'] == '0.25'
     assert (values['achieved rate (Hz)'], values['missed deadlines']) == ('231.3', '3')
     assert values['log size (bytes)'] == '101588'
-    first = key_values(config, RunState.PAUSED, None, None, 0, None, None)
+    first = drive_law_values(config=config, run_state=RunState.PAUSED, state=None,
+                             achieved_rate=None)
     assert (first['achieved rate (Hz)'], first['run state']) == ('not measured yet', 'paused')
-    real_time = key_values(configuration(), RunState.RUNNING, None, 99.95, 0, None, None)
+    real_time = drive_law_values(config=configuration(), run_state=RunState.RUNNING,
+                                 state=None, achieved_rate=99.95)
     assert (real_time['rate_hz'], real_time['log file']) == ('100', 'disabled')
     assert real_time['run state'] == 'running'
     assert 'alpha_step (deg)' not in real_time and 'log size (bytes)' not in real_time
@@ -109,7 +121,7 @@ def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
 
 def test_residual_reads_in_scientific_notation() -> None:
     config = configuration()
-    values = key_values(
-        config, RunState.RUNNING, solve(config.linkage, 0.7, DriveLaw(2.0)), 0.0, 0, None, None)
+    values = drive_law_values(config=config, run_state=RunState.RUNNING,
+                              state=solve(config.linkage, 0.7, DriveLaw(2.0)), achieved_rate=0.0)
     residual = values['loop closure residual']
     assert re.fullmatch(r'\d\.\d\de[+-]\d\d', residual) and float(residual) < 1e-12

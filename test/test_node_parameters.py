@@ -11,17 +11,26 @@ nothing written) and at run time over the parameter services.
 from __future__ import annotations
 
 import math
+import re
 
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.model.joints import Link
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
-from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.ros.parameters import parameter_descriptor
+from linkage_kinematics.run.configuration import (
+    build_configuration,
+    ConfigurationError,
+    parameter_value,
+)
 from linkage_kinematics.run.parameter_specs import (
+    Kind,
     PARAMETER_NAMES,
     parameter_specs,
+    ParameterSpec,
     unknown_parameters,
 )
 from node_process import (
@@ -29,6 +38,7 @@ from node_process import (
     get_parameter,
     Listener,
     PROCESS_TIMEOUT,
+    REPOSITORY,
     ros_context,
     run_node,
     set_parameter,
@@ -55,6 +65,7 @@ BAD_VALUES = {
     'inf': ({'k': math.inf}, 'k'),
     'wrong type': ({'omega0': 'fast'}, 'omega0'),
     'wrong type int': ({'branch': 1.0}, 'branch'),
+    'direction not an integer': ({'joints.crank.direction': 1.0}, 'joints.crank.direction'),
     'branch not ±1': ({'branch': 0}, 'branch'),
     'unknown preset': ({'preset': 'paper_v2'}, 'preset'),
     'no geometry without preset': ({'preset': ''}, 'crank_length'),
@@ -93,6 +104,105 @@ def test_build_configuration_names_the_bad_parameter(case):
         build_configuration(values)
     assert parameter in raised.value.parameter
     assert str(raised.value).startswith(raised.value.parameter + ': ')
+
+
+NUMERIC_SPECS = [spec for spec in parameter_specs('paper')
+                 if spec.kind in (Kind.REAL, Kind.INTEGER, Kind.SIGN)]
+
+
+def refused(name: str, value: object) -> ConfigurationError:
+    """Return the error build_configuration raises for the defaults with ``name`` = ``value``."""
+    with pytest.raises(ConfigurationError) as raised:
+        build_configuration(configuration_values(**{name: value}))
+    assert raised.value.parameter == name
+    return raised.value
+
+
+@pytest.mark.parametrize('spec', NUMERIC_SPECS, ids=lambda spec: spec.name)
+def test_the_descriptors_range_is_the_one_validated(spec):
+    """Just outside the range ros2 param describe shows is refused, its ends are accepted."""
+    descriptor = parameter_descriptor(spec)
+    if spec.kind is Kind.REAL:
+        (interval,) = descriptor.floating_point_range
+        low, high = interval.from_value, interval.to_value
+        # The descriptor cannot show an open end: its description says it (README, Parameters).
+        open_low = 'greater than' in descriptor.description
+        assert spec.interval.open_low == open_low
+        bounds = (f'greater than {low:g} {spec.unit} and at most {high:g} {spec.unit}' if open_low
+                  else f'in [{low:g}, {high:g}] {spec.unit}')
+        assert bounds in str(refused(spec.name, math.nextafter(high, math.inf)))
+        assert bounds in str(refused(spec.name, math.nextafter(low, -math.inf)))
+        inside = [high, math.nextafter(low, math.inf) if open_low else low]
+        if open_low:
+            assert bounds in str(refused(spec.name, low))
+    else:
+        (interval,) = descriptor.integer_range
+        low, high, step = interval.from_value, interval.to_value, interval.step
+        assert f'{high}' in str(refused(spec.name, high + 1))
+        assert f'{low}' in str(refused(spec.name, low - 1))
+        if step > 1:
+            refused(spec.name, low + 1)
+        inside = [low, high]
+    for value in inside:
+        assert parameter_value({spec.name: value}, spec.name) == value
+
+
+def test_an_integer_parameter_refuses_what_lies_between_its_off_value_and_its_range():
+    (spec,) = [spec for spec in NUMERIC_SPECS if spec.name == 'log.max_bag_size']
+    assert spec.off.value + 1 < spec.interval.low
+    assert str(refused(spec.name, spec.interval.low - 1)) == (
+        f'log.max_bag_size: must be 0 (no split) or a size in [1024, {2**63 - 1}] bytes, got '
+        'int 1023')
+
+
+SUPERSCRIPTS = str.maketrans('⁰¹²³⁴⁵⁶⁷⁸⁹', '0123456789')
+
+
+def readme_number(text: str) -> float:
+    """Return a bound as README writes it: 0, 10000, −10⁶, π/2, 2π."""
+    sign, text = (-1.0, text[1:]) if text.startswith('−') else (1.0, text)
+    power = re.fullmatch(r'10([⁰-⁹]+)', text)
+    if power:
+        return sign * 10.0 ** int(power[1].translate(SUPERSCRIPTS))
+    factor, pi, divisor = re.fullmatch(r'(\d*)(π?)(?:/(\d+))?', text).groups()
+    value = float(factor or 1) * (math.pi if pi else 1.0) / float(divisor or 1)
+    return sign * value
+
+
+def test_readme_states_each_real_parameters_range_as_validated():
+    """The README's Parameters table gives each real parameter's range as its spec has it."""
+    readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
+    table = readme[readme.index('## Parameters'):readme.index('**Geometry.**')]
+    stated = {}
+    for row in table.splitlines():
+        cells = row.split('|')
+        interval = re.search(r'in ([\[(])([^,]+), ([^\]]+)\]', row)
+        if len(cells) < 4 or interval is None:
+            continue
+        for name in re.findall(r'`([^`]+)`', cells[1]):
+            for link in Link:
+                stated[name.replace('<joint>', link.value)] = (
+                    readme_number(interval[2]), readme_number(interval[3]), interval[1] == '(')
+    reals = {spec.name: spec for spec in parameter_specs('') if spec.kind is Kind.REAL}
+    assert set(reals) <= set(stated)
+    for name, spec in reals.items():
+        low, high, open_low = stated[name]
+        assert (low, high) == pytest.approx((spec.interval.low, spec.interval.high)), name
+        assert open_low == spec.interval.open_low, name
+
+
+@pytest.mark.parametrize('preset_name', ['', 'paper', 'paper_full_turn', 'grashof_crank_rocker'])
+def test_every_default_passes_its_own_check(preset_name):
+    for spec in parameter_specs(preset_name):
+        if spec.default is not None:
+            assert parameter_value({spec.name: spec.default}, spec.name) == spec.default
+
+
+def test_a_spec_without_what_its_kind_needs_is_refused():
+    with pytest.raises(TypeError, match='real parameter rate_hz needs interval'):
+        ParameterSpec('rate_hz', 100.0, 'rate', Kind.REAL, unit='Hz')
+    with pytest.raises(TypeError, match='choice parameter mode needs choices'):
+        ParameterSpec('mode', 'real_time', 'mode', Kind.CHOICE)
 
 
 def test_defaults_are_the_seed_run_swinging_until_stopped():

@@ -47,7 +47,7 @@ from linkage_kinematics.run.configuration import (
     SourceKind,
 )
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
-from linkage_kinematics.run.diagnostics import RateMeter, report, StatusSchedule
+from linkage_kinematics.run.diagnostics import RateMeter, report, StatusInputs, StatusSchedule
 from linkage_kinematics.run.motion import blocked_note
 from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, unknown_parameters
 from linkage_kinematics.run.placement import CpuPlacement
@@ -267,12 +267,19 @@ class LinkageNode(RunStatus, Node):
         self._rate_meter.update(now_ns)
         self._status_schedule.sent(at_ns)
         recorder = self.outputs.recorder
-        level, text, values = report(
-            self.config, self.control.state, self._state,
-            event or self.problem or self.outputs.recording_error, self.activity,
-            self._source.health, now_ns, self._rate_meter.rate, self._source.missed_deadlines,
-            None if recorder is None else str(recorder.bag_path),
-            None if recorder is None else recorder.size_bytes)
+        level, text, values = report(StatusInputs(
+            config=self.config,
+            run_state=self.control.state,
+            state=self._state,
+            activity=self.activity,
+            achieved_rate=self._rate_meter.rate,
+            missed_deadlines=self._source.missed_deadlines,
+            log_file=None if recorder is None else str(recorder.bag_path),
+            log_size=None if recorder is None else recorder.size_bytes,
+            problem=event or self.problem or self.outputs.recording_error,
+            health=self._source.health,
+            now_ns=now_ns,
+        ))
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

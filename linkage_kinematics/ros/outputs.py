@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import json
 import time
-from typing import Any
+from typing import Any, NamedTuple
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
@@ -30,6 +30,7 @@ from linkage_kinematics.run.configuration import ConfigurationError, RunConfigur
 from linkage_kinematics.run.diagnostics import Level
 from rclpy.duration import Duration
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
@@ -55,6 +56,20 @@ class StartupError(Exception):
     """The node cannot start for a reason other than a parameter; the message names it."""
 
 
+class Publishers(NamedTuple):
+    """The node's publishers by what they carry, in the order they are made and recorded."""
+
+    joint_states: Publisher
+    state: Publisher
+    markers: Publisher
+    diagnostics: Publisher
+    robot_description: Publisher | None  # None with publish_robot_description false
+
+    def present(self) -> tuple[Publisher, ...]:
+        """Return the publishers the node has, in order."""
+        return tuple(publisher for publisher in self if publisher is not None)
+
+
 class NodeOutputs:
     """
     The node's publishers, the encoders of its per-state messages, and its recorder.
@@ -70,19 +85,15 @@ class NodeOutputs:
                  bag_writer_cpus: set[int] | None) -> None:
         self._node = node
         self.config = config
-        publishers = [
-            node.create_publisher(JointState, 'joint_states', DATA_QOS),
-            node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
-            node.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
-            node.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
-        ]
-        if config.publish_robot_description:
-            publishers.append(
-                node.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS))
-        self._publishers = {publisher.topic_name: publisher for publisher in publishers}
-        self._joint_states_topic, self._state_topic, self._markers_topic, \
-            self._diagnostics_topic = (publisher.topic_name for publisher in publishers[:4])
-        self._description_topic = publishers[4].topic_name if len(publishers) > 4 else None
+        self._publishers = Publishers(
+            joint_states=node.create_publisher(JointState, 'joint_states', DATA_QOS),
+            state=node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
+            markers=node.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
+            diagnostics=node.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
+            robot_description=(
+                node.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS)
+                if config.publish_robot_description else None),
+        )
         self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
         self._encoded: FourBar | None = None
@@ -102,9 +113,9 @@ class NodeOutputs:
         }
         # The latest status starts every file of a split bag, as the latched URDF does.
         topics = [
-            (topic, publisher.msg_type, publisher.qos_profile,
-             True if topic == self._diagnostics_topic else None)
-            for topic, publisher in self._publishers.items()
+            (publisher.topic_name, publisher.msg_type, publisher.qos_profile,
+             True if publisher is self._publishers.diagnostics else None)
+            for publisher in self._publishers.present()
         ]
         # and the TF robot_state_publisher would publish, logged only (docs/logging.md)
         topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
@@ -120,10 +131,10 @@ class NodeOutputs:
         except OSError as error:  # every BagError
             raise StartupError(f'cannot record: {error}') from None
 
-    def send(self, topic: str, data: bytes, log_time_ns: int) -> None:
+    def send(self, publisher: Publisher, data: bytes, log_time_ns: int) -> None:
         """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""
-        self._publishers[topic].publish(data)
-        self._record(topic, data, log_time_ns)
+        publisher.publish(data)
+        self._record(publisher.topic_name, data, log_time_ns)
 
     def _record(self, topic: str, data: bytes, log_time_ns: int) -> None:
         if self.recorder is None or self.recording_error is not None:
@@ -154,20 +165,21 @@ class NodeOutputs:
         self._prepare()
         positions, velocities = self._joints.values(state)
         published = self._joints.published
-        self.send(self._joint_states_topic,
+        self.send(self._publishers.joint_states,
                   self._joint_state_encoder.encode(stamp_ns, positions[published],
                                                    velocities[published]), stamp_ns)
         if self._robot_transforms is not None:
             # What robot_state_publisher makes of the driver and the passive joints, bag only.
             self._record(TF_TOPIC, self._robot_transforms.message(
                 dict(zip(self._joints.tree_names, positions)), stamp_ns), stamp_ns)
-        self.send(self._state_topic, self._state_encoder.encode(state, stamp_ns, motion_time),
-                  stamp_ns)
+        self.send(self._publishers.state,
+                  self._state_encoder.encode(state, stamp_ns, motion_time), stamp_ns)
 
     def publish_markers(self, state: LinkageState, stamp_ns: int) -> None:
         """Publish the scene of ``state``."""
         self._prepare()
-        self.send(self._markers_topic, self._marker_encoder.encode(state, stamp_ns), stamp_ns)
+        self.send(self._publishers.markers, self._marker_encoder.encode(state, stamp_ns),
+                  stamp_ns)
 
     def publish_description(self, stamp_ns: int) -> None:
         """
@@ -182,8 +194,9 @@ class NodeOutputs:
             return
         self._described = described
         text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
-        if self._description_topic is not None:
-            self.send(self._description_topic, encode_cdr(String(data=text)), stamp_ns)
+        if self._publishers.robot_description is not None:
+            self.send(self._publishers.robot_description, encode_cdr(String(data=text)),
+                      stamp_ns)
         if self.recorder is not None:
             self._robot_transforms = messages.RobotStateTransforms(text, config.frame_prefix)
             self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(stamp_ns),
@@ -201,7 +214,7 @@ class NodeOutputs:
             text,
             values,
         )
-        self.send(self._diagnostics_topic, encode_cdr(message), stamp_ns)
+        self.send(self._publishers.diagnostics, encode_cdr(message), stamp_ns)
 
     def flush_log(self) -> None:
         """
@@ -224,7 +237,7 @@ class NodeOutputs:
         The final state of a 'stop' run must not die with the process.
         """
         deadline = time.monotonic() + timeout
-        for publisher in self._publishers.values():
+        for publisher in self._publishers.present():
             publisher.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))
 
     def close_log(self) -> bool:

@@ -4,8 +4,8 @@
 """
 The node's parameters on the ROS side: declared with descriptors, whole numbers kept real.
 
-``run.parameter_specs`` owns what each parameter is and ``run.configuration`` how values are
-validated; this module only declares them on a node so that ``ros2 param describe`` shows their
+``run.parameter_specs`` owns what each parameter is and ``run.configuration`` checks values
+against it; this module only declares them on a node so that ``ros2 param describe`` shows their
 meaning, unit and range.
 """
 
@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import Any
 
 from linkage_kinematics.kinematics.geometry import GeometryError
-from linkage_kinematics.run.configuration import ConfigurationError, describe_value
+from linkage_kinematics.run.configuration import ConfigurationError, parameter_value
 from linkage_kinematics.run.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
@@ -67,9 +67,7 @@ def declare_parameters(node: Node) -> tuple[ParameterSpec, ...]:
     preset_spec = parameter_specs('paper')[0]
     node.declare_parameter(preset_spec.name, preset_spec.default,
                            parameter_descriptor(preset_spec, with_range=False))
-    preset_name = node.get_parameter('preset').value
-    if not isinstance(preset_name, str):
-        raise ConfigurationError('preset', f'must be a string, got {describe_value(preset_name)}')
+    preset_name = parameter_value({'preset': node.get_parameter('preset').value}, 'preset')
     try:
         specs = parameter_specs(preset_name)
     except GeometryError as error:

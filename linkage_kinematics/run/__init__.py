@@ -4,9 +4,10 @@
 """
 One run of the node, as pure Python (no rclpy): what the node decides, without ROS.
 
-``configuration`` (the parameters' limits and their validation into a RunConfiguration) from
-``parameter_specs`` (each parameter's default, descriptor text and range), the two sources
-``motion`` (the drive law in time) and ``measured`` (a measured joint completed), ``control``
-(~/pause, ~/resume, ~/reset), ``diagnostics`` (the status) and ``placement`` (cpu_affinity).
+``parameter_specs`` (each parameter's default, descriptor text and contract: kind, unit, range
+from ``limits``), ``configuration`` (values checked against it into a RunConfiguration), the two
+sources ``motion`` (the drive law in time) and ``measured`` (a measured joint completed),
+``control`` (~/pause, ~/resume, ~/reset), ``diagnostics`` (the status) and ``placement``
+(cpu_affinity).
 Imports only ``kinematics`` and ``model``.
 """

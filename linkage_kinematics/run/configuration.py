@@ -2,12 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The node's parameters: their limits, and the validation of their values into a RunConfiguration.
+The validation of the node's parameter values into a RunConfiguration.
 
-Pure functions of parameter values (name → value), no ROS: ``build_configuration`` checks every
-value and the motion they imply and raises ConfigurationError naming the first bad parameter; the
-node, the demo and the tests all validate through it. ``parameter_specs`` declares each parameter
-(default, descriptor text, range) from these limits. README.md documents each parameter.
+Pure functions of parameter values (name → value), no ROS: ``parameter_value`` checks one value
+against its spec (``parameter_specs``: kind, unit, range, choices), ``build_configuration``
+every value and then what they imply together (the geometry, distinct joint names, the motion),
+raising ConfigurationError naming the first bad parameter; the node, the demo and the tests all
+validate through it. README.md documents each parameter.
 """
 
 from __future__ import annotations
@@ -24,8 +25,6 @@ from linkage_kinematics.kinematics.geometry import (
     DIMENSIONS,
     FourBar,
     GeometryError,
-    GROUND_COORDINATES,
-    LINK_LENGTHS,
     preset,
     TWO_PI,
     UnreachableError,
@@ -33,54 +32,23 @@ from linkage_kinematics.kinematics.geometry import (
 from linkage_kinematics.kinematics.inversion import seen_from_rocker
 from linkage_kinematics.kinematics.solver import continued_branch, DeadPointError, solve
 from linkage_kinematics.model.joints import Driver, JointMap, JointMapping, Link
-from linkage_kinematics.run.limits import (
-    MAX_ANGLE,
-    MAX_BAG_DURATION,
-    MAX_BAG_SIZE,
-    MAX_CPU,
-    MAX_DISPLAY_RATE_HZ,
-    MAX_DRIVE_GAIN,
-    MAX_OMEGA0,
-    MAX_PARAMETER_LENGTH,
-    MAX_RATE_HZ,
-    MAX_TIME_CONSTANT,
-    MAX_TIMEOUT,
-    MIN_PASS_DURATION,
-    MIN_SPLIT_SIZE,
-    NO_CPU_AFFINITY,
-    NO_SPLIT,
+from linkage_kinematics.run.limits import MIN_PASS_DURATION
+from linkage_kinematics.run.parameter_specs import (
+    EndBehavior,
+    Kind,
+    MotionMode,
+    NODE_NAME,
+    ParameterSpec,
+    SourceKind,
+    SPECS,
 )
 import yaml
-
-NODE_NAME = 'linkage_node'
 
 # A step count within this fraction of a step of a whole number ends exactly on the segment
 # end, so 90° in 0.5° steps is 180 steps and not 180 plus a rounding-sized 181st.
 _STEP_COUNT_TOLERANCE = 1e-9
 # α − alpha_start within this of a whole number of turns is a whole-turn loop.
 _WHOLE_TURN_TOLERANCE = 1e-9
-
-
-class EndBehavior(StrEnum):
-    """What the crank does at the end of a pass: parameter ``end_behavior``, by its value."""
-
-    STOP = 'stop'
-    LOOP = 'loop'
-    BOUNCE = 'bounce'
-
-
-class MotionMode(StrEnum):
-    """When the node computes and publishes a state: parameter ``mode``, by its value."""
-
-    REAL_TIME = 'real_time'
-    FIXED_STEP = 'fixed_step'
-
-
-class SourceKind(StrEnum):
-    """Where the driver's motion comes from: parameter ``source``, by its value."""
-
-    DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
-    MEASURED = 'measured'  # the driver joint of each measured_joint_states message
 
 
 # The fields whose change restarts the motion from alpha_start (README: Run-time changes); a
@@ -174,85 +142,92 @@ def describe_value(value: object) -> str:
     return f'{type(value).__name__} {value!r}'
 
 
-def _real(values: Mapping[str, Any], name: str) -> float:
-    value = values.get(name)
+def _real(spec: ParameterSpec, value: object) -> float:
     # bool is an int in Python but a different parameter type in ROS.
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigurationError(name, f'must be a number, got {describe_value(value)}')
+        raise ConfigurationError(spec.name, f'must be a number, got {describe_value(value)}')
     value = float(value)
     if not math.isfinite(value):
-        raise ConfigurationError(name, f'must be finite, got {value!r}')
+        raise ConfigurationError(spec.name, f'must be finite, got {value!r}')
+    interval, unit = spec.interval, spec.unit  # set for every real (ParameterSpec)
+    if value in interval:
+        return value
+    if interval.open_low:
+        reason = (f'must be greater than {interval.low:g} {unit} and at most {interval.high:g} '
+                  f'{unit}')
+    else:
+        reason = f'must lie in [{interval.low:g}, {interval.high:g}] {unit}'
+    raise ConfigurationError(spec.name, f'{reason}, got {value!r}')
+
+
+def _integer(spec: ParameterSpec, value: object) -> int:
+    interval, off = spec.interval, spec.off  # both set for every integer (ParameterSpec)
+    if (isinstance(value, bool) or not isinstance(value, int)
+            or not (value == off.value or value in interval)):
+        unit = f' {spec.unit}' if spec.unit else ''
+        raise ConfigurationError(
+            spec.name,
+            f'must be {off.value} ({off.meaning}) or a {spec.noun} in [{interval.low}, '
+            f'{interval.high}]{unit}, got {describe_value(value)}',
+        )
     return value
 
 
-def _positive(values: Mapping[str, Any], name: str, unit: str, upper: float = math.inf) -> float:
-    value = _real(values, name)
-    if not 0.0 < value <= upper:
-        bound = f' and at most {upper:g} {unit}' if math.isfinite(upper) else ''
-        raise ConfigurationError(name, f'must be greater than 0 {unit}{bound}, got {value!r}')
+def _sign(spec: ParameterSpec, value: object) -> int:
+    if isinstance(value, bool) or not isinstance(value, int) or value not in (1, -1):
+        raise ConfigurationError(
+            spec.name, f'must be the integer 1 or -1, got {describe_value(value)}')
     return value
 
 
-def _within(
-    values: Mapping[str, Any], name: str, low: float, high: float, unit: str = 'rad'
-) -> float:
-    value = _real(values, name)
-    if not low <= value <= high:
-        raise ConfigurationError(name, f'must lie in [{low:g}, {high:g}] {unit}, got {value!r}')
-    return value
-
-
-def _text(
-    values: Mapping[str, Any],
-    name: str,
-    choices: tuple[str, ...] | None = None,
-    allow_empty: bool = False,
-) -> str:
-    value = values.get(name)
-    if not isinstance(value, str):
-        raise ConfigurationError(name, f'must be a string, got {describe_value(value)}')
-    if choices is not None and value not in choices:
-        raise ConfigurationError(name, f"must be one of {', '.join(choices)}; got {value!r}")
-    if choices is None and not value and not allow_empty:
-        raise ConfigurationError(name, 'must not be empty')
-    return value
-
-
-def _flag(values: Mapping[str, Any], name: str) -> bool:
-    value = values.get(name)
+def _flag(spec: ParameterSpec, value: object) -> bool:
     if not isinstance(value, bool):
-        raise ConfigurationError(name, f'must be true or false, got {describe_value(value)}')
+        raise ConfigurationError(spec.name, f'must be true or false, got {describe_value(value)}')
     return value
 
 
-def _cpu(values: Mapping[str, Any]) -> int:
-    value = values.get('cpu_affinity')
-    if (isinstance(value, bool) or not isinstance(value, int)
-            or not NO_CPU_AFFINITY <= value <= MAX_CPU):
+def _text(spec: ParameterSpec, value: object) -> str:
+    if not isinstance(value, str):
+        raise ConfigurationError(spec.name, f'must be a string, got {describe_value(value)}')
+    if not value and not spec.allow_empty:
+        raise ConfigurationError(spec.name, 'must not be empty')
+    return value
+
+
+def _choice(spec: ParameterSpec, value: object) -> StrEnum:
+    if not isinstance(value, str):
+        raise ConfigurationError(spec.name, f'must be a string, got {describe_value(value)}')
+    choices = spec.choices  # set for every choice (ParameterSpec)
+    if value not in tuple(choices):
         raise ConfigurationError(
-            'cpu_affinity',
-            f'must be {NO_CPU_AFFINITY} (no pinning) or a CPU number in [0, {MAX_CPU}], got '
-            f'{describe_value(value)}',
-        )
-    return value
+            spec.name, f"must be one of {', '.join(choices)}; got {value!r}")
+    return choices(value)
 
 
-def _bag_size(values: Mapping[str, Any]) -> int:
-    value = values.get('log.max_bag_size')
-    if (isinstance(value, bool) or not isinstance(value, int)
-            or not (value == NO_SPLIT or MIN_SPLIT_SIZE <= value <= MAX_BAG_SIZE)):
-        raise ConfigurationError(
-            'log.max_bag_size',
-            f'must be {NO_SPLIT} (no split) or a size in [{MIN_SPLIT_SIZE}, {MAX_BAG_SIZE}] '
-            f'bytes, got {describe_value(value)}',
-        )
-    return value
+_CHECKS = {
+    Kind.REAL: _real,
+    Kind.INTEGER: _integer,
+    Kind.SIGN: _sign,
+    Kind.FLAG: _flag,
+    Kind.TEXT: _text,
+    Kind.CHOICE: _choice,
+}
+
+
+def parameter_value(values: Mapping[str, Any], name: str) -> Any:
+    """
+    Return parameter ``name``'s value in ``values``, checked against its spec.
+
+    A real comes back as a float (a whole number is accepted), a choice as its enum member.
+    Raises ConfigurationError naming the parameter and what its spec asks for (a missing value
+    is refused as ``no value``).
+    """
+    spec = SPECS[name]
+    return _CHECKS[spec.kind](spec, values.get(name))
 
 
 def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
-    preset_name = values.get('preset')
-    if not isinstance(preset_name, str):
-        raise ConfigurationError('preset', f'must be a string, got {describe_value(preset_name)}')
+    preset_name = parameter_value(values, 'preset')
     if preset_name:
         try:
             preset(preset_name)
@@ -262,45 +237,27 @@ def _geometry(values: Mapping[str, Any]) -> tuple[str, FourBar]:
         if values.get(name) is None:
             raise ConfigurationError(name, "has no value: with preset '' all five of "
                                      f"{', '.join(DIMENSIONS)} must be given")
-    for name in LINK_LENGTHS:
-        _positive(values, name, 'm', MAX_PARAMETER_LENGTH)
-    for name in GROUND_COORDINATES:
-        _within(values, name, -MAX_PARAMETER_LENGTH, MAX_PARAMETER_LENGTH, 'm')
+    dimensions = {name: parameter_value(values, name) for name in DIMENSIONS}
     try:
-        linkage = FourBar(**{name: _real(values, name) for name in DIMENSIONS})
+        linkage = FourBar(**dimensions)
     except GeometryError as error:
         raise ConfigurationError(', '.join(DIMENSIONS), str(error)) from None
     return preset_name, linkage
 
 
-def _joints(values: Mapping[str, Any]) -> JointMap:
-    mappings = {}
-    for link in Link:
-        prefix = f'joints.{link.value}.'
-        direction = values.get(prefix + 'direction')
-        if isinstance(direction, bool) or direction not in (1, -1):
-            raise ConfigurationError(
-                prefix + 'direction',
-                f'must be the integer 1 or -1, got {describe_value(direction)}')
-        mappings[link.value] = JointMapping(
-            _text(values, prefix + 'name'), int(direction),
-            _within(values, prefix + 'offset', -MAX_ANGLE, MAX_ANGLE),
-        )
-    joints = JointMap(**mappings)
+def _joints(checked: Mapping[str, Any]) -> JointMap:
+    """Return the joints' mapping from checked values, whose three names must differ."""
+    joints = JointMap(**{
+        link.value: JointMapping(*(checked[f'joints.{link.value}.{field}']
+                                   for field in ('name', 'direction', 'offset')))
+        for link in Link
+    })
     names = joints.names(tuple(Link))
     if len(set(names)) < len(names):
         raise ConfigurationError(
             'joints.crank.name, joints.coupler.name, joints.rocker.name',
             f"the three joint names must differ, got {', '.join(names)}")
     return joints
-
-
-def _branch(values: Mapping[str, Any]) -> int:
-    branch = values.get('branch')
-    if isinstance(branch, bool) or not isinstance(branch, int) or branch not in (1, -1):
-        raise ConfigurationError(
-            'branch', f'must be the integer 1 or -1, got {describe_value(branch)}')
-    return int(branch)
 
 
 def _motion(
@@ -342,89 +299,76 @@ def _motion(
     return blocked_at, duration
 
 
+def _pass(
+    checked: Mapping[str, Any], linkage: FourBar, drive: DriveLaw
+) -> tuple[float | None, float, float, int]:
+    """
+    Return the drive law's pass: (blocked_at, duration in s, segment_end, step_count).
+
+    With ``source`` measured there is no pass: the drive-law parameters are not used, so not
+    checked against the geometry.
+    """
+    alpha_start, alpha_end = checked['alpha_start'], checked['alpha_end']
+    if checked['source'] is SourceKind.MEASURED:
+        return None, 0.0, alpha_end, 1
+    if checked['driver'] is not Driver.CRANK:
+        raise ConfigurationError(
+            'driver', 'the drive law turns the crank: driver rocker needs source measured')
+    blocked_at, duration = _motion(linkage, drive, checked['branch'], alpha_start, alpha_end)
+    segment_end = alpha_end if blocked_at is None else blocked_at
+    travel = abs(segment_end - alpha_start)
+    steps = travel / checked['alpha_step']
+    if not math.isfinite(steps):
+        raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
+    return blocked_at, duration, segment_end, max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
+
+
 def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     """
     Validate parameter values (name → value) into a RunConfiguration.
 
-    Raises ConfigurationError naming the first offending parameter. Integers are accepted for
-    real-valued parameters; anything else of the wrong type is rejected.
+    Raises ConfigurationError naming the first offending parameter: the geometry first, then
+    each value on its own in the order the node declares them, then what they imply together.
+    Integers are accepted for real-valued parameters; anything else of the wrong type is
+    rejected.
     """
     preset_name, linkage = _geometry(values)
-    branch = _branch(values)
-    omega0 = _within(values, 'omega0', -MAX_OMEGA0, MAX_OMEGA0, 'rad/s')
-    k = _within(values, 'k', -MAX_DRIVE_GAIN, MAX_DRIVE_GAIN, '1/s')
-    drive = DriveLaw(omega0, k)
-    alpha_start = _within(values, 'alpha_start', -MAX_ANGLE, MAX_ANGLE)
-    alpha_end = _within(values, 'alpha_end', -MAX_ANGLE, MAX_ANGLE)
-    end_behavior = EndBehavior(_text(values, 'end_behavior', tuple(EndBehavior)))
-    mode = MotionMode(_text(values, 'mode', tuple(MotionMode)))
-    alpha_step = _positive(values, 'alpha_step', 'rad', TWO_PI)
-    rate_hz = _positive(values, 'rate_hz', 'Hz', MAX_RATE_HZ)
-    display_rate_hz = _positive(values, 'display_rate_hz', 'Hz', MAX_DISPLAY_RATE_HZ)
-    frame_id = _text(values, 'frame_id')
-    frame_prefix = _text(values, 'frame_prefix', allow_empty=True)
-    min_transmission_angle = _within(
-        values, 'diagnostics.min_transmission_angle', 0.0, math.pi / 2.0
-    )
-    dead_point_warning = _within(values, 'diagnostics.dead_point_warning', 0.0, math.pi)
-    log_enabled = _flag(values, 'log.enabled')
-    log_folder = Path(_text(values, 'log.folder'))
-    log_max_bag_size = _bag_size(values)
-    log_max_bag_duration = _within(values, 'log.max_bag_duration', 0.0, MAX_BAG_DURATION, 's')
-    cpu_affinity = _cpu(values)
-    source = SourceKind(_text(values, 'source', tuple(SourceKind)))
-    driver = Driver(_text(values, 'driver', tuple(Driver)))
-    joints = _joints(values)
-    publish_robot_description = _flag(values, 'publish_robot_description')
-    measured_timeout = _positive(values, 'measured.timeout', 's', MAX_TIMEOUT)
-    max_jump = _positive(values, 'measured.max_jump', 'rad', math.pi)
-    acceleration_time_constant = _within(
-        values, 'measured.acceleration_time_constant', 0.0, MAX_TIME_CONSTANT, 's')
-    if source is SourceKind.MEASURED:
-        # No pass: the drive-law parameters are not used, so not checked against the geometry.
-        blocked_at, segment_duration, segment_end, step_count = None, 0.0, alpha_end, 1
-    else:
-        if driver is not Driver.CRANK:
-            raise ConfigurationError(
-                'driver', 'the drive law turns the crank: driver rocker needs source measured')
-        blocked_at, segment_duration = _motion(linkage, drive, branch, alpha_start, alpha_end)
-        segment_end = alpha_end if blocked_at is None else blocked_at
-        travel = abs(segment_end - alpha_start)
-        steps = travel / alpha_step
-        if not math.isfinite(steps):
-            raise ConfigurationError('alpha_step', f'is too small for a pass of {travel!r} rad')
-        step_count = max(1, math.ceil(steps - _STEP_COUNT_TOLERANCE))
-    autostart = _flag(values, 'autostart')
+    checked = {name: parameter_value(values, name) for name in SPECS}
+    joints = _joints(checked)
+    drive = DriveLaw(checked['omega0'], checked['k'])
+    blocked_at, segment_duration, segment_end, step_count = _pass(checked, linkage, drive)
+    alpha_start, alpha_end = checked['alpha_start'], checked['alpha_end']
+    driver = checked['driver']
     return RunConfiguration(
         preset=preset_name,
         linkage=linkage,
         drive=drive,
-        branch=branch,
+        branch=checked['branch'],
         alpha_start=alpha_start,
         alpha_end=alpha_end,
-        end_behavior=end_behavior,
-        mode=mode,
-        alpha_step=alpha_step,
-        rate_hz=rate_hz,
-        display_rate_hz=display_rate_hz,
-        frame_id=frame_id,
-        frame_prefix=frame_prefix,
-        min_transmission_angle=min_transmission_angle,
-        dead_point_warning=dead_point_warning,
-        log_enabled=log_enabled,
-        log_folder=log_folder,
-        log_max_bag_size=log_max_bag_size,
-        log_max_bag_duration=log_max_bag_duration,
-        cpu_affinity=cpu_affinity,
-        source=source,
+        end_behavior=checked['end_behavior'],
+        mode=checked['mode'],
+        alpha_step=checked['alpha_step'],
+        rate_hz=checked['rate_hz'],
+        display_rate_hz=checked['display_rate_hz'],
+        frame_id=checked['frame_id'],
+        frame_prefix=checked['frame_prefix'],
+        min_transmission_angle=checked['diagnostics.min_transmission_angle'],
+        dead_point_warning=checked['diagnostics.dead_point_warning'],
+        log_enabled=checked['log.enabled'],
+        log_folder=Path(checked['log.folder']),
+        log_max_bag_size=checked['log.max_bag_size'],
+        log_max_bag_duration=checked['log.max_bag_duration'],
+        cpu_affinity=checked['cpu_affinity'],
+        source=checked['source'],
         driver=driver,
         driven_linkage=linkage if driver is Driver.CRANK else seen_from_rocker(linkage),
         joints=joints,
-        publish_robot_description=publish_robot_description,
-        measured_timeout=measured_timeout,
-        max_jump=max_jump,
-        acceleration_time_constant=acceleration_time_constant,
-        autostart=autostart,
+        publish_robot_description=checked['publish_robot_description'],
+        measured_timeout=checked['measured.timeout'],
+        max_jump=checked['measured.max_jump'],
+        acceleration_time_constant=checked['measured.acceleration_time_constant'],
+        autostart=checked['autostart'],
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,
         blocked_at=blocked_at,

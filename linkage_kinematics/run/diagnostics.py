@@ -4,7 +4,8 @@
 """
 What the node's diagnostics say and when, without ROS.
 
-``assess`` gives the status's level and message and ``report`` its whole content;
+``assess`` gives the status's level and message and ``report`` its whole content, from the
+``StatusInputs`` the node has at that moment;
 ``MeasuredHealth`` is the measured source's record of dropped samples and of the time since
 the last valid one. ``key_values`` formats the status's key values (README, "Diagnostics") so
 that a viewer shows them as they are: counts as integers, small residuals in scientific
@@ -18,6 +19,7 @@ jitter of a few ticks.
 from __future__ import annotations
 
 import collections
+from dataclasses import dataclass
 from enum import IntEnum
 import math
 
@@ -90,25 +92,36 @@ class RateMeter:
         return self.rate
 
 
-def key_values(
-    config: RunConfiguration,
-    run_state: RunState,
-    state: LinkageState | None,
-    achieved_rate: float | None,
-    missed_deadlines: int,
-    log_file: str | None,
-    log_size: int | None,
-    health: MeasuredHealth | None = None,
-    now_ns: int = 0,
-) -> dict[str, str]:
+@dataclass(frozen=True, kw_only=True)
+class StatusInputs:
     """
-    Return the status's key values (README, "Diagnostics") as diagnostic_msgs/KeyValue strings.
+    What one status is made of, as the node has it when it sends one (README, Diagnostics).
 
-    ``run_state`` says whether the motion runs or is paused; ``achieved_rate`` None means not
-    measured yet (the first status); ``log_file`` None means logging is disabled; ``log_size`` is
-    the bag's size in bytes. ``health`` is the measured source's (None under the drive law),
-    whose values replace the drive law's pace and settings.
+    ``run_state`` says whether the motion runs or is paused and ``state`` is the latest state
+    (None before the first). ``problem`` makes the status ERROR (the crank cannot go on, the
+    log failed); ``activity`` is its message when all is well. ``health`` is the measured
+    source's (None under the drive law), judged at ``now_ns``; its values replace the drive
+    law's pace and settings. ``achieved_rate`` None means not measured yet (the first status);
+    ``log_file`` None means logging is disabled; ``log_size`` is the bag's size in bytes.
     """
+
+    config: RunConfiguration
+    run_state: RunState
+    state: LinkageState | None
+    activity: str
+    achieved_rate: float | None
+    missed_deadlines: int
+    log_file: str | None
+    log_size: int | None
+    problem: str | None = None
+    health: MeasuredHealth | None = None
+    now_ns: int = 0
+
+
+def key_values(inputs: StatusInputs) -> dict[str, str]:
+    """Return the status's key values (README, Diagnostics) as diagnostic_msgs/KeyValue texts."""
+    config, state, health = inputs.config, inputs.state, inputs.health
+    log_file, log_size = inputs.log_file, inputs.log_size
     # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
     # the values that change at the top.
     values = {}
@@ -134,13 +147,13 @@ def key_values(
             'loop closure residual': f'{residual:.2e}',
         })
     values['achieved rate (Hz)'] = (
-        NOT_MEASURED if achieved_rate is None else f'{achieved_rate:.1f}')
+        NOT_MEASURED if inputs.achieved_rate is None else f'{inputs.achieved_rate:.1f}')
     if health is not None:
-        values.update(health.values(now_ns, config))
+        values.update(health.values(inputs.now_ns, config))
         if log_file is not None and log_size is not None:
             values['log size (bytes)'] = str(int(log_size))
         values['log file'] = LOG_DISABLED if log_file is None else log_file
-        values['run state'] = run_state.value
+        values['run state'] = inputs.run_state.value
         return values
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
@@ -148,11 +161,11 @@ def key_values(
         values['rate_hz'] = f'{config.rate_hz:g}'
     else:
         values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'
-    values['missed deadlines'] = str(int(missed_deadlines))
+    values['missed deadlines'] = str(int(inputs.missed_deadlines))
     if log_file is not None and log_size is not None:
         values['log size (bytes)'] = str(int(log_size))
     values['log file'] = LOG_DISABLED if log_file is None else log_file
-    values['run state'] = run_state.value
+    values['run state'] = inputs.run_state.value
     values['mode'] = config.mode.value
     values['end behavior'] = config.end_behavior.value
     return values
@@ -215,33 +228,20 @@ def assess(
     return Level.OK, activity
 
 
-def report(
-    config: RunConfiguration,
-    run_state: RunState,
-    state: LinkageState | None,
-    problem: str | None,
-    activity: str,
-    health: MeasuredHealth | None,
-    now_ns: int,
-    achieved_rate: float | None,
-    missed_deadlines: int,
-    log_file: str | None,
-    log_size: int | None,
-) -> tuple[Level, str, dict[str, str]]:
+def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
     """
     Return the level, message and key values of one status (README, Diagnostics).
 
-    ``health`` is the measured source's (None under the drive law); its drops since the last
-    status make it WARN and its staleness ERROR. The rest as ``key_values`` takes them.
+    A measured source's drops since the last status make it WARN and its staleness ERROR.
     """
+    config, health, problem = inputs.config, inputs.health, inputs.problem
     warnings: tuple[str, ...] = ()
     if health is not None:
         warnings = health.take_warnings()
         driver_name = config.joints[Link(config.driver.value)].name
-        problem = problem or health.problem(now_ns, config.measured_timeout, driver_name)
-    values = key_values(config, run_state, state, achieved_rate, missed_deadlines, log_file,
-                        log_size, health, now_ns)
-    level, text = assess(config, state, problem, activity, warnings)
+        problem = problem or health.problem(inputs.now_ns, config.measured_timeout, driver_name)
+    values = key_values(inputs)
+    level, text = assess(config, inputs.state, problem, inputs.activity, warnings)
     return level, text, values
 
 

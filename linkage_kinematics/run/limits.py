@@ -4,8 +4,9 @@
 """
 The limits of the node's parameters, one owner for each: validation, descriptors and the bag.
 
-``configuration`` checks values against them, ``parameter_specs`` shows them in the parameters'
-descriptors, and ``bag.writer`` enforces rosbag2's split rule with the same two numbers.
+``parameter_specs`` puts them into each parameter's contract (which ``configuration`` checks
+values against and the descriptors show), ``configuration`` checks the pass against
+MIN_PASS_DURATION, and ``bag.writer`` enforces rosbag2's split rule with the same two numbers.
 """
 
 MAX_RATE_HZ = 10000.0

@@ -2,12 +2,14 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The node's parameters as declared: each one's name, default, descriptor text and limits.
+The node's parameters as declared: each one's name, default, descriptor text and contract.
 
 Pure, no ROS: one small function per group of parameters (geometry, motion, outputs, logging,
-measured input and joints), in the order the node declares them. ``parameters`` owns the limits
-and the validation of values; ``node_parameters`` turns these specifications into ROS
-descriptors.
+measured input and joints), in the order the node declares them. Each spec says what a value
+must be (its kind, unit, range, the choices of a closed set) once: ``configuration`` checks
+values against it and ``ros.parameters`` turns it into the ROS descriptor. The closed sets of
+values (``EndBehavior``, ``MotionMode``, ``SourceKind``) are defined here, with the parameters they
+are the values of, so that ``configuration`` imports this module and not the other way round.
 """
 
 from __future__ import annotations
@@ -15,13 +17,13 @@ from __future__ import annotations
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass
 import difflib
+from enum import Enum, StrEnum
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 from linkage_kinematics.kinematics.geometry import DIMENSIONS, LINK_LENGTHS, preset, TWO_PI
 from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, Link
 from linkage_kinematics.model.urdf import DEFAULT_FRAME_ID
-from linkage_kinematics.run.configuration import EndBehavior, MotionMode, NODE_NAME, SourceKind
 from linkage_kinematics.run.limits import (
     MAX_ANGLE,
     MAX_BAG_DURATION,
@@ -39,17 +41,109 @@ from linkage_kinematics.run.limits import (
     NO_SPLIT,
 )
 
+NODE_NAME = 'linkage_node'
+
+
+class EndBehavior(StrEnum):
+    """What the crank does at the end of a pass: parameter ``end_behavior``, by its value."""
+
+    STOP = 'stop'
+    LOOP = 'loop'
+    BOUNCE = 'bounce'
+
+
+class MotionMode(StrEnum):
+    """When the node computes and publishes a state: parameter ``mode``, by its value."""
+
+    REAL_TIME = 'real_time'
+    FIXED_STEP = 'fixed_step'
+
+
+class SourceKind(StrEnum):
+    """Where the driver's motion comes from: parameter ``source``, by its value."""
+
+    DRIVE_LAW = 'drive_law'  # a timer and the drive law ω = omega0 + k·α (the paper's run)
+    MEASURED = 'measured'  # the driver joint of each measured_joint_states message
+
+
+class Kind(Enum):
+    """What a parameter's values are, and so how ``configuration`` checks one."""
+
+    REAL = 'real'  # a finite number in ``interval`` (a whole number is taken as that real)
+    INTEGER = 'integer'  # an integer in ``interval``, or ``off``
+    SIGN = 'sign'  # the integer 1 or -1
+    FLAG = 'flag'  # true or false
+    TEXT = 'text'  # a string, empty only where ``allow_empty``
+    CHOICE = 'choice'  # a string, one of the values of the enum ``choices``
+
+
+@dataclass(frozen=True)
+class Interval:
+    """The values of a numeric parameter: [low, high], or (low, high] where ``open_low``."""
+
+    low: float
+    high: float
+    open_low: bool = False
+
+    def __contains__(self, value: float) -> bool:
+        """Whether ``value`` lies in the interval."""
+        above_low = self.low < value if self.open_low else self.low <= value
+        return above_low and value <= self.high
+
+
+class Off(NamedTuple):
+    """An integer parameter's value outside its interval that turns its feature off."""
+
+    value: int
+    meaning: str  # what the value does, e.g. 'no split'
+
 
 @dataclass(frozen=True)
 class ParameterSpec:
-    """One node parameter: its default (None: no default), descriptor text and limits."""
+    """
+    One node parameter: its default (None: no default), descriptor text and contract.
+
+    ``kind`` says which of the other fields apply: ``unit`` and ``interval`` to numbers, ``off``
+    and ``noun`` (what a value in the interval is, for messages) to integers, ``allow_empty``
+    to text, ``choices`` to choices.
+    """
 
     name: str
     default: Any
     description: str
+    kind: Kind
     read_only: bool = False
-    floating_range: tuple[float, float] | None = None
-    integer_range: tuple[int, int, int] | None = None
+    unit: str = ''
+    interval: Interval | None = None
+    off: Off | None = None
+    noun: str = ''
+    allow_empty: bool = False
+    choices: type[StrEnum] | None = None
+
+    def __post_init__(self) -> None:
+        """Refuse a spec without the fields its kind needs (at import, so no check lacks them)."""
+        needs = {Kind.REAL: ('interval', 'unit'), Kind.INTEGER: ('interval', 'off', 'noun'),
+                 Kind.CHOICE: ('choices',)}.get(self.kind, ())
+        missing = [field for field in needs if not getattr(self, field)]
+        if missing:
+            raise TypeError(f"{self.kind.value} parameter {self.name} needs {', '.join(missing)}")
+
+    @property
+    def floating_range(self) -> tuple[float, float] | None:
+        """Return the descriptor's floating-point range (from, to), None if not a real."""
+        if self.kind is not Kind.REAL:
+            return None
+        return self.interval.low, self.interval.high
+
+    @property
+    def integer_range(self) -> tuple[int, int, int] | None:
+        """Return the descriptor's integer range (from, to, step), None if not an integer."""
+        if self.kind is Kind.SIGN:
+            return -1, 1, 2
+        if self.kind is not Kind.INTEGER:
+            return None
+        # A descriptor holds one range: from the off value, which lies below the interval.
+        return self.off.value, int(self.interval.high), 1
 
 
 _DIMENSION_TEXTS = {
@@ -69,7 +163,7 @@ def _geometry_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
             'preset', 'paper',
             "mechanism whose dimensions are the geometry parameters' defaults: "
             "paper, paper_full_turn, grashof_crank_rocker, or '' for none",
-            read_only=True,
+            Kind.TEXT, read_only=True, allow_empty=True,
         ),
         *(
             ParameterSpec(
@@ -77,8 +171,10 @@ def _geometry_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
                 getattr(geometry, name) if geometry is not None else None,
                 f"{_DIMENSION_TEXTS[name]} (m); defaults to the preset's value, required when "
                 "preset is ''",
-                floating_range=((0.0 if name in LINK_LENGTHS else -MAX_PARAMETER_LENGTH),
-                                MAX_PARAMETER_LENGTH),
+                Kind.REAL, unit='m',
+                interval=(Interval(0.0, MAX_PARAMETER_LENGTH, open_low=True)
+                          if name in LINK_LENGTHS
+                          else Interval(-MAX_PARAMETER_LENGTH, MAX_PARAMETER_LENGTH)),
             )
             for name in DIMENSIONS
         ),
@@ -91,30 +187,32 @@ def _motion_specs() -> tuple[ParameterSpec, ...]:
         ParameterSpec('branch', 1,
                       'assembly at alpha_start: +1 (B left of A→C) or −1; through change points '
                       'the motion continues on its smooth branch',
-                      integer_range=(-1, 1, 2)),
+                      Kind.SIGN),
         ParameterSpec('omega0', 2.0, 'drive law ω = omega0 + k·α: omega0 (rad/s)',
-                      floating_range=(-MAX_OMEGA0, MAX_OMEGA0)),
+                      Kind.REAL, unit='rad/s', interval=Interval(-MAX_OMEGA0, MAX_OMEGA0)),
         ParameterSpec('k', 0.0, 'drive law ω = omega0 + k·α: k (1/s)',
-                      floating_range=(-MAX_DRIVE_GAIN, MAX_DRIVE_GAIN)),
+                      Kind.REAL, unit='1/s', interval=Interval(-MAX_DRIVE_GAIN, MAX_DRIVE_GAIN)),
         ParameterSpec('alpha_start', 0.0, 'crank angle where the motion starts (rad)',
-                      floating_range=(-MAX_ANGLE, MAX_ANGLE)),
+                      Kind.REAL, unit='rad', interval=Interval(-MAX_ANGLE, MAX_ANGLE)),
         ParameterSpec('alpha_end', math.pi / 2.0,
                       'crank angle where one pass ends (rad), not alpha_start',
-                      floating_range=(-MAX_ANGLE, MAX_ANGLE)),
+                      Kind.REAL, unit='rad', interval=Interval(-MAX_ANGLE, MAX_ANGLE)),
         # A node runs until it is stopped, as every ROS node does: by default the crank swings
         # to and fro over its pass, which suits the paper's mechanism (it cannot turn fully).
         ParameterSpec('end_behavior', EndBehavior.BOUNCE.value,
-                      'at the end of a pass: stop (and exit), loop or bounce'),
+                      'at the end of a pass: stop (and exit), loop or bounce',
+                      Kind.CHOICE, choices=EndBehavior),
         ParameterSpec('mode', MotionMode.REAL_TIME.value,
                       'real_time: α from node-clock time at rate_hz; fixed_step: steps of '
-                      'alpha_step, each published when the drive law reaches it'),
+                      'alpha_step, each published when the drive law reaches it',
+                      Kind.CHOICE, choices=MotionMode),
         ParameterSpec('alpha_step', math.radians(0.5),
                       'crank step in fixed_step mode (rad), greater than 0',
-                      floating_range=(0.0, TWO_PI)),
+                      Kind.REAL, unit='rad', interval=Interval(0.0, TWO_PI, open_low=True)),
         ParameterSpec('rate_hz', 100.0,
                       'state compute and publish rate in real_time mode (Hz), greater than 0; '
                       'unused in fixed_step mode',
-                      floating_range=(0.0, MAX_RATE_HZ)),
+                      Kind.REAL, unit='Hz', interval=Interval(0.0, MAX_RATE_HZ, open_low=True)),
     )
 
 
@@ -123,21 +221,22 @@ def _output_specs() -> tuple[ParameterSpec, ...]:
     return (
         ParameterSpec('display_rate_hz', 30.0,
                       'publish rate of linkage/markers (Hz), greater than 0',
-                      floating_range=(0.0, MAX_DISPLAY_RATE_HZ)),
+                      Kind.REAL, unit='Hz',
+                      interval=Interval(0.0, MAX_DISPLAY_RATE_HZ, open_low=True)),
         ParameterSpec('frame_id', DEFAULT_FRAME_ID,
                       'frame of the markers and linkage/state, root link of the URDF',
-                      read_only=True),
+                      Kind.TEXT, read_only=True),
         ParameterSpec('frame_prefix', '',
                       "prefix of every frame id the node publishes (robot_state_publisher's "
                       "frame_prefix, e.g. 'left/'); the URDF stays unprefixed",
-                      read_only=True),
+                      Kind.TEXT, read_only=True, allow_empty=True),
         ParameterSpec('diagnostics.min_transmission_angle', math.radians(10.0),
                       'WARN when min(μ, π − μ) of the transmission angle μ is below this (rad)',
-                      floating_range=(0.0, math.pi / 2.0)),
+                      Kind.REAL, unit='rad', interval=Interval(0.0, math.pi / 2.0)),
         ParameterSpec('diagnostics.dead_point_warning', math.radians(1.0),
                       'WARN when the crank is closer than this to a dead point or a change '
                       'point (rad)',
-                      floating_range=(0.0, math.pi)),
+                      Kind.REAL, unit='rad', interval=Interval(0.0, math.pi)),
     )
 
 
@@ -145,23 +244,27 @@ def _logging_specs() -> tuple[ParameterSpec, ...]:
     """Return the bag's parameters and where the node's process and its bag writer run."""
     return (
         ParameterSpec('log.enabled', True, 'record every published message to a bag',
-                      read_only=True),
+                      Kind.FLAG, read_only=True),
         ParameterSpec('log.folder', 'bags',
                       'folder that receives a new bag per run (relative to the working '
-                      'directory)', read_only=True),
+                      'directory)', Kind.TEXT, read_only=True),
         ParameterSpec('log.max_bag_size', NO_SPLIT,
                       "bytes after which the bag goes on in a new file (rosbag2's "
                       f'--max-bag-size); 0 never splits, else at least {MIN_SPLIT_SIZE}',
-                      read_only=True, integer_range=(NO_SPLIT, MAX_BAG_SIZE, 1)),
+                      Kind.INTEGER, read_only=True, unit='bytes',
+                      interval=Interval(MIN_SPLIT_SIZE, MAX_BAG_SIZE),
+                      off=Off(NO_SPLIT, 'no split'), noun='size'),
         ParameterSpec('log.max_bag_duration', float(NO_SPLIT),
                       "seconds after which the bag goes on in a new file (rosbag2's "
                       '--max-bag-duration, here also a fraction); 0 never splits',
-                      read_only=True, floating_range=(0.0, MAX_BAG_DURATION)),
+                      Kind.REAL, read_only=True, unit='s',
+                      interval=Interval(0.0, MAX_BAG_DURATION)),
         ParameterSpec('cpu_affinity', NO_CPU_AFFINITY,
                       "CPU that every thread of the node's process runs on, its bag writer "
                       "process on the others (as ros2_control's cpu_affinity); -1 leaves "
                       'both to the operating system',
-                      integer_range=(NO_CPU_AFFINITY, MAX_CPU, 1)),
+                      Kind.INTEGER, interval=Interval(0, MAX_CPU),
+                      off=Off(NO_CPU_AFFINITY, 'no pinning'), noun='CPU number'),
     )
 
 
@@ -171,29 +274,30 @@ def _joint_specs() -> tuple[ParameterSpec, ...]:
         ParameterSpec('source', SourceKind.DRIVE_LAW.value,
                       'drive_law: a timer turns the crank under the drive law; measured: the '
                       'driver joint of each message on measured_joint_states',
-                      read_only=True),
+                      Kind.CHOICE, read_only=True, choices=SourceKind),
         ParameterSpec('driver', Driver.CRANK.value,
                       'joint that moves the linkage: crank (at O) or rocker (at C, '
                       'source measured only)',
-                      read_only=True),
+                      Kind.CHOICE, read_only=True, choices=Driver),
         *(
             spec
             for link in Link
             for spec in (
                 ParameterSpec(f'joints.{link.value}.name', DEFAULT_JOINT_NAMES[link],
-                              f'name of the {link.value} joint in joint_states and the URDF'),
+                              f'name of the {link.value} joint in joint_states and the URDF',
+                              Kind.TEXT),
                 ParameterSpec(f'joints.{link.value}.direction', 1,
                               f'+1 or -1: lab value of the {link.value} joint = direction · '
-                              'node value + offset', integer_range=(-1, 1, 2)),
+                              'node value + offset', Kind.SIGN),
                 ParameterSpec(f'joints.{link.value}.offset', 0.0,
                               f'offset of the {link.value} joint (rad): lab value = '
                               'direction · node value + offset',
-                              floating_range=(-MAX_ANGLE, MAX_ANGLE)),
+                              Kind.REAL, unit='rad', interval=Interval(-MAX_ANGLE, MAX_ANGLE)),
             )
         ),
         ParameterSpec('publish_robot_description', True,
                       "publish the node's URDF on robot_description (false where the lab's "
-                      'robot_state_publisher has its own)', read_only=True),
+                      'robot_state_publisher has its own)', Kind.FLAG, read_only=True),
     )
 
 
@@ -202,15 +306,16 @@ def _measured_specs() -> tuple[ParameterSpec, ...]:
     return (
         ParameterSpec('measured.timeout', 1.0,
                       'diagnostics ERROR after this long without a valid measured sample (s), '
-                      'greater than 0', floating_range=(0.0, MAX_TIMEOUT)),
+                      'greater than 0',
+                      Kind.REAL, unit='s', interval=Interval(0.0, MAX_TIMEOUT, open_low=True)),
         ParameterSpec('measured.max_jump', math.pi / 2.0,
                       'a measured driver angle further than this from the last one used is '
                       'dropped (rad, greater than 0; π drops none)',
-                      floating_range=(0.0, math.pi)),
+                      Kind.REAL, unit='rad', interval=Interval(0.0, math.pi, open_low=True)),
         ParameterSpec('measured.acceleration_time_constant', 0.02,
                       "time constant of the low-pass filter on the driver's angular "
                       'acceleration estimate (s); 0 for the raw difference of velocities',
-                      floating_range=(0.0, MAX_TIME_CONSTANT)),
+                      Kind.REAL, unit='s', interval=Interval(0.0, MAX_TIME_CONSTANT)),
     )
 
 
@@ -226,14 +331,15 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         ParameterSpec('autostart', True,
                       'start the motion at once; false: publish the scene at alpha_start, the '
                       'URDF and the status, then wait for ~/resume',
-                      read_only=True),
+                      Kind.FLAG, read_only=True),
     )
 
 
-PARAMETER_NAMES = tuple(spec.name for spec in parameter_specs(''))
-REAL_PARAMETERS = frozenset(
-    spec.name for spec in parameter_specs('') if spec.floating_range is not None
-)
+# Every parameter's spec by name, in declaration order: the contract values are checked against
+# (the geometry's defaults, which depend on the preset, are not part of it).
+SPECS = {spec.name: spec for spec in parameter_specs('')}
+PARAMETER_NAMES = tuple(SPECS)
+REAL_PARAMETERS = frozenset(name for name, spec in SPECS.items() if spec.kind is Kind.REAL)
 
 
 def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[str]:
