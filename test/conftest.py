@@ -5,7 +5,7 @@
 The fixtures of the tests that start processes, and which tests ``./dev test`` runs again.
 
 ``domain_id``: the module's own ROS_DOMAIN_ID. ``nodes``: starts node processes in it and ends
-every one after the test (node_process.NodeProcesses).
+every one after the test (node_process.NodeProcesses); ``module_nodes`` after the module.
 """
 
 from collections.abc import Iterator
@@ -15,6 +15,7 @@ import pytest
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:
+    """Add --process-reruns (./dev test passes 2; colcon test, without it, runs each test once)."""
     parser.addoption(
         '--process-reruns', type=int, default=0, metavar='N',
         help='run a failed test marked "processes" again, up to N times (pytest-rerunfailures)')
@@ -50,9 +51,19 @@ def other_domain_id() -> Iterator[int]:
         yield leased
 
 
-@pytest.fixture
-def nodes(domain_id: int) -> Iterator[NodeProcesses]:
-    """Start processes in the module's domain; each has ended (SIGINT, or worse) after the test."""
+def _node_processes(domain_id: int) -> Iterator[NodeProcesses]:
     processes = NodeProcesses(domain_id)
     yield processes
     processes.finish()
+
+
+@pytest.fixture
+def nodes(domain_id: int) -> Iterator[NodeProcesses]:
+    """Start processes in the module's domain; each has ended (SIGINT, or worse) after the test."""
+    yield from _node_processes(domain_id)
+
+
+@pytest.fixture(scope='module')
+def module_nodes(domain_id: int) -> Iterator[NodeProcesses]:
+    """``nodes`` for a module's fixture (e.g. one run that many tests read)."""
+    yield from _node_processes(domain_id)

@@ -159,25 +159,6 @@ def start_node(
         )
 
 
-def stop_process(process: subprocess.Popen) -> None:
-    """Make sure a node process has ended (for test teardown)."""
-    if process.poll() is None:
-        process.kill()
-        process.wait(timeout=PROCESS_TIMEOUT)
-
-
-def run_node(
-    parameters: Mapping[str, Any], domain_id: int, output: Path, ros_arguments: Sequence[str] = ()
-) -> tuple[int, str]:
-    """Run a node to its end; return its exit status and output."""
-    process = start_node(parameters, domain_id, output, ros_arguments=ros_arguments)
-    try:
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
-    return status, output.read_text()
-
-
 def end_process(
     process: subprocess.Popen, stop_timeouts: Sequence[tuple[int, float]] = STOP_TIMEOUTS
 ) -> list[str]:
@@ -219,7 +200,9 @@ class NodeProcesses:
         self.processes.append((process, f' (output in {output})' if output else ''))
         return process
 
-    def start(self, parameters: Mapping[str, Any], output: Path, **options: Any) -> subprocess.Popen:
+    def start(
+        self, parameters: Mapping[str, Any], output: Path, **options: Any
+    ) -> subprocess.Popen:
         """``start_node`` in the test's domain, ended with the test at the latest."""
         return self.add(start_node(parameters, self.domain_id, output, **options), output)
 

@@ -19,7 +19,6 @@ import json
 import math
 from pathlib import Path
 import re
-import signal
 import subprocess
 import sys
 import time
@@ -59,13 +58,11 @@ from node_process import (
     decode,
     expected_state_point,
     Listener,
-    PROCESS_TIMEOUT,
+    NodeProcesses,
     REPOSITORY,
     ros_context,
     ros_environment,
     stamp_ns,
-    start_node,
-    stop_process,
     time_msg,
     TYPESTORE,
 )
@@ -94,7 +91,6 @@ DATA_TOPICS = ('/joint_states', '/linkage/state', '/linkage/markers', '/diagnost
 RATE_HZ = 200.0
 # 90° at this constant ω takes 0.3 s: a short run.
 SHORT_RUN_OMEGA = (math.pi / 2) / 0.3
-DOMAIN_ID = 30
 NAMES = list(DEFAULT_JOINT_NAMES.values())
 
 
@@ -583,7 +579,9 @@ def test_recorder_refuses_a_log_folder_under_a_regular_file(tmp_path: Path) -> N
 
 
 @pytest.fixture(scope='module')
-def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+def node_run(
+    tmp_path_factory: pytest.TempPathFactory, module_nodes: NodeProcesses
+) -> dict[str, Any]:
     """
     Return a logging run that the listener has heard on every topic, ended by SIGINT.
 
@@ -592,21 +590,18 @@ def node_run(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """
     run_folder = tmp_path_factory.mktemp('node_run')
     folder = run_folder / 'bags'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(module_nodes.domain_id) as context:
         listener = listen_to_node_topics(context, 'bag_test_listener')
-        process = start_node(
+        process = module_nodes.start(
             {'log.folder': str(folder), 'rate_hz': RATE_HZ, 'omega0': SHORT_RUN_OMEGA,
              'end_behavior': 'loop'},
-            DOMAIN_ID,
             run_folder / 'node.log',
         )
         try:
             assert listener.wait_for_every_topic(count=2), (run_folder / 'node.log').read_text()
-            process.send_signal(signal.SIGINT)
-            assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (
+            assert module_nodes.interrupt(process) == 0, (
                 (run_folder / 'node.log').read_text())
         finally:
-            stop_process(process)
             listener.destroy()
     return {'bag': only_bag(folder), 'received': listener.received}
 
@@ -753,7 +748,9 @@ def test_metadata_yaml_is_rosbag2_jazzy_format(node_run: dict[str, Any]) -> None
 # --- linkage-replay ---------------------------------------------------------------------------
 
 
-def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: Path) -> None:
+def test_replay_republishes_the_logged_run(
+    node_run: dict[str, Any], nodes: NodeProcesses, other_domain_id: int, tmp_path: Path
+) -> None:
     bag = node_run['bag']
     logged = read_with_rosbags(bag)
     logged_states = {
@@ -761,27 +758,25 @@ def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: P
         for _, m, _ in logged['/linkage/state']
     }
     logged_joints = {stamp_ns(m): list(m.position) for _, m, _ in logged['/joint_states']}
-    with ros_context(DOMAIN_ID + 1) as context:
+    with ros_context(other_domain_id) as context:
         listener = listen_to_node_topics(context, 'replay_test_listener')
         states = listener.received['/linkage/state']
         with open(tmp_path / 'replay.log', 'w') as output:
             # At the logged pace, looped until every logged state was heard: a listener that
             # discovers the replay late, or falls behind while the machine is busy (the logged
             # QoS keeps the last 10), hears the rest in a later round.
-            replay = subprocess.Popen(
+            replay = nodes.add(subprocess.Popen(
                 [sys.executable, '-m', 'linkage_kinematics.cli.replay', str(bag), '--loop'],
-                cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 1), stdout=output,
+                cwd=REPOSITORY, env=ros_environment(other_domain_id), stdout=output,
                 stderr=subprocess.STDOUT,
-            )
+            ), tmp_path / 'replay.log')
         try:
             assert listener.spin_until(
                 lambda: listener.heard_every_topic()
                 and len({stamp_ns(m) for m in states}) == len(logged_states)
             ), (tmp_path / 'replay.log').read_text()
-            replay.send_signal(signal.SIGINT)
-            assert replay.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / 'replay.log').read_text()
+            assert nodes.interrupt(replay) == 0, (tmp_path / 'replay.log').read_text()
         finally:
-            stop_process(replay)
             listener.destroy()
     received = listener.received
     for message in states:
@@ -798,27 +793,27 @@ def test_replay_republishes_the_logged_run(node_run: dict[str, Any], tmp_path: P
     assert received['/robot_description'][0].data == logged['/robot_description'][0][1].data
 
 
-def test_replay_loops_until_interrupted(node_run: dict[str, Any], tmp_path: Path) -> None:
+def test_replay_loops_until_interrupted(
+    node_run: dict[str, Any], nodes: NodeProcesses, other_domain_id: int, tmp_path: Path
+) -> None:
     bag = node_run['bag']
     logged_states = len(read_with_rosbags(bag)['/linkage/state'])
-    with ros_context(DOMAIN_ID + 2) as context:
+    with ros_context(other_domain_id) as context:
         listener = Listener('replay_loop_listener', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         with open(tmp_path / 'replay.log', 'w') as output:
-            replay = subprocess.Popen(
+            replay = nodes.add(subprocess.Popen(
                 [sys.executable, '-m', 'linkage_kinematics.cli.replay', str(bag), '--loop',
                  '--rate', '4', '--topics', '/linkage/state'],
-                cwd=REPOSITORY, env=ros_environment(DOMAIN_ID + 2), stdout=output,
+                cwd=REPOSITORY, env=ros_environment(other_domain_id), stdout=output,
                 stderr=subprocess.STDOUT,
-            )
+            ), tmp_path / 'replay.log')
         try:
             assert listener.spin_until(
                 lambda: len(listener.received['/linkage/state']) > 2 * logged_states
             )
-            replay.send_signal(signal.SIGINT)
-            assert replay.wait(timeout=PROCESS_TIMEOUT) == 0
+            assert nodes.interrupt(replay) == 0
         finally:
-            stop_process(replay)
             listener.destroy()
     output_text = (tmp_path / 'replay.log').read_text()
     assert 'Traceback' not in output_text and 'published' in output_text

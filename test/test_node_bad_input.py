@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 import math
-import signal
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
@@ -38,8 +37,6 @@ from node_process import (
     PROCESS_TIMEOUT,
     ros_context,
     stamp_ns,
-    start_node,
-    stop_process,
 )
 import numpy as np
 import pytest
@@ -48,7 +45,6 @@ from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
-DOMAIN_ID = 70
 PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.941°, clockwise from 0
 DEFAULTS = {spec.name: spec.default for spec in parameter_specs('paper')}
@@ -197,20 +193,18 @@ START_UP_CASES = {
 }
 
 
-def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(tmp_path):
+def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
+    nodes, tmp_path
+):
     # All at once: each process ends during start-up, so they cannot disturb each other.
     runs = {}
     for case, (name, value) in START_UP_CASES.items():
         folder = tmp_path / case.replace(' ', '_')
         folder.mkdir()
-        runs[case] = (start_node({name: value, 'log.folder': str(folder / 'bags')}, DOMAIN_ID,
-                                 folder / 'node.log'), folder)
-    try:
-        statuses = {case: process.wait(timeout=PROCESS_TIMEOUT)
-                    for case, (process, _) in runs.items()}
-    finally:
-        for process, _ in runs.values():
-            stop_process(process)
+        runs[case] = (nodes.start({name: value, 'log.folder': str(folder / 'bags')},
+                                  folder / 'node.log'), folder)
+    statuses = {case: process.wait(timeout=PROCESS_TIMEOUT)
+                for case, (process, _) in runs.items()}
     for case, (name, _) in START_UP_CASES.items():
         folder = runs[case][1]
         output = (folder / 'node.log').read_text()
@@ -226,14 +220,14 @@ def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
 # --- run time: every bad value through the parameter service, logging on -----------------------
 
 
-def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_path):
+def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(nodes, tmp_path):
     bags = tmp_path / 'bags'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('bad_input_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         states = listener.received['/linkage/state']
-        process = start_node({'end_behavior': 'loop', 'log.folder': str(bags)}, DOMAIN_ID,
-                             tmp_path / 'node.log')
+        process = nodes.start({'end_behavior': 'loop', 'log.folder': str(bags)},
+                              tmp_path / 'node.log')
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -266,10 +260,8 @@ def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_p
             after_rejections = len(states)
             assert listener.spin_until(lambda: len(states) > after_rejections + 20)
             assert process.poll() is None
-            process.send_signal(signal.SIGINT)
-            status = process.wait(timeout=PROCESS_TIMEOUT)
+            status = nodes.interrupt(process)
         finally:
-            stop_process(process)
             listener.destroy()
 
     assert status == 0, (tmp_path / 'node.log').read_text()
@@ -340,7 +332,9 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
         f'alpha_end = {math.degrees(-0.1):.6f}°: it reverses')
 
 
-def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(tmp_path):
+def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(
+    nodes, tmp_path
+):
     """
     Drive the paper's mechanism clockwise from 0 into its dead point at ≈ −1.941°.
 
@@ -349,18 +343,18 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
     """
     warning = math.radians(3.0)  # the whole pass lies within 3° of the dead point
     drive = DriveLaw(-0.05)  # 0.68 s from 0 to the dead point
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('dead_point_tester', context)
         for topic, msg_type in (('/diagnostics', DiagnosticArray),
                                 ('/linkage/state', JointTrajectory),
                                 ('/joint_states', JointState)):
             listener.subscribe(topic, msg_type)
         diagnostics = listener.received['/diagnostics']
-        process = start_node(
+        process = nodes.start(
             {'end_behavior': 'loop', 'omega0': drive.omega0, 'alpha_end': -0.1,
              'rate_hz': 200.0, 'diagnostics.dead_point_warning': warning,
              'log.folder': str(tmp_path / 'bags')},
-            DOMAIN_ID, tmp_path / 'node.log')
+            tmp_path / 'node.log')
 
         def errors(behavior: str) -> list[DiagnosticArray]:
             return [array for array in diagnostics
@@ -383,7 +377,6 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
             listener.drain()
             status = process.wait(timeout=PROCESS_TIMEOUT)
         finally:
-            stop_process(process)
             listener.destroy()
 
     output = (tmp_path / 'node.log').read_text()

@@ -20,7 +20,8 @@ STUBBORN = [sys.executable, '-c', (
     'time.sleep(600)\n'
 )]
 # Deadlines short enough for a test that waits through all of them, long enough to be kept.
-QUICK = ((int(signal.SIGINT), 2.0), (int(signal.SIGTERM), 2.0), (int(signal.SIGKILL), PROCESS_TIMEOUT))
+QUICK = ((int(signal.SIGINT), 2.0), (int(signal.SIGTERM), 2.0),
+         (int(signal.SIGKILL), PROCESS_TIMEOUT))
 
 
 def _stubborn() -> subprocess.Popen:
