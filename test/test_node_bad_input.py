@@ -14,6 +14,7 @@ message), and the dead point under 'loop', 'bounce' and 'stop'.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 import math
 
@@ -332,6 +333,71 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
         f'alpha_end = {math.degrees(-0.1):.6f}°: it reverses')
 
 
+def _assert_errors_at_and_warnings_before_the_dead_point(
+    diagnostics: list[DiagnosticArray], errors: Callable[[str], list[DiagnosticArray]],
+    warning: float,
+) -> None:
+    """Each end behavior's ERROR at the dead point says what it does; WARN before it, moving."""
+    where = f'the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}°'
+    for behavior, outcome in (('loop', 'restarts from alpha_start'), ('bounce', 'reverses'),
+                              ('stop', 'stops')):
+        assert errors(behavior), behavior
+        for error in (array.status[0] for array in errors(behavior)):
+            assert error.message.startswith(where), error.message
+            assert f': it {outcome}' in error.message
+            # The last state shown is just before the dead point, on the reachable side.
+            alpha = float(_values(error)['alpha (rad)'])
+            assert DEAD_POINT < alpha < DEAD_POINT + 0.01
+    # Before it, while moving: WARN, saying how close the dead point is and that it lies ahead.
+    moving = [array.status[0] for array in diagnostics
+              if array.status[0].level != DiagnosticStatus.ERROR
+              and 'alpha (rad)' in _values(array.status[0])]
+    assert any(_values(status_message)['end behavior'] == 'bounce' for status_message in moving)
+    for status_message in moving:
+        assert status_message.level == DiagnosticStatus.WARN
+        distance = math.radians(float(_values(status_message)['dead point distance (deg)']))
+        assert distance < warning
+        assert 'from a dead point' in status_message.message
+        assert 'before alpha_end' in status_message.message
+
+
+def _assert_bounce_turns_at_the_dead_point_and_at_alpha_start(
+    states: list[JointTrajectory], errors: Callable[[str], list[DiagnosticArray]],
+    drive: DriveLaw,
+) -> None:
+    """
+    Between two turns at the dead point, 'bounce' runs back to alpha_start and out again.
+
+    Back: |α| decreasing, ω > 0; out: the reverse.
+    """
+    first_turn, second_turn = (stamp_ns(array) for array in errors('bounce')[:2])
+    # The ERROR carries the stamp of the tick that met the dead point, as does that tick's state.
+    cycle = [message.points[0] for message in states
+             if first_turn < stamp_ns(message) < second_turn]
+    assert len(cycle) > 100
+    alphas_in_cycle = [point.positions[0] for point in cycle]
+    speeds = [point.velocities[0] for point in cycle]
+    peak = alphas_in_cycle.index(max(alphas_in_cycle))
+    # The crank turned at the dead point somewhere after the last state before the turn, and
+    # runs back at |ω| = 0.05 rad/s: its first state back lies within what it can turn since then
+    # (a bound from the stamps, so that a late tick on a busy machine cannot fail it).
+    last_before_turn = max(stamp_ns(message) for message in states
+                           if stamp_ns(message) < first_turn)
+    first_back = min(stamp_ns(message) for message in states if stamp_ns(message) > first_turn)
+    turnable = abs(drive.omega0) * (first_back - last_before_turn) * 1e-9
+    assert 0.0 < alphas_in_cycle[0] - DEAD_POINT <= turnable + 1e-12
+    # The turn at alpha_start = 0 lies between the peak's neighbours; likewise bounded by stamps.
+    stamps_in_cycle = [stamp_ns(message) for message in states
+                       if first_turn < stamp_ns(message) < second_turn]
+    widest_gap = max(stamps_in_cycle[peak + 1] - stamps_in_cycle[peak],
+                     stamps_in_cycle[peak] - stamps_in_cycle[peak - 1])
+    assert -abs(drive.omega0) * widest_gap * 1e-9 - 1e-12 <= alphas_in_cycle[peak] <= 0.0
+    assert all(b > a for a, b in zip(alphas_in_cycle[:peak], alphas_in_cycle[1:peak + 1]))
+    assert all(b < a for a, b in zip(alphas_in_cycle[peak:], alphas_in_cycle[peak + 1:]))
+    assert all(speed > 0.0 for speed in speeds[:peak])
+    assert all(speed < 0.0 for speed in speeds[peak + 1:])
+
+
 def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(
     nodes, tmp_path
 ):
@@ -381,27 +447,7 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
 
     output = (tmp_path / 'node.log').read_text()
     assert status == 1, output
-    where = f'the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}°'
-    for behavior, outcome in (('loop', 'restarts from alpha_start'), ('bounce', 'reverses'),
-                              ('stop', 'stops')):
-        assert errors(behavior), behavior
-        for error in (array.status[0] for array in errors(behavior)):
-            assert error.message.startswith(where), error.message
-            assert f': it {outcome}' in error.message
-            # The last state shown is just before the dead point, on the reachable side.
-            alpha = float(_values(error)['alpha (rad)'])
-            assert DEAD_POINT < alpha < DEAD_POINT + 0.01
-    # Before it, while moving: WARN, saying how close the dead point is and that it lies ahead.
-    moving = [array.status[0] for array in diagnostics
-              if array.status[0].level != DiagnosticStatus.ERROR
-              and 'alpha (rad)' in _values(array.status[0])]
-    assert any(_values(status_message)['end behavior'] == 'bounce' for status_message in moving)
-    for status_message in moving:
-        assert status_message.level == DiagnosticStatus.WARN
-        distance = math.radians(float(_values(status_message)['dead point distance (deg)']))
-        assert distance < warning
-        assert 'from a dead point' in status_message.message
-        assert 'before alpha_end' in status_message.message
+    _assert_errors_at_and_warnings_before_the_dead_point(diagnostics, errors, warning)
 
     states = listener.received['/linkage/state']
     joint_states = listener.received['/joint_states']
@@ -414,34 +460,7 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
                                                                         point.velocities[0])))
         assert tuple(point.positions[:3]) == (state.alpha, state.beta, state.gamma)
         assert tuple(point.velocities[:3]) == (state.omega, -state.omega_bc, state.omega_ab)
-    # Bounce, between two turns at the dead point: back from it to alpha_start (|α| decreasing,
-    # ω > 0), then out again.
-    first_turn, second_turn = (stamp_ns(array) for array in errors('bounce')[:2])
-    # The ERROR carries the stamp of the tick that met the dead point, as does that tick's state.
-    cycle = [message.points[0] for message in states
-             if first_turn < stamp_ns(message) < second_turn]
-    assert len(cycle) > 100
-    alphas_in_cycle = [point.positions[0] for point in cycle]
-    speeds = [point.velocities[0] for point in cycle]
-    peak = alphas_in_cycle.index(max(alphas_in_cycle))
-    # The crank turned at the dead point somewhere after the last state before the turn, and
-    # runs back at |ω| = 0.05 rad/s: its first state back lies within what it can turn since then
-    # (a bound from the stamps, so that a late tick on a busy machine cannot fail it).
-    last_before_turn = max(stamp_ns(message) for message in states
-                           if stamp_ns(message) < first_turn)
-    first_back = min(stamp_ns(message) for message in states if stamp_ns(message) > first_turn)
-    turnable = abs(drive.omega0) * (first_back - last_before_turn) * 1e-9
-    assert 0.0 < alphas_in_cycle[0] - DEAD_POINT <= turnable + 1e-12
-    # The turn at alpha_start = 0 lies between the peak's neighbours; likewise bounded by stamps.
-    stamps_in_cycle = [stamp_ns(message) for message in states
-                       if first_turn < stamp_ns(message) < second_turn]
-    widest_gap = max(stamps_in_cycle[peak + 1] - stamps_in_cycle[peak],
-                     stamps_in_cycle[peak] - stamps_in_cycle[peak - 1])
-    assert -abs(drive.omega0) * widest_gap * 1e-9 - 1e-12 <= alphas_in_cycle[peak] <= 0.0
-    assert all(b > a for a, b in zip(alphas_in_cycle[:peak], alphas_in_cycle[1:peak + 1]))
-    assert all(b < a for a, b in zip(alphas_in_cycle[peak:], alphas_in_cycle[peak + 1:]))
-    assert all(speed > 0.0 for speed in speeds[:peak])
-    assert all(speed < 0.0 for speed in speeds[peak + 1:])
+    _assert_bounce_turns_at_the_dead_point_and_at_alpha_start(states, errors, drive)
     # Stop: the run ends just before the dead point.
     # (as close as the last tick before it came: 0.01 rad is 0.2 s at |ω| = 0.05 rad/s, so a tick
     # late on a busy machine cannot fail this)
