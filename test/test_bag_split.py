@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 import time
 
+from bag_files import only_bag
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.errors import BagError
@@ -38,7 +39,6 @@ import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosbags.rosbag2 import Reader
 from std_msgs.msg import String
-from test_bag_writer import only_bag
 
 LATCHED = ('/robot_description', '/tf_static', '/diagnostics')
 # the node's topics and the TF robot_state_publisher would publish (logged only)

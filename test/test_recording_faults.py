@@ -21,6 +21,15 @@ import sys
 import time
 from typing import Any
 
+from bag_files import (
+    bag_information,
+    listen_to_node_topics,
+    LOGGED_TOPICS,
+    only_bag,
+    read_with_rosbags,
+    stopped,
+    topic_counts,
+)
 from diagnostic_msgs.msg import DiagnosticStatus
 from linkage_kinematics.bag import reader as bag_reader
 from mcap.exceptions import EndOfFile
@@ -36,19 +45,10 @@ from node_process import (
     ros_context,
     ros_environment,
     stamp_ns,
+    TYPESTORE,
 )
 import pytest
 from rosbags.rosbag2 import Reader
-from test_bag_writer import (
-    bag_information,
-    listen_to_node_topics,
-    LOGGED_TOPICS,
-    only_bag,
-    read_with_rosbags,
-    stopped,
-    topic_counts,
-    TYPESTORE,
-)
 
 LOOP_PARAMETERS = {'rate_hz': 200.0, 'end_behavior': 'loop'}
 

@@ -15,11 +15,11 @@ from pathlib import Path
 import statistics
 import time
 
+from bag_files import bag_information, only_bag, topic_counts
 from linkage_kinematics.bag import reader as bag_reader
-from node_process import NodeProcesses
+from node_process import NodeProcesses, TYPESTORE
 import pytest
 from rosbags.rosbag2 import Reader
-from test_bag_writer import bag_information, only_bag, topic_counts, TYPESTORE
 
 RATE_HZ = 1000.0
 SOAK_SECONDS = float(os.environ.get('LINKAGE_SOAK_SECONDS', '600'))
