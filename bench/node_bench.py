@@ -11,6 +11,7 @@ objects in this process so each part can be timed alone, next to a bare rclpy pu
 
 from __future__ import annotations
 
+from collections.abc import Callable
 import json
 import math
 import os
@@ -158,6 +159,89 @@ def memory_run(minutes: float, domain_base: int) -> str:
 
 # --- cost per tick, in this process ---------------------------------------------------------
 
+def _tick_parts(logging_node: Any, quiet_node: Any, bare_publisher: Any,
+                count: int) -> dict[str, Callable[[], int]]:
+    """
+    Return ``tick_split``'s parts: each does its part of a tick ``count`` times.
+
+    With the logging node's configuration, encoders, publishers and recorder, both nodes' whole
+    ticks and the bare publisher.
+    """
+    from linkage_kinematics.kinematics.solver import solve
+    from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
+    from linkage_kinematics.ros import messages
+    from linkage_kinematics.run.motion import sample_at_time, solve_sample
+    from rclpy.serialization import deserialize_message
+    from sensor_msgs.msg import JointState
+
+    config = logging_node.config
+    recorder = logging_node.outputs.recorder
+    publishers = logging_node.outputs._publishers
+    clock = logging_node.get_clock()
+    elapsed = [i * 1e-3 for i in range(count)]
+    samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
+    state = solve_sample(config, samples[0])
+    stamp = clock.now()
+    names = list(DEFAULT_JOINT_NAMES.values())
+    positions, velocities = tree_values(state, Driver.CRANK)
+    joint_state_encoder = messages.JointStateEncoder(names)
+    state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
+    joint_state_data = joint_state_encoder.encode(stamp.nanoseconds, positions, velocities)
+    trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
+    # the node's own JointState, as a subscriber's rclpy decodes it
+    bare_message = deserialize_message(joint_state_data, JointState)
+
+    def compute() -> int:
+        for sample in samples:
+            solve_sample(config, sample)
+        return count
+
+    def solve_only() -> int:
+        for sample in samples:
+            solve(config.linkage, sample.alpha, config.drive, config.branch)
+        return count
+
+    def encode() -> int:
+        for _ in range(count):
+            nanoseconds = clock.now().nanoseconds
+            joint_state_encoder.encode(nanoseconds, positions, velocities)
+            state_encoder.encode(state, nanoseconds, 0.0)
+        return count
+
+    def publish() -> int:
+        for _ in range(count):
+            publishers.joint_states.publish(joint_state_data)
+            publishers.state.publish(trajectory_data)
+        return count
+
+    def record() -> int:
+        for index in range(count):
+            recorder.record('/joint_states', joint_state_data, index)
+            recorder.record('/linkage/state', trajectory_data, index)
+        return count
+
+    def tick(node: Any) -> int:
+        for _ in range(count):
+            node._source.tick()
+        return count
+
+    def bare() -> int:
+        for _ in range(count):
+            bare_publisher.publish(bare_message)
+        return count
+
+    return {
+        'compute: sample_at_time + solve_sample (kinematics.solve)': compute,
+        '  of which kinematics.solve alone': solve_only,
+        "encode: the node's encoders of both messages, with clock.now()": encode,
+        'publish: both encoded messages': publish,
+        'log: Recorder.record of both encoded messages': record,
+        'whole tick, logging on (DriveLawTimer.tick)': lambda: tick(logging_node),
+        'whole tick, logging off (DriveLawTimer.tick)': lambda: tick(quiet_node),
+        'bare rclpy publish of the same JointState': bare,
+    }
+
+
 def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, dict[str, float]]:
     """
     Median time of each part of the node's tick and of a bare rclpy publish, side by side.
@@ -166,14 +250,9 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     topic, so both publishes really send over loopback.
     """
     os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
-    from linkage_kinematics.kinematics.solver import solve
-    from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
-    from linkage_kinematics.ros import messages
     from linkage_kinematics.ros.node import LinkageNode
-    from linkage_kinematics.run.motion import sample_at_time, solve_sample
     import rclpy
     from rclpy.parameter import Parameter
-    from rclpy.serialization import deserialize_message
     from sensor_msgs.msg import JointState
 
     count = 300 if quick else 1500
@@ -194,74 +273,8 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             bare_node = rclpy.create_node('bench_bare_publisher')
             nodes.append(bare_node)
             bare_publisher = bare_node.create_publisher(JointState, '/bench/joint_states', 10)
-            config = logging_node.config
-            recorder = logging_node.outputs.recorder
-            publishers = logging_node.outputs._publishers
-            clock = logging_node.get_clock()
-            elapsed = [i * 1e-3 for i in range(count)]
-            samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
-            state = solve_sample(config, samples[0])
-            stamp = clock.now()
-            names = list(DEFAULT_JOINT_NAMES.values())
-            positions, velocities = tree_values(state, Driver.CRANK)
-            joint_state_encoder = messages.JointStateEncoder(names)
-            state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
-            joint_state_data = joint_state_encoder.encode(stamp.nanoseconds, positions,
-                                                          velocities)
-            trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
-            # the node's own JointState, as a subscriber's rclpy decodes it
-            bare_message = deserialize_message(joint_state_data, JointState)
+            parts = _tick_parts(logging_node, quiet_node, bare_publisher, count)
             time.sleep(STARTUP_S)  # let the listener match both publishers
-
-            def compute() -> int:
-                for sample in samples:
-                    solve_sample(config, sample)
-                return count
-
-            def solve_only() -> int:
-                for sample in samples:
-                    solve(config.linkage, sample.alpha, config.drive, config.branch)
-                return count
-
-            def encode() -> int:
-                for _ in range(count):
-                    nanoseconds = clock.now().nanoseconds
-                    joint_state_encoder.encode(nanoseconds, positions, velocities)
-                    state_encoder.encode(state, nanoseconds, 0.0)
-                return count
-
-            def publish() -> int:
-                for _ in range(count):
-                    publishers.joint_states.publish(joint_state_data)
-                    publishers.state.publish(trajectory_data)
-                return count
-
-            def record() -> int:
-                for index in range(count):
-                    recorder.record('/joint_states', joint_state_data, index)
-                    recorder.record('/linkage/state', trajectory_data, index)
-                return count
-
-            def tick(node: LinkageNode) -> int:
-                for _ in range(count):
-                    node._source.tick()
-                return count
-
-            def bare() -> int:
-                for _ in range(count):
-                    bare_publisher.publish(bare_message)
-                return count
-
-            parts = {
-                'compute: sample_at_time + solve_sample (kinematics.solve)': compute,
-                '  of which kinematics.solve alone': solve_only,
-                "encode: the node's encoders of both messages, with clock.now()": encode,
-                'publish: both encoded messages': publish,
-                'log: Recorder.record of both encoded messages': record,
-                'whole tick, logging on (DriveLawTimer.tick)': lambda: tick(logging_node),
-                'whole tick, logging off (DriveLawTimer.tick)': lambda: tick(quiet_node),
-                'bare rclpy publish of the same JointState': bare,
-            }
             times = interleaved_medians(parts, repetitions)
         finally:
             for node in nodes:

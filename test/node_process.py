@@ -4,19 +4,23 @@
 """
 Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
 
-Every test module that starts nodes uses its own ROS_DOMAIN_ID so that tests
-running at the same time never see each other's nodes.
+Every test module that starts nodes runs in its own ROS_DOMAIN_ID (``domain_lease``, the
+``domain_id`` fixture), so that tests never see each other's nodes; every process a test starts
+through ``NodeProcesses`` (the ``nodes`` fixture) has ended when the test has.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
+import fcntl
 import math
 import os
 from pathlib import Path
+import signal
 import subprocess
 import sys
+import tempfile
 import time
 from typing import Any
 
@@ -24,6 +28,7 @@ from builtin_interfaces.msg import Time
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.run.parameter_specs import parameter_specs
+import pytest
 import rclpy
 from rclpy.executors import SingleThreadedExecutor
 from rclpy.node import Node
@@ -39,6 +44,53 @@ REPOSITORY = Path(__file__).resolve().parent.parent
 PROCESS_TIMEOUT = 60.0
 # The message types of ROS 2 Jazzy, as rosbags knows them independently of rclpy.
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+# The ROS_DOMAIN_IDs the tests take: those whose DDS ports stay below Linux's ephemeral range,
+# but 0, the default, which other ROS programs on the machine use.
+DOMAIN_IDS = range(1, 102)
+# One lock file per id: a test run holds the id's lock (flock) while it uses it, so that two runs
+# on one machine at once (two worktrees, a rerun started before the last ended) never share one.
+DOMAIN_LOCKS = Path(tempfile.gettempdir()) / 'linkage_kinematics-ros-domains'
+# How long a process that outlived its test gets after each signal of the teardown (s): SIGINT is
+# how the node is meant to end (it finalizes its bag), SIGTERM and SIGKILL are the escalation.
+STOP_TIMEOUTS = ((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, PROCESS_TIMEOUT))
+
+
+class _DomainIds:
+    """Hands out the ROS_DOMAIN_IDs no other holder (here or in another test run) has."""
+
+    def __init__(self) -> None:
+        # Ids go round: the next lease starts after the last one taken, so a module (or a rerun)
+        # never gets the id its predecessor just gave back.
+        self.last = DOMAIN_IDS[-1]
+
+    def take(self) -> tuple[int, int]:
+        """Lock the next free id; return it and the lock's file descriptor."""
+        DOMAIN_LOCKS.mkdir(exist_ok=True)
+        start = DOMAIN_IDS.index(self.last) + 1
+        for offset in range(len(DOMAIN_IDS)):
+            domain_id = DOMAIN_IDS[(start + offset) % len(DOMAIN_IDS)]
+            descriptor = os.open(DOMAIN_LOCKS / f'{domain_id}', os.O_RDWR | os.O_CREAT, 0o666)
+            try:
+                fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(descriptor)
+                continue
+            self.last = domain_id
+            return domain_id, descriptor
+        raise RuntimeError(f'every ROS_DOMAIN_ID in {DOMAIN_IDS} is held by another test run')
+
+
+_DOMAIN_IDS = _DomainIds()
+
+
+@contextmanager
+def domain_lease() -> Iterator[int]:
+    """Hold a ROS_DOMAIN_ID that no other test, and no other test run, holds meanwhile."""
+    domain_id, descriptor = _DOMAIN_IDS.take()
+    try:
+        yield domain_id
+    finally:
+        os.close(descriptor)  # which releases the lock
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:
@@ -107,23 +159,87 @@ def start_node(
         )
 
 
-def stop_process(process: subprocess.Popen) -> None:
-    """Make sure a node process has ended (for test teardown)."""
-    if process.poll() is None:
-        process.kill()
-        process.wait(timeout=PROCESS_TIMEOUT)
+def end_process(
+    process: subprocess.Popen, stop_timeouts: Sequence[tuple[int, float]] = STOP_TIMEOUTS
+) -> list[str]:
+    """
+    End ``process`` if it still runs: SIGINT, then SIGTERM, then SIGKILL, each with a deadline.
+
+    Return the signals it outlived (empty when it had ended or ended on the first).
+    """
+    outlived = []
+    for signal_number, timeout in stop_timeouts:
+        if process.poll() is not None:
+            break
+        process.send_signal(signal_number)
+        try:
+            process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            outlived.append(signal.Signals(signal_number).name)
+    return outlived
 
 
-def run_node(
-    parameters: Mapping[str, Any], domain_id: int, output: Path, ros_arguments: Sequence[str] = ()
-) -> tuple[int, str]:
-    """Run a node to its end; return its exit status and output."""
-    process = start_node(parameters, domain_id, output, ros_arguments=ros_arguments)
-    try:
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
-    return status, output.read_text()
+class NodeProcesses:
+    """
+    The processes one test starts (the ``nodes`` fixture), all ended by ``finish``.
+
+    ``finish`` runs after the test whatever it did, so a failing test leaves no process behind,
+    and a process that needed more than SIGINT is reported as a teardown error beside (not
+    instead of) the test's own failure.
+    """
+
+    def __init__(
+        self, domain_id: int, stop_timeouts: Sequence[tuple[int, float]] = STOP_TIMEOUTS
+    ) -> None:
+        self.domain_id = domain_id
+        self.stop_timeouts = stop_timeouts
+        self.processes: list[tuple[subprocess.Popen, str]] = []
+
+    def add(self, process: subprocess.Popen, output: Path | None = None) -> subprocess.Popen:
+        """Have ``process`` (started elsewhere, e.g. an encoder) ended with the test's."""
+        self.processes.append((process, f' (output in {output})' if output else ''))
+        return process
+
+    def start(
+        self, parameters: Mapping[str, Any], output: Path, **options: Any
+    ) -> subprocess.Popen:
+        """``start_node`` in the test's domain, ended with the test at the latest."""
+        return self.add(start_node(parameters, self.domain_id, output, **options), output)
+
+    def run(
+        self, parameters: Mapping[str, Any], output: Path, ros_arguments: Sequence[str] = ()
+    ) -> tuple[int, str]:
+        """Run a node to its end; return its exit status and output."""
+        process = self.start(parameters, output, ros_arguments=ros_arguments)
+        return process.wait(timeout=PROCESS_TIMEOUT), output.read_text()
+
+    @staticmethod
+    def interrupt(
+        process: subprocess.Popen, signal_number: int = signal.SIGINT,
+        timeout: float = PROCESS_TIMEOUT,
+    ) -> int:
+        """Send SIGINT (or ``signal_number``) and wait: the exit status."""
+        process.send_signal(signal_number)
+        return process.wait(timeout=timeout)
+
+    def stop_all(self) -> list[str]:
+        """End every process still running; describe each that SIGINT did not end."""
+        problems = []
+        for process, output in self.processes:
+            outlived = end_process(process, self.stop_timeouts)
+            if outlived:
+                still = ', still running' if process.poll() is None else ''
+                # the module of a `python -m`, else the program
+                command = process.args[2] if process.args[1:2] == ['-m'] else process.args[0]
+                problems.append(f"{command} (pid {process.pid}) outlived {', '.join(outlived)}"
+                                f'{still}{output}')
+        return problems
+
+    def finish(self) -> None:
+        """End every process; fail the teardown if one needed more than SIGINT."""
+        problems = self.stop_all()
+        if problems:
+            pytest.fail('teardown: ' + '; '.join(problems), pytrace=False)
 
 
 def bag_writer_pid(node_pid: int) -> int:

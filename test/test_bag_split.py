@@ -16,9 +16,9 @@ from collections import Counter
 import errno
 import os
 from pathlib import Path
-import signal
 import time
 
+from bag_files import only_bag
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.errors import BagError
@@ -31,19 +31,15 @@ from linkage_kinematics.bag.recovery import recover_bag
 from linkage_kinematics.bag.writer import BagWriter, MIN_SPLIT_SIZE
 from mcap_ros2.reader import read_ros2_messages
 from node_process import (
+    NodeProcesses,
     PROCESS_TIMEOUT,
-    run_node,
-    start_node,
-    stop_process,
     TYPESTORE,
 )
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosbags.rosbag2 import Reader
 from std_msgs.msg import String
-from test_bag_writer import only_bag
 
-DOMAIN_ID = 86
 LATCHED = ('/robot_description', '/tf_static', '/diagnostics')
 # the node's topics and the TF robot_state_publisher would publish (logged only)
 LOGGED_TOPICS = ('/joint_states', '/linkage/state', '/robot_description', '/linkage/markers',
@@ -198,12 +194,14 @@ def test_recovery_completes_every_file_of_a_split_bag(tmp_path: Path) -> None:
     assert BagMetadata.read(bag).custom_data['run'] == 'killed'
 
 
-def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: Path) -> None:
+def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
     """The seed's 0.785 s turn in files of 0.2 s: each holds the URDF and a status."""
     folder = tmp_path / 'bags'
-    status, output = run_node(
+    status, output = nodes.run(
         {'log.folder': str(folder), 'log.max_bag_duration': 0.2, 'rate_hz': 200.0,
-         'end_behavior': 'stop'}, DOMAIN_ID, tmp_path / 'node.log')
+         'end_behavior': 'stop'}, tmp_path / 'node.log')
     assert status == 0, output
     bag = only_bag(folder)
     files = assert_metadata_lists_every_file(bag)
@@ -228,7 +226,7 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(tmp_path: 
     assert nanoseconds[-1] - nanoseconds[0] == round(0.5 * 3.141592653589793 / 2.0 * 1e9)
 
 
-def test_a_node_splits_its_bag_by_size(tmp_path: Path) -> None:
+def test_a_node_splits_its_bag_by_size(nodes: NodeProcesses, tmp_path: Path) -> None:
     """
     A looping node in files of 4 KiB: split at each flushed chunk.
 
@@ -236,20 +234,16 @@ def test_a_node_splits_its_bag_by_size(tmp_path: Path) -> None:
     above 1 KiB, so there every message would start a file before the status was logged once.
     """
     folder = tmp_path / 'bags'
-    process = start_node(
+    process = nodes.start(
         {'log.folder': str(folder), 'log.max_bag_size': 4 * MIN_SPLIT_SIZE, 'rate_hz': 200.0,
-         'end_behavior': 'loop'}, DOMAIN_ID + 1, tmp_path / 'node.log')
-    try:
-        deadline = time.monotonic() + PROCESS_TIMEOUT
-        while time.monotonic() < deadline:
-            bags = list(folder.glob('*/metadata.yaml')) if folder.exists() else []
-            if bags and len(BagMetadata.read(bags[0].parent).relative_file_paths) >= 3:
-                break
-            time.sleep(0.1)
-        process.send_signal(signal.SIGINT)
-        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / 'node.log').read_text()
-    finally:
-        stop_process(process)
+         'end_behavior': 'loop'}, tmp_path / 'node.log')
+    deadline = time.monotonic() + PROCESS_TIMEOUT
+    while time.monotonic() < deadline:
+        bags = list(folder.glob('*/metadata.yaml')) if folder.exists() else []
+        if bags and len(BagMetadata.read(bags[0].parent).relative_file_paths) >= 3:
+            break
+        time.sleep(0.1)
+    assert nodes.interrupt(process) == 0, (tmp_path / 'node.log').read_text()
     files = assert_metadata_lists_every_file(only_bag(folder))
     assert len(files) >= 3
     for logged in files:

@@ -23,7 +23,7 @@ from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
 from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
-from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
+from node_process import NodeProcesses, PROCESS_TIMEOUT, REPOSITORY
 import numpy as np
 import pytest
 from rosbags.rosbag2 import Reader
@@ -31,7 +31,6 @@ from rosbags.typesys import get_typestore, Stores
 import urchin
 import yaml
 
-DOMAIN_ID = 41
 NAMESPACE = '/left'
 FRAME_PREFIX = 'left/'
 TF_TYPE = 'tf2_msgs/msg/TFMessage'
@@ -220,19 +219,17 @@ def test_tf_message_encoders_write_what_rosbags_serializes() -> None:
 
 
 @pytest.fixture(scope='module')
-def namespaced_bag(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def namespaced_bag(
+    tmp_path_factory: pytest.TempPathFactory, module_nodes: NodeProcesses
+) -> Path:
     """Return the bag folder of the seed's constant-law turn by a node in /left, frames left/…."""
     run_folder = tmp_path_factory.mktemp('tf_run')
     folder = run_folder / 'bags'
-    process = start_node(
+    process = module_nodes.start(
         {'frame_prefix': FRAME_PREFIX, 'end_behavior': 'stop', 'log.folder': str(folder)},
-        DOMAIN_ID,
         run_folder / 'node.log', ros_arguments=['-r', f'__ns:={NAMESPACE}'],
     )
-    try:
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
+    status = process.wait(timeout=PROCESS_TIMEOUT)
     assert status == 0, (run_folder / 'node.log').read_text()
     [bag] = folder.iterdir()
     return bag

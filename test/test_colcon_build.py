@@ -14,7 +14,6 @@ import os
 from pathlib import Path
 import re
 import shutil
-import signal
 import subprocess
 import sys
 
@@ -22,17 +21,18 @@ from linkage_kinematics.bag import reader as bag_reader
 from linkage_kinematics.bag.metadata import BagMetadata
 from node_process import (
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
     ros_environment,
-    start_node,
-    stop_process,
 )
 import pytest
 from sensor_msgs.msg import JointState
 
-DOMAIN_ID = 12
+# Every test here builds the package with colcon or runs what it built: ./dev test reruns one
+# that failed (conftest.py), as it does a test that talks to a node.
+pytestmark = pytest.mark.processes
 # What the nested `colcon test` runs in full: quick tests that need the test dependencies
 # (hypothesis, and mpmath through test/reference.py). Naming them keeps the nested suite from
 # running this module again, and so from nesting for ever.
@@ -123,7 +123,9 @@ def test_colcon_test_runs_the_suite_with_pytest_and_test_result_counts_it(
     assert f'Summary: {expected} tests, 0 errors, 0 failures, 0 skipped' in summary, summary
 
 
-def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: Path) -> None:
+def test_colcon_build_installs_a_node_that_publishes(
+    workspace: Path, nodes: NodeProcesses, tmp_path: Path
+) -> None:
     install = workspace / 'install'
     executable = install / 'linkage_kinematics' / 'lib' / 'linkage_kinematics' / 'linkage_node'
     assert executable.is_file() and os.access(executable, os.X_OK)
@@ -134,28 +136,25 @@ def test_colcon_build_installs_a_node_that_publishes(workspace: Path, tmp_path: 
                       'interfaces/tf2_msgs/msg/TFMessage.json'):
         assert (share / installed).is_file(), installed
 
-    environment = _colcon_environment(install, ros_environment(DOMAIN_ID))
+    environment = _colcon_environment(install, ros_environment(nodes.domain_id))
     imported = subprocess.run(
         [sys.executable, '-c', 'import linkage_kinematics.ros.node as n; print(n.__file__)'],
         cwd=tmp_path, env=environment, capture_output=True, text=True, check=True,
     ).stdout.strip()
     assert Path(imported).is_relative_to(install), imported
 
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('colcon_listener', context)
         listener.subscribe('/joint_states', JointState)
-        process = start_node(
-            {'end_behavior': 'loop', 'log.folder': str(tmp_path / 'bags')}, DOMAIN_ID,
-            tmp_path / 'node.log',
+        process = nodes.start(
+            {'end_behavior': 'loop', 'log.folder': str(tmp_path / 'bags')}, tmp_path / 'node.log',
             executable=[str(executable)], environment=environment, cwd=tmp_path,
         )
         try:
             assert listener.spin_until(lambda: len(listener.received['/joint_states']) >= 5), (
                 tmp_path / 'node.log').read_text()
-            process.send_signal(signal.SIGINT)
-            assert process.wait(timeout=PROCESS_TIMEOUT) == 0
+            assert nodes.interrupt(process) == 0
         finally:
-            stop_process(process)
             listener.destroy()
     assert list(listener.received['/joint_states'][0].name) == [
         'crank_joint', 'coupler_joint', 'rocker_joint']

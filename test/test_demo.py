@@ -10,7 +10,6 @@ with the mechanism.
 """
 
 import math
-import os
 from pathlib import Path
 import subprocess
 import sys
@@ -21,6 +20,7 @@ from linkage_kinematics.bag.reader import iter_messages, read_states
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.run.diagnostics import STATUS_PERIOD
 import matplotlib.image
+from node_process import ros_environment
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message
@@ -29,8 +29,8 @@ REPO = Path(__file__).resolve().parents[1]
 DEMO = [sys.executable, '-m', 'linkage_kinematics.cli.demo']
 
 
-def test_demo_logs_both_laws_and_prints_the_seed_tables(tmp_path: Path) -> None:
-    environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+def test_demo_logs_both_laws_and_prints_the_seed_tables(domain_id: int, tmp_path: Path) -> None:
+    environment = ros_environment(domain_id)
     completed = subprocess.run(
         [*DEMO, '--log-folder', str(tmp_path / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=300,
@@ -121,10 +121,12 @@ def test_bad_arguments_get_one_line_and_no_run(
     assert not (tmp_path / 'bags').exists()
 
 
-def test_unwritable_log_folder_is_reported_without_a_traceback(tmp_path: Path) -> None:
+def test_unwritable_log_folder_is_reported_without_a_traceback(
+    domain_id: int, tmp_path: Path
+) -> None:
     blocker = tmp_path / 'a_file'
     blocker.write_text('not a folder')
-    environment = dict(os.environ, ROS_DOMAIN_ID='91', ROS_AUTOMATIC_DISCOVERY_RANGE='LOCALHOST')
+    environment = ros_environment(domain_id)
     completed = subprocess.run(
         [*DEMO, '--log-folder', str(blocker / 'bags')],
         cwd=REPO, env=environment, capture_output=True, text=True, timeout=60,

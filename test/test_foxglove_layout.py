@@ -25,12 +25,11 @@ from linkage_kinematics.kinematics.solver import solve
 from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
-from node_process import decode, REPOSITORY, start_node, stop_process
+from node_process import decode, NodeProcesses, REPOSITORY
 import pytest
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import get_types_from_msg
 
-DOMAIN_ID = 40
 NODE_EXIT_TIMEOUT = 60.0  # s; the stop run ends by itself after 1.57 s of motion
 LAYOUT_FILE = REPOSITORY / 'foxglove' / 'linkage_layout.json'
 TITLE_KEYS = ('foxglovePanelTitle', 'lichtblickPanelTitle')
@@ -120,7 +119,9 @@ def layout_tree_panels(node: Any) -> list[str]:
 
 
 @pytest.fixture(scope='module')
-def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+def node_bag(
+    tmp_path_factory: pytest.TempPathFactory, module_nodes: NodeProcesses
+) -> dict[str, Any]:
     """
     Return the seed's variable-law turn, logged by the real node.
 
@@ -128,15 +129,12 @@ def node_bag(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """
     run_folder = tmp_path_factory.mktemp('layout_run')
     folder = run_folder / 'bags'
-    process = start_node(
+    process = module_nodes.start(
         {'omega0': SEED_VARIABLE.omega0, 'k': SEED_VARIABLE.k, 'alpha_start': 0.0,
          'alpha_end': math.pi / 2, 'end_behavior': 'stop', 'log.folder': str(folder)},
-        DOMAIN_ID, run_folder / 'node.log',
+        run_folder / 'node.log',
     )
-    try:
-        status = process.wait(timeout=NODE_EXIT_TIMEOUT)
-    finally:
-        stop_process(process)
+    status = process.wait(timeout=NODE_EXIT_TIMEOUT)
     assert status == 0, (run_folder / 'node.log').read_text()
     [mcap_file] = folder.glob('*/*.mcap')
     with open(mcap_file, 'rb') as stream:

@@ -25,12 +25,11 @@ from linkage_kinematics.bag.reader import read_states
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.run.configuration import mechanism_entries
 from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES
-from node_process import PROCESS_TIMEOUT, REPOSITORY, start_node, stop_process
+from node_process import NodeProcesses, PROCESS_TIMEOUT, REPOSITORY
 import pytest
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
 
-DOMAIN_ID = 78
 SHARE = Path(get_package_share_directory('linkage_kinematics'))
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 PYTHON_LAUNCH_FILES = ('linkage.launch.py', 'mechanisms.launch.py')
@@ -198,7 +197,9 @@ def test_mechanism_entries_come_from_the_parameters_file(tmp_path: Path) -> None
             mechanism_entries(bad)
 
 
-def _run_to_end(tmp_path: Path, parameters_file: Path, namespace: str, **overrides) -> Path:
+def _run_to_end(
+    nodes: NodeProcesses, tmp_path: Path, parameters_file: Path, namespace: str, **overrides
+) -> Path:
     """Run the node with ``--params-file`` in ``namespace`` from ``tmp_path``; its bag."""
     output = tmp_path / 'node.log'
     arguments = ['--params-file', str(parameters_file)]
@@ -206,11 +207,8 @@ def _run_to_end(tmp_path: Path, parameters_file: Path, namespace: str, **overrid
         arguments += ['-p', f'{name}:={value}']
     if namespace:
         arguments += ['-r', f'__ns:={namespace}']
-    process = start_node({}, DOMAIN_ID, output, cwd=tmp_path, ros_arguments=arguments)
-    try:
-        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, output.read_text()
-    finally:
-        stop_process(process)
+    process = nodes.start({}, output, cwd=tmp_path, ros_arguments=arguments)
+    assert process.wait(timeout=PROCESS_TIMEOUT) == 0, output.read_text()
     (bag,) = re.findall(r'bag finalized: (\S+),', output.read_text())
     return tmp_path / bag
 
@@ -219,9 +217,9 @@ def _run_to_end(tmp_path: Path, parameters_file: Path, namespace: str, **overrid
     ('constant', DriveLaw(2.0)), ('variable', DriveLaw(0.1, 2.3))])
 @pytest.mark.parametrize('namespace', ['', '/lab'])
 def test_each_seed_parameters_file_runs_the_node_to_its_end(
-    tmp_path: Path, scenario: str, drive: DriveLaw, namespace: str
+    nodes: NodeProcesses, tmp_path: Path, scenario: str, drive: DriveLaw, namespace: str
 ) -> None:
-    bag = _run_to_end(tmp_path, SHARE / 'config' / f'seed_{scenario}.yaml', namespace)
+    bag = _run_to_end(nodes, tmp_path, SHARE / 'config' / f'seed_{scenario}.yaml', namespace)
     _, states = read_states(bag)
     assert states.alpha[0] == 0.0 and states.alpha[-1] == math.pi / 2
     assert list(states.omega) == [drive.angular_velocity(alpha) for alpha in states.alpha]
@@ -229,10 +227,10 @@ def test_each_seed_parameters_file_runs_the_node_to_its_end(
 
 @pytest.mark.parametrize('namespace', ['/left', '/right'])
 def test_each_mechanism_of_the_two_mechanisms_file_takes_its_own_entry(
-    tmp_path: Path, namespace: str
+    nodes: NodeProcesses, tmp_path: Path, namespace: str
 ) -> None:
     # Its own entry loops or bounces for ever; 'stop' after it ends the run at alpha_end.
-    bag = _run_to_end(tmp_path, SHARE / 'config' / 'two_mechanisms.yaml', namespace,
+    bag = _run_to_end(nodes, tmp_path, SHARE / 'config' / 'two_mechanisms.yaml', namespace,
                       end_behavior='stop')
     assert bag.parent == tmp_path / 'bags' / namespace.strip('/')
     with Reader(bag) as reader:

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 import json
 import math
 from pathlib import Path
-import signal
 import subprocess
 import sys
 from typing import Any
@@ -35,13 +34,12 @@ from linkage_kinematics.run.measured import MeasuredFollower, Rejection
 from linkage_kinematics.run.parameter_specs import parameter_specs
 from node_process import (
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
     ros_environment,
     stamp_ns,
-    start_node,
-    stop_process,
 )
 import pytest
 from rclpy.qos import QoSProfile
@@ -55,7 +53,6 @@ from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 import yaml
 
-DOMAIN_ID = 80
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 PAPER = preset('paper').geometry
 CRANK_ROCKER = preset('grashof_crank_rocker').geometry
@@ -75,8 +72,8 @@ LAB_JOINTS = {
 
 
 @pytest.fixture(scope='module')
-def context():
-    with ros_context(DOMAIN_ID) as ros:
+def context(domain_id):
+    with ros_context(domain_id) as ros:
         yield ros
 
 
@@ -98,7 +95,7 @@ def sample(stamp: int, names: list[str], positions: list[float], velocities: lis
 
 
 @contextmanager
-def measured_node(context, tmp_path: Path, parameters: Mapping[str, Any],
+def measured_node(context, nodes: NodeProcesses, tmp_path: Path, parameters: Mapping[str, Any],
                   topic: str = '/measured_joint_states') -> Iterator[tuple[Listener, Any]]:
     """Start a measured node (remapped to ``topic``) and a listener on all its topics."""
     listener = Listener('measured_listener', context)
@@ -107,42 +104,38 @@ def measured_node(context, tmp_path: Path, parameters: Mapping[str, Any],
         listener.subscribe(name, msg_type)
     listener.subscribe('/robot_description', String, transient_local=True)
     remap = [] if topic == '/measured_joint_states' else ['-r', f'measured_joint_states:={topic}']
-    process = start_node({'source': 'measured', 'log.folder': str(tmp_path / 'bags'),
-                          **parameters}, DOMAIN_ID, tmp_path / 'node.log', ros_arguments=remap)
+    process = nodes.start({'source': 'measured', 'log.folder': str(tmp_path / 'bags'),
+                           **parameters}, tmp_path / 'node.log', ros_arguments=remap)
     try:
         assert listener.wait_for_publisher('/linkage/state'), (tmp_path / 'node.log').read_text()
         yield listener, process
     finally:
-        stop_process(process)
         listener.destroy()
 
 
-def run_encoder(tmp_path: Path, samples: list[dict[str, Any]], listener: Listener,
-                topic: str = '/measured_joint_states') -> None:
+def run_encoder(nodes: NodeProcesses, tmp_path: Path, samples: list[dict[str, Any]],
+                listener: Listener, topic: str = '/measured_joint_states') -> None:
     """Run the encoder process over ``samples`` to its end, spinning the listener meanwhile."""
     plan = tmp_path / 'samples.json'
     plan.write_text(json.dumps({'topic': topic, 'state_topic': '/linkage/state',
                                 'samples': samples}))
     with open(tmp_path / 'encoder.log', 'w') as log:
-        encoder = subprocess.Popen(
+        encoder = nodes.add(subprocess.Popen(
             [sys.executable, str(REPOSITORY / 'test' / 'encoder_process.py'), str(plan)],
-            env=ros_environment(DOMAIN_ID), stdout=log, stderr=subprocess.STDOUT)
-    try:
-        assert listener.spin_until(lambda: encoder.poll() is not None)
-        assert encoder.returncode == 0, (tmp_path / 'encoder.log').read_text()
-    finally:
-        stop_process(encoder)
+            env=ros_environment(nodes.domain_id), stdout=log, stderr=subprocess.STDOUT),
+            tmp_path / 'encoder.log')
+    assert listener.spin_until(lambda: encoder.poll() is not None)
+    assert encoder.returncode == 0, (tmp_path / 'encoder.log').read_text()
 
 
-def follow(context, tmp_path: Path, parameters: Mapping[str, Any],
+def follow(context, nodes: NodeProcesses, tmp_path: Path, parameters: Mapping[str, Any],
            samples: list[dict[str, Any]], topic: str = '/measured_joint_states') -> Run:
     """Run a measured node over the encoder's ``samples``, then end it with SIGINT."""
-    with measured_node(context, tmp_path, parameters, topic) as (listener, process):
-        run_encoder(tmp_path, samples, listener, topic)
+    with measured_node(context, nodes, tmp_path, parameters, topic) as (listener, process):
+        run_encoder(nodes, tmp_path, samples, listener, topic)
         answered = sum(item['answered'] for item in samples)
         assert listener.spin_until(lambda: len(listener.received['/linkage/state']) >= answered)
-        process.send_signal(signal.SIGINT)
-        status = process.wait(timeout=PROCESS_TIMEOUT)
+        status = nodes.interrupt(process)
         listener.drain()
     (bag,) = (tmp_path / 'bags').iterdir()
     return Run(listener.received, status, bag, (tmp_path / 'node.log').read_text())
@@ -247,7 +240,7 @@ def chain_end(urdf: str, positions: Mapping[str, float], end: float) -> tuple[fl
 # --- the crank measured under a lab's names and conventions --------------------------------
 
 
-def test_a_lab_crank_wrapping_at_pi_is_completed_to_the_reference(context, tmp_path):
+def test_a_lab_crank_wrapping_at_pi_is_completed_to_the_reference(context, nodes, tmp_path):
     """
     Three full turns of a crank-rocker, the encoder wrapping at ±π, next to an unrelated joint.
 
@@ -265,8 +258,8 @@ def test_a_lab_crank_wrapping_at_pi_is_completed_to_the_reference(context, tmp_p
         samples.append(sample(stamp, ['gripper_finger', 'knee_motor'], [0.01 * index, lab_angle],
                               [0.0, -omega]))
         crank_inputs[stamp] = (-(lab_angle - 0.4), omega, lab_angle, alpha)
-    run = follow(context, tmp_path, {'preset': 'grashof_crank_rocker',
-                                     'measured.timeout': PROCESS_TIMEOUT, **LAB_JOINTS},
+    run = follow(context, nodes, tmp_path, {'preset': 'grashof_crank_rocker',
+                                            'measured.timeout': PROCESS_TIMEOUT, **LAB_JOINTS},
                  samples, topic='/joint_states')
     assert run.status == 0, run.output
     names = ('knee_link', 'knee_output')
@@ -304,7 +297,7 @@ def test_a_lab_crank_wrapping_at_pi_is_completed_to_the_reference(context, tmp_p
 # --- the rocker as the driver -----------------------------------------------------------------
 
 
-def test_the_seed_mechanism_driven_by_its_rocker_matches_the_reference(context, tmp_path):
+def test_the_seed_mechanism_driven_by_its_rocker_matches_the_reference(context, nodes, tmp_path):
     """The seed's rocker turned through β = 0 … 86° in 0.5° steps (θ_BC = π − β), measured."""
     samples = []
     rocker_inputs = {}
@@ -314,8 +307,8 @@ def test_the_seed_mechanism_driven_by_its_rocker_matches_the_reference(context, 
         omega_bc = -1.7
         samples.append(sample(stamp, ['rocker_joint'], [theta], [omega_bc]))
         rocker_inputs[stamp] = (theta, omega_bc)
-    run = follow(context, tmp_path, {'driver': 'rocker', 'measured.timeout': PROCESS_TIMEOUT},
-                 samples)
+    run = follow(context, nodes, tmp_path,
+                 {'driver': 'rocker', 'measured.timeout': PROCESS_TIMEOUT}, samples)
     assert run.status == 0, run.output
     names = ('coupler_joint', 'crank_joint')
     assert_stamps_are_the_inputs(run, samples, names)
@@ -349,7 +342,7 @@ def test_the_seed_mechanism_driven_by_its_rocker_matches_the_reference(context, 
 
 
 def test_a_parallelogram_goes_through_its_change_points_with_estimated_velocity(
-        context, tmp_path):
+        context, nodes, tmp_path):
     """
     The parallelogram 0.3/1.0/0.3/1.0 (assembly −1 at α = 0) over two turns, positions only.
 
@@ -364,7 +357,7 @@ def test_a_parallelogram_goes_through_its_change_points_with_estimated_velocity(
         alpha = math.radians(0.5 * index)
         samples.append(sample(stamp, ['crank_joint'], [math.remainder(alpha, TWO_PI)], []))
         alphas[stamp] = alpha
-    run = follow(context, tmp_path, {
+    run = follow(context, nodes, tmp_path, {
         'preset': '', 'crank_length': 0.3, 'coupler_length': 1.0, 'rocker_length': 0.3,
         'ground_x': 1.0, 'ground_y': 0.0, 'branch': -1,
         'measured.timeout': PROCESS_TIMEOUT}, samples)
@@ -395,7 +388,7 @@ def test_a_parallelogram_goes_through_its_change_points_with_estimated_velocity(
 # --- bad samples ----------------------------------------------------------------------------
 
 
-def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, tmp_path):
+def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, nodes, tmp_path):
     """
     Each kind of bad sample between valid ones; then silence until the timeout.
 
@@ -419,9 +412,9 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, t
         sample(11 * ms, ['coupler_joint', 'rocker_joint'], [0.0, 0.0], [], answered=False),
         sample(12 * ms, crank, [0.03], [1.0]),
     ]
-    with measured_node(context, tmp_path, {'measured.max_jump': 1.0,
-                                           'measured.timeout': 2.0}) as (listener, process):
-        run_encoder(tmp_path, samples, listener)
+    with measured_node(context, nodes, tmp_path, {'measured.max_jump': 1.0,
+                                                  'measured.timeout': 2.0}) as (listener, process):
+        run_encoder(nodes, tmp_path, samples, listener)
 
         def statuses() -> list[DiagnosticStatus]:
             return [status for message in listener.received['/diagnostics']
@@ -434,8 +427,7 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, t
 
         assert listener.spin_until(timed_out)
         assert process.poll() is None, 'the node must keep running'
-        process.send_signal(signal.SIGINT)
-        assert process.wait(timeout=PROCESS_TIMEOUT) == 0
+        assert nodes.interrupt(process) == 0
         listener.drain()
     run = Run(listener.received, 0, next((tmp_path / 'bags').iterdir()),
               (tmp_path / 'node.log').read_text())
@@ -516,15 +508,16 @@ def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(
         assert chain_end(urdf, values, end[0]) == pytest.approx(end[1], abs=TOLERANCE)
 
 
-def test_the_services_pause_and_resume_following_and_autostart_false_waits(context, tmp_path):
+def test_the_services_pause_and_resume_following_and_autostart_false_waits(
+        context, nodes, tmp_path):
     """
     With autostart false nothing is followed until ~/resume; ~/pause ignores samples.
 
     Each sample is published only after the service's answer came back, so the node has acted
     on the call before the sample arrives.
     """
-    with measured_node(context, tmp_path, {'autostart': False, 'log.enabled': False,
-                                           'measured.timeout': PROCESS_TIMEOUT}) as (
+    with measured_node(context, nodes, tmp_path, {'autostart': False, 'log.enabled': False,
+                                                  'measured.timeout': PROCESS_TIMEOUT}) as (
             listener, process):
         clients = {name: listener.node.create_client(Trigger, f'/linkage_node/{name}')
                    for name in ('pause', 'resume', 'reset')}

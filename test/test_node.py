@@ -14,6 +14,7 @@ import math
 from pathlib import Path
 import resource
 import signal
+import time
 import xml.etree.ElementTree as ElementTree
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
@@ -32,11 +33,10 @@ from node_process import (
     configuration_values,
     expected_state_point,
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
-    start_node,
-    stop_process,
 )
 import pytest
 from rclpy.parameter import Parameter
@@ -47,7 +47,6 @@ from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import Marker, MarkerArray
 import yaml
 
-DOMAIN_ID = 10
 PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.94°, clockwise from 0
 DATA_TOPICS = {
@@ -60,8 +59,8 @@ QUIET = {'log.enabled': False}
 
 
 @pytest.fixture(scope='module')
-def context():
-    with ros_context(DOMAIN_ID) as ros:
+def context(domain_id):
+    with ros_context(domain_id) as ros:
         yield ros
 
 
@@ -74,7 +73,9 @@ def listener(context, request):
     listening.destroy()
 
 
-def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
+def _listen_to_run(
+    listener: Listener, nodes: NodeProcesses, parameters: dict, output: Path
+) -> int:
     """
     Run a node with ``parameters`` (end_behavior 'stop') to its end while listening.
 
@@ -86,22 +87,19 @@ def _listen_to_run(listener: Listener, parameters: dict, output: Path) -> int:
     the switch waits until the listener has heard a time after the first, which the restart's
     zero is below even if the listener joined at the node's very first state.
     """
-    process = start_node({**parameters, 'end_behavior': 'loop'}, DOMAIN_ID, output)
+    process = nodes.start({**parameters, 'end_behavior': 'loop'}, output)
     trajectories = listener.received['/linkage/state']
-    try:
-        assert listener.spin_until(
-            lambda: trajectories and _seconds(trajectories[-1].points[0].time_from_start) > 0.0
-        ), output.read_text()
-        client = AsyncParameterClient(listener.node, 'linkage_node')
-        assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-        future = client.set_parameters([Parameter('end_behavior', value='stop')])
-        assert listener.spin_until(future.done)
-        assert future.result().results[0].successful
-        listener.spin_until(lambda: process.poll() is not None)
-        listener.drain()
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
+    assert listener.spin_until(
+        lambda: trajectories and _seconds(trajectories[-1].points[0].time_from_start) > 0.0
+    ), output.read_text()
+    client = AsyncParameterClient(listener.node, 'linkage_node')
+    assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
+    future = client.set_parameters([Parameter('end_behavior', value='stop')])
+    assert listener.spin_until(future.done)
+    assert future.result().results[0].successful
+    listener.spin_until(lambda: process.poll() is not None)
+    listener.drain()
+    status = process.wait(timeout=PROCESS_TIMEOUT)
     times = [_seconds(message.points[0].time_from_start) for message in trajectories]
     restart = max(i for i in range(1, len(times)) if times[i] < times[i - 1])
     restart_stamp = _stamp_ns(trajectories[restart])
@@ -164,11 +162,16 @@ def _assert_matches_library(listener: Listener, drive: DriveLaw) -> None:
         assert all(later > earlier for earlier, later in zip(stamps, stamps[1:])), topic
 
 
-def test_stop_run_publishes_the_library_state_and_ends_exactly_at_alpha_end(listener, tmp_path):
+def test_stop_run_publishes_the_library_state_and_ends_exactly_at_alpha_end(
+    listener, nodes, tmp_path
+):
     rate_hz = 400.0
     drive = DriveLaw(1.0)
+    started = time.monotonic()
     status = _listen_to_run(
-        listener, {**QUIET, 'omega0': drive.omega0, 'rate_hz': rate_hz}, tmp_path / 'node.log')
+        listener, nodes, {**QUIET, 'omega0': drive.omega0, 'rate_hz': rate_hz},
+        tmp_path / 'node.log')
+    lifetime = time.monotonic() - started
 
     assert status == 0, (tmp_path / 'node.log').read_text()
     _assert_matches_library(listener, drive)
@@ -207,17 +210,25 @@ def test_stop_run_publishes_the_library_state_and_ends_exactly_at_alpha_end(list
     assert float(values['alpha (deg)']) == pytest.approx(90.0)
     assert float(values['loop closure residual']) < 1e-12
     assert float(values['achieved rate (Hz)']) > 0.0
-    assert int(values['missed deadlines']) >= 0
+    # A busy machine may miss any number of the 400 Hz periods, and the count runs over the whole
+    # run (the loop before the restart too), so no exact number is known; but it is a whole
+    # number in every status, it never goes down, and it cannot pass the periods that fell due
+    # while the node lived (less than the test's wait for it; two runs, each due at its start).
+    counts = [_values(array.status[0])['missed deadlines']
+              for array in listener.received['/diagnostics']]
+    assert all(count.isdigit() for count in counts), counts
+    assert [int(count) for count in counts] == sorted(int(count) for count in counts)
+    assert int(values['missed deadlines']) <= rate_hz * lifetime + 2
     assert values['log file'] == 'disabled'
     for key in ('dead point distance (deg)', 'transmission angle (deg)'):
         assert key in values
 
 
-def test_fixed_step_publishes_exact_steps_and_drive_law_times(listener, tmp_path):
+def test_fixed_step_publishes_exact_steps_and_drive_law_times(listener, nodes, tmp_path):
     drive = DriveLaw(0.10, 2.3)
     step = math.radians(0.5)
     status = _listen_to_run(
-        listener,
+        listener, nodes,
         {**QUIET, 'mode': 'fixed_step', 'omega0': drive.omega0, 'k': drive.k, 'rate_hz': 200.0},
         tmp_path / 'node.log',
     )
@@ -237,12 +248,12 @@ def test_fixed_step_publishes_exact_steps_and_drive_law_times(listener, tmp_path
     ids=['near-dead-point', 'at-dead-point'],
 )
 def test_diagnostics_near_and_at_a_dead_point(
-    listener, tmp_path, alpha_end, expected_status, expected_level
+    listener, nodes, tmp_path, alpha_end, expected_status, expected_level
 ):
     # Slow enough that the listener has long joined before the crank gets there.
     drive = DriveLaw(-0.02)
     status = _listen_to_run(
-        listener,
+        listener, nodes,
         {**QUIET, 'omega0': drive.omega0, 'alpha_end': alpha_end, 'rate_hz': 500.0},
         tmp_path / 'node.log',
     )
@@ -264,25 +275,20 @@ def test_diagnostics_near_and_at_a_dead_point(
 
 @pytest.mark.parametrize(
     'signal_number', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
-def test_signal_ends_a_logging_run_cleanly(listener, tmp_path, signal_number):
+def test_signal_ends_a_logging_run_cleanly(listener, nodes, tmp_path, signal_number):
     bags = tmp_path / 'bags'
-    process = start_node(
+    process = nodes.start(
         {'end_behavior': 'loop', 'rate_hz': 200.0, 'log.folder': str(bags)},
-        DOMAIN_ID,
         tmp_path / 'node.log',
     )
-    try:
-        # Every topic is in the bag once the listener has heard it (markers come at the display
-        # rate, diagnostics once a second).
-        assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
-        # A subscriber that joins late still gets the description (transient local).
-        listener.subscribe('/robot_description', String, transient_local=True)
-        assert listener.spin_until(lambda: listener.received['/robot_description'])
-        assert listener.received['/robot_description'][0].data == urdf_text(PAPER)
-        process.send_signal(signal_number)
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
+    # Every topic is in the bag once the listener has heard it (markers come at the display
+    # rate, diagnostics once a second).
+    assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
+    # A subscriber that joins late still gets the description (transient local).
+    listener.subscribe('/robot_description', String, transient_local=True)
+    assert listener.spin_until(lambda: listener.received['/robot_description'])
+    assert listener.received['/robot_description'][0].data == urdf_text(PAPER)
+    status = nodes.interrupt(process, signal_number)
 
     assert status == 0, (tmp_path / 'node.log').read_text()
     assert listener.received['/diagnostics'][-1].status[0].level == DiagnosticStatus.OK
@@ -317,23 +323,21 @@ def _limit_file_size() -> None:
     resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
 
 
-def test_failed_recording_turns_diagnostics_to_error_and_publishing_goes_on(listener, tmp_path):
+def test_failed_recording_turns_diagnostics_to_error_and_publishing_goes_on(
+    listener, nodes, tmp_path
+):
     bags = tmp_path / 'bags'
-    process = start_node(
+    process = nodes.start(
         {'end_behavior': 'loop', 'rate_hz': 1000.0, 'log.folder': str(bags)},
-        DOMAIN_ID, tmp_path / 'node.log', preexec_fn=_limit_file_size,
+        tmp_path / 'node.log', preexec_fn=_limit_file_size,
     )
     diagnostics = listener.received['/diagnostics']
-    try:
-        assert listener.spin_until(
-            lambda: diagnostics and diagnostics[-1].status[0].level == DiagnosticStatus.ERROR)
-        assert 'recording stopped' in diagnostics[-1].status[0].message
-        count = len(listener.received['/joint_states'])
-        assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 50)
-        process.send_signal(signal.SIGINT)
-        status = process.wait(timeout=PROCESS_TIMEOUT)
-    finally:
-        stop_process(process)
+    assert listener.spin_until(
+        lambda: diagnostics and diagnostics[-1].status[0].level == DiagnosticStatus.ERROR)
+    assert 'recording stopped' in diagnostics[-1].status[0].message
+    count = len(listener.received['/joint_states'])
+    assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 50)
+    status = nodes.interrupt(process)
 
     assert status == 0, (tmp_path / 'node.log').read_text()
     (bag,) = bags.iterdir()

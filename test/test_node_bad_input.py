@@ -14,9 +14,9 @@ message), and the dead point under 'loop', 'bounce' and 'stop'.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 import math
-import signal
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
@@ -38,8 +38,6 @@ from node_process import (
     PROCESS_TIMEOUT,
     ros_context,
     stamp_ns,
-    start_node,
-    stop_process,
 )
 import numpy as np
 import pytest
@@ -48,7 +46,6 @@ from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
-DOMAIN_ID = 70
 PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.941°, clockwise from 0
 DEFAULTS = {spec.name: spec.default for spec in parameter_specs('paper')}
@@ -197,20 +194,18 @@ START_UP_CASES = {
 }
 
 
-def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(tmp_path):
+def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
+    nodes, tmp_path
+):
     # All at once: each process ends during start-up, so they cannot disturb each other.
     runs = {}
     for case, (name, value) in START_UP_CASES.items():
         folder = tmp_path / case.replace(' ', '_')
         folder.mkdir()
-        runs[case] = (start_node({name: value, 'log.folder': str(folder / 'bags')}, DOMAIN_ID,
-                                 folder / 'node.log'), folder)
-    try:
-        statuses = {case: process.wait(timeout=PROCESS_TIMEOUT)
-                    for case, (process, _) in runs.items()}
-    finally:
-        for process, _ in runs.values():
-            stop_process(process)
+        runs[case] = (nodes.start({name: value, 'log.folder': str(folder / 'bags')},
+                                  folder / 'node.log'), folder)
+    statuses = {case: process.wait(timeout=PROCESS_TIMEOUT)
+                for case, (process, _) in runs.items()}
     for case, (name, _) in START_UP_CASES.items():
         folder = runs[case][1]
         output = (folder / 'node.log').read_text()
@@ -226,14 +221,14 @@ def test_bad_values_at_start_up_end_each_node_with_one_line_and_nothing_written(
 # --- run time: every bad value through the parameter service, logging on -----------------------
 
 
-def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_path):
+def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(nodes, tmp_path):
     bags = tmp_path / 'bags'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('bad_input_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         states = listener.received['/linkage/state']
-        process = start_node({'end_behavior': 'loop', 'log.folder': str(bags)}, DOMAIN_ID,
-                             tmp_path / 'node.log')
+        process = nodes.start({'end_behavior': 'loop', 'log.folder': str(bags)},
+                              tmp_path / 'node.log')
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -266,10 +261,8 @@ def test_bad_values_at_run_time_are_refused_and_the_node_and_its_log_go_on(tmp_p
             after_rejections = len(states)
             assert listener.spin_until(lambda: len(states) > after_rejections + 20)
             assert process.poll() is None
-            process.send_signal(signal.SIGINT)
-            status = process.wait(timeout=PROCESS_TIMEOUT)
+            status = nodes.interrupt(process)
         finally:
-            stop_process(process)
             listener.destroy()
 
     assert status == 0, (tmp_path / 'node.log').read_text()
@@ -340,54 +333,11 @@ def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
         f'alpha_end = {math.degrees(-0.1):.6f}°: it reverses')
 
 
-def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(tmp_path):
-    """
-    Drive the paper's mechanism clockwise from 0 into its dead point at ≈ −1.941°.
-
-    Aiming at −0.1 rad: 'loop' restarts there, 'bounce' reverses there, 'stop' ends with status 1;
-    each time diagnostics report ERROR at once, and WARN (close to the dead point) before it.
-    """
-    warning = math.radians(3.0)  # the whole pass lies within 3° of the dead point
-    drive = DriveLaw(-0.05)  # 0.68 s from 0 to the dead point
-    with ros_context(DOMAIN_ID) as context:
-        listener = Listener('dead_point_tester', context)
-        for topic, msg_type in (('/diagnostics', DiagnosticArray),
-                                ('/linkage/state', JointTrajectory),
-                                ('/joint_states', JointState)):
-            listener.subscribe(topic, msg_type)
-        diagnostics = listener.received['/diagnostics']
-        process = start_node(
-            {'end_behavior': 'loop', 'omega0': drive.omega0, 'alpha_end': -0.1,
-             'rate_hz': 200.0, 'diagnostics.dead_point_warning': warning,
-             'log.folder': str(tmp_path / 'bags')},
-            DOMAIN_ID, tmp_path / 'node.log')
-
-        def errors(behavior: str) -> list[DiagnosticArray]:
-            return [array for array in diagnostics
-                    if array.status[0].level == DiagnosticStatus.ERROR
-                    and _values(array.status[0])['end behavior'] == behavior]
-
-        try:
-            client = AsyncParameterClient(listener.node, 'linkage_node')
-            assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
-            assert listener.spin_until(lambda: errors('loop'))
-            (result,) = listener.result_of(
-                client.set_parameters([Parameter('end_behavior', value='bounce')])).results
-            assert result.successful
-            # Two turns at the dead point, so a whole pass back and out lies between them.
-            assert listener.spin_until(lambda: len(errors('bounce')) >= 2)
-            (result,) = listener.result_of(
-                client.set_parameters([Parameter('end_behavior', value='stop')])).results
-            assert result.successful
-            assert listener.spin_until(lambda: process.poll() is not None)
-            listener.drain()
-            status = process.wait(timeout=PROCESS_TIMEOUT)
-        finally:
-            stop_process(process)
-            listener.destroy()
-
-    output = (tmp_path / 'node.log').read_text()
-    assert status == 1, output
+def _assert_errors_at_and_warnings_before_the_dead_point(
+    diagnostics: list[DiagnosticArray], errors: Callable[[str], list[DiagnosticArray]],
+    warning: float,
+) -> None:
+    """Each end behavior's ERROR at the dead point says what it does; WARN before it, moving."""
     where = f'the crank cannot go past the dead point at {math.degrees(DEAD_POINT):.6f}°'
     for behavior, outcome in (('loop', 'restarts from alpha_start'), ('bounce', 'reverses'),
                               ('stop', 'stops')):
@@ -410,19 +360,16 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
         assert 'from a dead point' in status_message.message
         assert 'before alpha_end' in status_message.message
 
-    states = listener.received['/linkage/state']
-    joint_states = listener.received['/joint_states']
-    assert all(map(_finite, states)) and all(map(_finite, joint_states))
-    alphas = [message.points[0].positions[0] for message in states]
-    assert all(DEAD_POINT < alpha <= 0.0 for alpha in alphas)
-    for message in states:
-        point = message.points[0]
-        state = solve(PAPER, point.positions[0], DriveLaw(math.copysign(0.05,
-                                                                        point.velocities[0])))
-        assert tuple(point.positions[:3]) == (state.alpha, state.beta, state.gamma)
-        assert tuple(point.velocities[:3]) == (state.omega, -state.omega_bc, state.omega_ab)
-    # Bounce, between two turns at the dead point: back from it to alpha_start (|α| decreasing,
-    # ω > 0), then out again.
+
+def _assert_bounce_turns_at_the_dead_point_and_at_alpha_start(
+    states: list[JointTrajectory], errors: Callable[[str], list[DiagnosticArray]],
+    drive: DriveLaw,
+) -> None:
+    """
+    Between two turns at the dead point, 'bounce' runs back to alpha_start and out again.
+
+    Back: |α| decreasing, ω > 0; out: the reverse.
+    """
     first_turn, second_turn = (stamp_ns(array) for array in errors('bounce')[:2])
     # The ERROR carries the stamp of the tick that met the dead point, as does that tick's state.
     cycle = [message.points[0] for message in states
@@ -449,6 +396,71 @@ def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_
     assert all(b < a for a, b in zip(alphas_in_cycle[peak:], alphas_in_cycle[peak + 1:]))
     assert all(speed > 0.0 for speed in speeds[:peak])
     assert all(speed < 0.0 for speed in speeds[peak + 1:])
+
+
+def test_dead_point_before_alpha_end_is_an_error_that_loop_bounce_and_stop_each_handle(
+    nodes, tmp_path
+):
+    """
+    Drive the paper's mechanism clockwise from 0 into its dead point at ≈ −1.941°.
+
+    Aiming at −0.1 rad: 'loop' restarts there, 'bounce' reverses there, 'stop' ends with status 1;
+    each time diagnostics report ERROR at once, and WARN (close to the dead point) before it.
+    """
+    warning = math.radians(3.0)  # the whole pass lies within 3° of the dead point
+    drive = DriveLaw(-0.05)  # 0.68 s from 0 to the dead point
+    with ros_context(nodes.domain_id) as context:
+        listener = Listener('dead_point_tester', context)
+        for topic, msg_type in (('/diagnostics', DiagnosticArray),
+                                ('/linkage/state', JointTrajectory),
+                                ('/joint_states', JointState)):
+            listener.subscribe(topic, msg_type)
+        diagnostics = listener.received['/diagnostics']
+        process = nodes.start(
+            {'end_behavior': 'loop', 'omega0': drive.omega0, 'alpha_end': -0.1,
+             'rate_hz': 200.0, 'diagnostics.dead_point_warning': warning,
+             'log.folder': str(tmp_path / 'bags')},
+            tmp_path / 'node.log')
+
+        def errors(behavior: str) -> list[DiagnosticArray]:
+            return [array for array in diagnostics
+                    if array.status[0].level == DiagnosticStatus.ERROR
+                    and _values(array.status[0])['end behavior'] == behavior]
+
+        try:
+            client = AsyncParameterClient(listener.node, 'linkage_node')
+            assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
+            assert listener.spin_until(lambda: errors('loop'))
+            (result,) = listener.result_of(
+                client.set_parameters([Parameter('end_behavior', value='bounce')])).results
+            assert result.successful
+            # Two turns at the dead point, so a whole pass back and out lies between them.
+            assert listener.spin_until(lambda: len(errors('bounce')) >= 2)
+            (result,) = listener.result_of(
+                client.set_parameters([Parameter('end_behavior', value='stop')])).results
+            assert result.successful
+            assert listener.spin_until(lambda: process.poll() is not None)
+            listener.drain()
+            status = process.wait(timeout=PROCESS_TIMEOUT)
+        finally:
+            listener.destroy()
+
+    output = (tmp_path / 'node.log').read_text()
+    assert status == 1, output
+    _assert_errors_at_and_warnings_before_the_dead_point(diagnostics, errors, warning)
+
+    states = listener.received['/linkage/state']
+    joint_states = listener.received['/joint_states']
+    assert all(map(_finite, states)) and all(map(_finite, joint_states))
+    alphas = [message.points[0].positions[0] for message in states]
+    assert all(DEAD_POINT < alpha <= 0.0 for alpha in alphas)
+    for message in states:
+        point = message.points[0]
+        state = solve(PAPER, point.positions[0], DriveLaw(math.copysign(0.05,
+                                                                        point.velocities[0])))
+        assert tuple(point.positions[:3]) == (state.alpha, state.beta, state.gamma)
+        assert tuple(point.velocities[:3]) == (state.omega, -state.omega_bc, state.omega_ab)
+    _assert_bounce_turns_at_the_dead_point_and_at_alpha_start(states, errors, drive)
     # Stop: the run ends just before the dead point.
     # (as close as the last tick before it came: 0.01 rad is 0.2 s at |ω| = 0.05 rad/s, so a tick
     # late on a busy machine cannot fail this)

@@ -17,18 +17,15 @@ from node_process import (
     bag_writer_pid,
     get_parameter,
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     ros_context,
-    run_node,
     set_parameter,
-    start_node,
-    stop_process,
 )
 import pytest
 from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
 
-DOMAIN_ID = 13
 AVAILABLE = os.sched_getaffinity(0)
 NODE_CPU = max(AVAILABLE)
 # With one CPU the bag writer shares it with the node.
@@ -42,14 +39,16 @@ def thread_cpus(pid: int) -> dict[int, set[int]]:
             for thread in os.listdir(f'/proc/{pid}/task')}
 
 
-def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(tmp_path: Path) -> None:
+def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
     output = tmp_path / 'node.log'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('cpu_affinity_tester', context)
         listener.subscribe('/joint_states', JointState)
-        process = start_node(
+        process = nodes.start(
             {'end_behavior': 'loop', 'rate_hz': 200.0, 'cpu_affinity': NODE_CPU,
-             'log.folder': str(tmp_path / 'bags')}, DOMAIN_ID, output)
+             'log.folder': str(tmp_path / 'bags')}, output)
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -76,7 +75,6 @@ def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(tmp_path: Pat
             assert listener.spin_until(lambda: len(listener.received['/joint_states']) > count + 5)
             assert process.poll() is None
         finally:
-            stop_process(process)
             listener.destroy()
     log = output.read_text()
     assert (f'running on CPU {NODE_CPU}; the bag writer on CPU '
@@ -85,10 +83,12 @@ def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(tmp_path: Pat
 
 
 @pytest.mark.parametrize('value', [NOT_AVAILABLE, -2, 1024, '0'])
-def test_a_cpu_the_process_may_not_use_is_a_start_up_error(tmp_path: Path, value) -> None:
+def test_a_cpu_the_process_may_not_use_is_a_start_up_error(
+    nodes: NodeProcesses, tmp_path: Path, value
+) -> None:
     bags = tmp_path / 'bags'
-    status, output = run_node({'cpu_affinity': value, 'log.folder': str(bags)}, DOMAIN_ID,
-                              tmp_path / 'node.log')
+    status, output = nodes.run({'cpu_affinity': value, 'log.folder': str(bags)},
+                               tmp_path / 'node.log')
     assert status == 2, output
     assert 'linkage_node: invalid parameter cpu_affinity: ' in output
     assert 'Traceback' not in output

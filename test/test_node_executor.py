@@ -17,8 +17,6 @@ removes it) and the new one run on its own period.
 
 from __future__ import annotations
 
-import signal
-
 from linkage_kinematics.bag import reader as bag_reader
 from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, parameter_specs
 from node_process import (
@@ -27,8 +25,6 @@ from node_process import (
     PROCESS_TIMEOUT,
     ros_context,
     stamp_ns,
-    start_node,
-    stop_process,
     time_msg,
 )
 from rclpy.parameter import Parameter
@@ -37,18 +33,17 @@ from rclpy.qos import QoSProfile
 from rosgraph_msgs.msg import Clock
 from trajectory_msgs.msg import JointTrajectory
 
-DOMAIN_ID = 77
 CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick
 STEP = 10_000_000  # ns of simulated time per /clock step: one period at 100 Hz, half at 50 Hz
 
 
-def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_path):
-    with ros_context(DOMAIN_ID) as context:
+def test_events_executor_serves_parameters_and_re_creates_the_state_timer(nodes, tmp_path):
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('executor_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         states = listener.received['/linkage/state']
-        process = start_node({'end_behavior': 'loop', 'rate_hz': 100.0, 'log.enabled': False},
-                             DOMAIN_ID, tmp_path / 'node.log')
+        process = nodes.start({'end_behavior': 'loop', 'rate_hz': 100.0, 'log.enabled': False},
+                              tmp_path / 'node.log')
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -69,7 +64,6 @@ def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_pa
             assert listener.spin_until(lambda: len(states) >= changed_at + 3)
             assert process.poll() is None
         finally:
-            stop_process(process)
             listener.destroy()
 
     # Timers never fire early: only the new 0.5 s timer ticks (the old one ticked every 10 ms).
@@ -78,17 +72,17 @@ def test_events_executor_serves_parameters_and_re_creates_the_state_timer(tmp_pa
         (later - earlier) * 1e-6 for earlier, later in zip(stamps, stamps[1:])]
 
 
-def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
+def test_rate_change_on_sim_time_ticks_on_the_new_period(nodes, tmp_path):
     bags = tmp_path / 'bags'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('executor_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         states = listener.received['/linkage/state']
         clock = listener.node.create_publisher(Clock, '/clock', QoSProfile(depth=10))
-        process = start_node(
+        process = nodes.start(
             {'end_behavior': 'loop', 'rate_hz': 100.0, 'display_rate_hz': 1.0,
              'use_sim_time': True, 'log.folder': str(bags)},
-            DOMAIN_ID, tmp_path / 'node.log')
+            tmp_path / 'node.log')
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -115,10 +109,8 @@ def test_rate_change_on_sim_time_ticks_on_the_new_period(tmp_path):
                     drive_sim_clock(listener, clock, states, clock_ns)
                     after.append(clock_ns)
             assert process.poll() is None
-            process.send_signal(signal.SIGINT)
-            status = process.wait(timeout=PROCESS_TIMEOUT)
+            status = nodes.interrupt(process)
         finally:
-            stop_process(process)
             listener.destroy()
 
     assert status == 0, (tmp_path / 'node.log').read_text()

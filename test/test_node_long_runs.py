@@ -21,10 +21,9 @@ from linkage_kinematics.kinematics.solver import solve
 from node_process import (
     drive_sim_clock,
     Listener,
+    NodeProcesses,
     ros_context,
     stamp_ns,
-    start_node,
-    stop_process,
 )
 import pytest
 from rclpy.qos import QoSProfile
@@ -32,7 +31,6 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
-DOMAIN_ID = 72
 CRANK_ROCKER = preset('grashof_crank_rocker').geometry
 DRIVE = DriveLaw(TWO_PI)  # one turn per second
 CLOCK_START = 1_000_000_000_000  # ns of simulated time at the first tick
@@ -47,7 +45,7 @@ def _seconds(nanoseconds: int) -> float:
 
 
 def _run_on_sim_time(
-    tmp_path, parameters: dict, phases: list[list[int]]
+    nodes: NodeProcesses, tmp_path, parameters: dict, phases: list[list[int]]
 ) -> tuple[list, list]:
     """
     Run a node with ``parameters`` on simulated time.
@@ -55,14 +53,14 @@ def _run_on_sim_time(
     Stepping the clock through ``phases`` (a state for each step); return the /linkage/state and
     /joint_states messages received.
     """
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('sim_time_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         listener.subscribe('/joint_states', JointState)
         clock = listener.node.create_publisher(Clock, '/clock', QoSProfile(depth=10))
         states = listener.received['/linkage/state']
-        process = start_node({**parameters, 'use_sim_time': True, 'log.enabled': False},
-                             DOMAIN_ID, tmp_path / 'node.log')
+        process = nodes.start({**parameters, 'use_sim_time': True, 'log.enabled': False},
+                              tmp_path / 'node.log')
         try:
             assert listener.spin_until(lambda: listener.node.count_subscribers('/clock') > 0)
             for phase in phases:
@@ -72,16 +70,15 @@ def _run_on_sim_time(
                 lambda: len(listener.received['/joint_states']) >= len(states))
             assert process.poll() is None, (tmp_path / 'node.log').read_text()
         finally:
-            stop_process(process)
             listener.destroy()
     return states, listener.received['/joint_states']
 
 
-def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(tmp_path):
+def test_ten_thousand_revolutions_on_sim_time_stay_exact_and_continuous(nodes, tmp_path):
     phases = [[CLOCK_START + n * STEP for n in range(STEPS + 1)],
               [CLOCK_START + JUMP + n * STEP for n in range(STEPS + 1)]]
     states, joint_states = _run_on_sim_time(
-        tmp_path,
+        nodes, tmp_path,
         {'preset': 'grashof_crank_rocker', 'end_behavior': 'loop', 'alpha_start': 0.0,
          'alpha_end': TWO_PI, 'omega0': DRIVE.omega0, 'rate_hz': 100.0},
         phases)
@@ -146,7 +143,7 @@ QUARTER = 250_000_000  # ns of simulated time: a quarter turn, from change point
 TURNS = 1000
 
 
-def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_path):
+def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(nodes, tmp_path):
     """
     OA = BC, AB = OC.
 
@@ -157,7 +154,7 @@ def test_a_parallelogram_turns_a_thousand_times_through_its_change_points(tmp_pa
     phases = [[CLOCK_START + n * QUARTER for n in range(9)],
               [CLOCK_START + (TURNS - 2) * 1_000_000_000 + n * QUARTER for n in range(9)]]
     states, joint_states = _run_on_sim_time(
-        tmp_path,
+        nodes, tmp_path,
         {'preset': '', **PARALLELOGRAM, 'branch': -1, 'end_behavior': 'loop',
          'alpha_start': 0.0, 'alpha_end': TWO_PI, 'omega0': DRIVE.omega0},
         phases)

@@ -21,10 +21,9 @@ from linkage_kinematics.kinematics.solver import solve
 from linkage_kinematics.model.urdf import urdf_text
 from node_process import (
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     ros_context,
-    start_node,
-    stop_process,
 )
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
@@ -33,7 +32,6 @@ from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 
-DOMAIN_ID = 76
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 # namespace → (preset, frame prefix); '' is a node with no namespace beside them.
 MECHANISMS = {
@@ -49,10 +47,12 @@ def _topic(namespace: str, name: str) -> str:
     return f'{namespace}/{name}'
 
 
-def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_path: Path):
+def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(
+    nodes: NodeProcesses, tmp_path: Path
+):
     bags = tmp_path / 'bags'  # one folder for all three: bag names must not collide
     processes = {}
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('namespace_tester', context)
         for namespace in MECHANISMS:
             listener.subscribe(_topic(namespace, 'linkage/state'), JointTrajectory)
@@ -67,8 +67,8 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
                               'alpha_end': -1.0 if drive.omega0 < 0 else 1.0,
                               'end_behavior': 'bounce', 'frame_prefix': prefix,
                               'log.folder': str(bags)}
-                processes[namespace] = start_node(
-                    parameters, DOMAIN_ID, tmp_path / f"node{namespace.replace('/', '_')}.log",
+                processes[namespace] = nodes.start(
+                    parameters, tmp_path / f"node{namespace.replace('/', '_')}.log",
                     ros_arguments=['-r', f'__ns:={namespace}'] if namespace else [],
                 )
             assert listener.wait_for_every_topic(count=3)
@@ -77,8 +77,6 @@ def test_mechanisms_in_namespaces_keep_to_their_own_topics_frames_and_bags(tmp_p
             for namespace, process in processes.items():
                 assert process.wait(timeout=PROCESS_TIMEOUT) == 0
         finally:
-            for process in processes.values():
-                stop_process(process)
             listener.destroy()
 
     for namespace, (preset_name, prefix) in MECHANISMS.items():

@@ -40,10 +40,7 @@ from node_process import (
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
-    run_node,
     set_parameter,
-    start_node,
-    stop_process,
 )
 import pytest
 from rclpy.parameter import Parameter, parameter_value_to_python
@@ -53,7 +50,6 @@ from std_msgs.msg import String
 from trajectory_msgs.msg import JointTrajectory
 from visualization_msgs.msg import MarkerArray
 
-DOMAIN_ID = 11
 PAPER = preset('paper').geometry
 DEAD_POINT = min(PAPER.reachability.dead_points, key=abs)  # ≈ −1.94°
 
@@ -253,13 +249,13 @@ def test_measured_mode_does_not_check_the_drive_law(overrides):
         build_configuration({**values, 'source': 'drive_law'})
 
 
-def test_the_measured_node_starts_where_the_drive_laws_defaults_cannot(tmp_path):
+def test_the_measured_node_starts_where_the_drive_laws_defaults_cannot(nodes, tmp_path):
     """A lab whose crank cannot reach alpha_start … alpha_end follows its encoder at once."""
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('measured_start_listener', context)
         listener.subscribe('/diagnostics', DiagnosticArray)
-        process = start_node({'source': 'measured', 'omega0': 0.0, 'log.enabled': False,
-                              **BEYOND_DEFAULTS}, DOMAIN_ID, tmp_path / 'node.log')
+        process = nodes.start({'source': 'measured', 'omega0': 0.0, 'log.enabled': False,
+                               **BEYOND_DEFAULTS}, tmp_path / 'node.log')
         try:
             statuses = listener.received['/diagnostics']
             assert listener.spin_until(lambda: any(
@@ -268,7 +264,6 @@ def test_the_measured_node_starts_where_the_drive_laws_defaults_cannot(tmp_path)
                 tmp_path / 'node.log').read_text()
             assert process.poll() is None
         finally:
-            stop_process(process)
             listener.destroy()
 
 
@@ -291,11 +286,10 @@ def test_only_motion_changes_restart_the_motion():
 
 
 @pytest.mark.parametrize('case', PROCESS_CASES)
-def test_bad_value_at_start_up_ends_the_node_with_one_clear_line(tmp_path, case):
+def test_bad_value_at_start_up_ends_the_node_with_one_clear_line(nodes, tmp_path, case):
     overrides, parameter = BAD_VALUES[case]
     bags = tmp_path / 'bags'
-    status, output = run_node({**overrides, 'log.folder': str(bags)}, DOMAIN_ID,
-                              tmp_path / 'node.log')
+    status, output = nodes.run({**overrides, 'log.folder': str(bags)}, tmp_path / 'node.log')
     assert status == 2, output
     assert 'Traceback' not in output
     plain = [line for line in output.splitlines() if line.startswith('linkage_node: invalid')]
@@ -305,11 +299,10 @@ def test_bad_value_at_start_up_ends_the_node_with_one_clear_line(tmp_path, case)
     assert not bags.exists()
 
 
-def test_unwritable_log_folder_is_a_start_up_error(tmp_path):
+def test_unwritable_log_folder_is_a_start_up_error(nodes, tmp_path):
     blocker = tmp_path / 'not_a_folder'
     blocker.write_text('')
-    status, output = run_node({'log.folder': str(blocker / 'bags')}, DOMAIN_ID,
-                              tmp_path / 'node.log')
+    status, output = nodes.run({'log.folder': str(blocker / 'bags')}, tmp_path / 'node.log')
     assert status == 2, output
     assert 'invalid parameter log.folder' in output
     assert blocker.read_text() == ''
@@ -328,13 +321,13 @@ def test_unknown_parameters_are_named_with_the_closest_known_name():
     assert unknown_parameters(declared, declared) == []
 
 
-def test_an_unknown_parameter_gets_a_warning_and_the_node_runs_on(tmp_path):
+def test_an_unknown_parameter_gets_a_warning_and_the_node_runs_on(nodes, tmp_path):
     # A misspelt -p, and a wildcard entry of a parameters file shared with other nodes.
     shared = tmp_path / 'shared.yaml'
     shared.write_text('/**:\n  ros__parameters:\n    use_sim_time: false\n    gain: 0.5\n'
                       '/other_node:\n  ros__parameters:\n    rate: 7\n')
-    status, output = run_node(
-        {'rate': 50, 'end_behavior': 'stop', 'log.enabled': False}, DOMAIN_ID,
+    status, output = nodes.run(
+        {'rate': 50, 'end_behavior': 'stop', 'log.enabled': False},
         tmp_path / 'node.log', ros_arguments=['--params-file', str(shared)])
     assert status == 0, output
     warnings = [line for line in output.splitlines() if '[WARN]' in line]
@@ -346,14 +339,14 @@ def test_an_unknown_parameter_gets_a_warning_and_the_node_runs_on(tmp_path):
         "'rate_hz'?")
 
 
-def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
-    with ros_context(DOMAIN_ID) as context:
+def test_run_time_changes_are_validated_whole_and_applied_atomically(nodes, tmp_path):
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('parameter_tester', context)
         listener.subscribe('/joint_states', JointState)
         listener.subscribe('/linkage/state', JointTrajectory)
-        process = start_node(
+        process = nodes.start(
             {'end_behavior': 'bounce', 'rate_hz': 100.0, 'log.enabled': False},
-            DOMAIN_ID, tmp_path / 'node.log')
+            tmp_path / 'node.log')
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -412,22 +405,21 @@ def test_run_time_changes_are_validated_whole_and_applied_atomically(tmp_path):
                 assert scene.markers[DISK_ID].scale.x == 0.5
             assert process.poll() is None
         finally:
-            stop_process(process)
             listener.destroy()
 
 
 def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change_nothing(
-    tmp_path,
+    nodes, tmp_path,
 ):
     output = tmp_path / 'node.log'
-    with ros_context(DOMAIN_ID) as context:
+    with ros_context(nodes.domain_id) as context:
         listener = Listener('parameter_contract_tester', context)
         listener.subscribe('/linkage/state', JointTrajectory)
         states = listener.received['/linkage/state']
-        process = start_node(
+        process = nodes.start(
             {'preset': 'grashof_crank_rocker', 'alpha_end': 2.0 * math.pi,
              'end_behavior': 'loop', 'rate_hz': 50, 'log.enabled': False},
-            DOMAIN_ID, output)
+            output)
         try:
             client = AsyncParameterClient(listener.node, 'linkage_node')
             assert client.wait_for_services(timeout_sec=PROCESS_TIMEOUT)
@@ -471,7 +463,6 @@ def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change
             assert times == sorted(times)
             assert process.poll() is None
         finally:
-            stop_process(process)
             listener.destroy()
     log = output.read_text()
     assert log.count('parameters changed') == 1 and 'parameters changed: rate_hz=60.0' in log

@@ -19,8 +19,6 @@ import sys
 
 from node_process import node_command, PROCESS_TIMEOUT, REPOSITORY, ros_environment
 
-DOMAIN_ID = 88
-
 
 def start_up_failure(
     tmp_path: Path, environment: dict[str, str], ros_arguments: tuple[str, ...] = ()
@@ -44,8 +42,10 @@ def assert_one_line(lines: list[str], cause: str) -> None:
     assert not any('Traceback' in line for line in lines)
 
 
-def test_a_missing_ament_environment_is_one_line_naming_it(tmp_path: Path) -> None:
-    environment = ros_environment(DOMAIN_ID)
+def test_a_missing_ament_environment_is_one_line_naming_it(
+    domain_id: int, tmp_path: Path
+) -> None:
+    environment = ros_environment(domain_id)
     del environment['AMENT_PREFIX_PATH']
     status, lines = start_up_failure(tmp_path, environment)
     assert status == 2, lines
@@ -53,7 +53,9 @@ def test_a_missing_ament_environment_is_one_line_naming_it(tmp_path: Path) -> No
     assert not (tmp_path / 'bags').exists()
 
 
-def test_a_missing_message_definition_is_one_line_naming_it(tmp_path: Path) -> None:
+def test_a_missing_message_definition_is_one_line_naming_it(
+    domain_id: int, tmp_path: Path
+) -> None:
     """An ament prefix with every package of this environment but visualization_msgs."""
     prefix = tmp_path / 'prefix'
     index = prefix / 'share' / 'ament_index' / 'resource_index' / 'packages'
@@ -63,7 +65,7 @@ def test_a_missing_message_definition_is_one_line_naming_it(tmp_path: Path) -> N
         if marker.name != 'visualization_msgs' and (installed / marker.name).is_dir():
             (index / marker.name).write_text('')
             os.symlink(installed / marker.name, prefix / 'share' / marker.name)
-    environment = ros_environment(DOMAIN_ID + 1)
+    environment = ros_environment(domain_id)
     environment['AMENT_PREFIX_PATH'] = str(prefix)
     status, lines = start_up_failure(tmp_path, environment)
     assert status == 2, lines
@@ -71,9 +73,11 @@ def test_a_missing_message_definition_is_one_line_naming_it(tmp_path: Path) -> N
     assert not (tmp_path / 'bags').exists()
 
 
-def test_ros_arguments_rcl_refuses_are_one_line_naming_them(tmp_path: Path) -> None:
+def test_ros_arguments_rcl_refuses_are_one_line_naming_them(
+    domain_id: int, tmp_path: Path
+) -> None:
     missing = tmp_path / 'no_such_parameters.yaml'
-    status, lines = start_up_failure(tmp_path, ros_environment(DOMAIN_ID + 2),
+    status, lines = start_up_failure(tmp_path, ros_environment(domain_id),
                                      ('--params-file', str(missing)))
     assert status == 2, lines
     assert_one_line(lines, f"cannot start ROS: failed to initialize rcl: Couldn't parse params "

@@ -16,12 +16,11 @@ from pathlib import Path
 
 from linkage_kinematics.bag.reader import iter_messages
 from linkage_kinematics.kinematics.drive import DriveLaw
-from node_process import run_node
+from node_process import NodeProcesses
 import pytest
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
 
-DOMAIN_ID = 74
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 ALPHA_START = 0.3  # rad; far enough from the paper's dead point for an OK status
 ALPHA_END = math.pi / 2
@@ -44,15 +43,17 @@ def _logged(bag: Path) -> dict[str, list[tuple[int, object]]]:
 
 @pytest.fixture(scope='module', params=[(mode, law) for mode in ('real_time', 'fixed_step')
                                         for law in LAWS], ids=lambda p: f'{p[0]}-{p[1]}')
-def run(request, tmp_path_factory) -> tuple[DriveLaw, dict[str, list[tuple[int, object]]], Path]:
+def run(
+    request, tmp_path_factory, module_nodes: NodeProcesses
+) -> tuple[DriveLaw, dict[str, list[tuple[int, object]]], Path]:
     mode, law = request.param
     drive = LAWS[law]
     folder = tmp_path_factory.mktemp(f'{mode}_{law}')
-    status, output = run_node(
+    status, output = module_nodes.run(
         {'mode': mode, 'omega0': drive.omega0, 'k': drive.k, 'alpha_start': ALPHA_START,
          'alpha_end': ALPHA_END, 'alpha_step': math.radians(2.0), 'end_behavior': 'stop',
          'log.folder': str(folder / 'bags')},
-        DOMAIN_ID, folder / 'node.log')
+        folder / 'node.log')
     assert status == 0, output
     (bag,) = (folder / 'bags').iterdir()
     return drive, _logged(bag), bag

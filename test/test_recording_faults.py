@@ -21,6 +21,15 @@ import sys
 import time
 from typing import Any
 
+from bag_files import (
+    bag_information,
+    listen_to_node_topics,
+    LOGGED_TOPICS,
+    only_bag,
+    read_with_rosbags,
+    stopped,
+    topic_counts,
+)
 from diagnostic_msgs.msg import DiagnosticStatus
 from linkage_kinematics.bag import reader as bag_reader
 from mcap.exceptions import EndOfFile
@@ -30,27 +39,16 @@ from mcap.stream_reader import StreamReader
 from node_process import (
     bag_writer_pid,
     Listener,
+    NodeProcesses,
     PROCESS_TIMEOUT,
     REPOSITORY,
     ros_context,
     ros_environment,
-    run_node,
     stamp_ns,
-    start_node,
-    stop_process,
+    TYPESTORE,
 )
 import pytest
 from rosbags.rosbag2 import Reader
-from test_bag_writer import (
-    bag_information,
-    listen_to_node_topics,
-    LOGGED_TOPICS,
-    only_bag,
-    read_with_rosbags,
-    stopped,
-    topic_counts,
-    TYPESTORE,
-)
 
 LOOP_PARAMETERS = {'rate_hz': 200.0, 'end_behavior': 'loop'}
 
@@ -78,20 +76,19 @@ FILE_SIZE_LIMIT_BYTES = 512 * 1024
 
 @contextlib.contextmanager
 def node_with_listener(
-    parameters: dict[str, Any], domain: int, output: Path, **start_options: Any
+    nodes: NodeProcesses, parameters: dict[str, Any], output: Path, **start_options: Any
 ) -> Iterator[tuple[Listener, subprocess.Popen]]:
     """
-    Return a node process (``start_node``'s arguments) and a listener to all its topics.
+    Return a node process (``NodeProcesses.start``'s arguments) and a listener to all its topics.
 
-    On their own ROS domain; both ended on leaving.
+    The listener is destroyed on leaving; the node at the latest after the test (``nodes``).
     """
-    with ros_context(domain) as context:
-        listener = listen_to_node_topics(context, f'faults_listener_{domain}')
-        process = start_node(parameters, domain, output, **start_options)
+    with ros_context(nodes.domain_id) as context:
+        listener = listen_to_node_topics(context, 'faults_listener')
+        process = nodes.start(parameters, output, **start_options)
         try:
             yield listener, process
         finally:
-            stop_process(process)
             listener.destroy()
 
 
@@ -140,7 +137,7 @@ def recover(bag: Path) -> subprocess.CompletedProcess:
     )
 
 
-def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
+def kill_once_every_topic_is_logged(nodes: NodeProcesses, tmp_path: Path, folder: Path,
                                     kill_writer: bool) -> tuple[Path, int, int]:
     """
     Run a logging node until complete chunks hold every topic, then SIGKILL it.
@@ -149,7 +146,7 @@ def kill_once_every_topic_is_logged(tmp_path: Path, folder: Path, domain: int,
     Return the bag, the stamp of the last /joint_states heard and the wall time of the kill (ns).
     """
     with node_with_listener(
-        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, domain, tmp_path / 'node.log'
+        nodes, {**LOOP_PARAMETERS, 'log.folder': str(folder)}, tmp_path / 'node.log'
     ) as (listener, process):
         bag = wait_for_bag(folder, process)
         (mcap_path,) = bag.glob('*.mcap')
@@ -176,7 +173,7 @@ def wait_until_gone(pid: int) -> None:
 
 
 def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
-    tmp_path: Path,
+    nodes: NodeProcesses, tmp_path: Path,
 ) -> None:
     """
     Return the bag writer outlives a killed node.
@@ -186,7 +183,7 @@ def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
     """
     folder = tmp_path / 'bags'
     bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
-        tmp_path, folder, 35, kill_writer=False)
+        nodes, tmp_path, folder, kill_writer=False)
     deadline = time.monotonic() + PROCESS_TIMEOUT
     while bag_reader.bag_files(bag)[0].truncated or not bag_information(bag)['message_count']:
         assert time.monotonic() < deadline, 'the bag writer did not finish the bag'
@@ -206,11 +203,11 @@ def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
 
 
 def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes_the_bag(
-    tmp_path: Path,
+    nodes: NodeProcesses, tmp_path: Path,
 ) -> None:
     folder = tmp_path / 'bags'
     bag, last_heard_ns, killed_at_ns = kill_once_every_topic_is_logged(
-        tmp_path, folder, 34, kill_writer=True)
+        nodes, tmp_path, folder, kill_writer=True)
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.truncated
@@ -240,15 +237,16 @@ def test_sigkill_of_node_and_writer_keeps_complete_chunks_and_recovery_completes
 
 
 @pytest.mark.parametrize('stop_signal', [signal.SIGINT, signal.SIGTERM], ids=['SIGINT', 'SIGTERM'])
-def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal.Signals) -> None:
+def test_sigint_and_sigterm_finalize_the_bag(
+    nodes: NodeProcesses, tmp_path: Path, stop_signal: signal.Signals
+) -> None:
     folder = tmp_path / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 36, tmp_path / 'node.log'
+        nodes, {**LOOP_PARAMETERS, 'log.folder': str(folder)}, tmp_path / 'node.log'
     ) as (listener, process):
         bag = wait_for_bag(folder, process)
         assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
-        process.send_signal(stop_signal)
-        assert process.wait(timeout=PROCESS_TIMEOUT) == 0, (tmp_path / 'node.log').read_text()
+        assert nodes.interrupt(process, stop_signal) == 0, (tmp_path / 'node.log').read_text()
 
     (mcap_file,) = bag_reader.bag_files(bag)
     assert mcap_file.complete
@@ -264,13 +262,13 @@ def test_sigint_and_sigterm_finalize_the_bag(tmp_path: Path, stop_signal: signal
 
 
 def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(
-        tmp_path: Path) -> None:
+        nodes: NodeProcesses, tmp_path: Path) -> None:
     # chmod does not stop root; a path under a regular file fails for everyone.
     blocker = tmp_path / 'afile'
     blocker.write_text('not a folder')
     folder = blocker / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 37, tmp_path / 'node.log'
+        nodes, {**LOOP_PARAMETERS, 'log.folder': str(folder)}, tmp_path / 'node.log'
     ) as (listener, process):
         assert listener.spin_until(stopped(process))
         listener.spin_until(lambda: False, timeout=1.0)  # anything published arrives by now
@@ -282,7 +280,9 @@ def test_log_folder_that_cannot_be_created_stops_the_node_before_publishing(
     assert blocker.read_text() == 'not a folder'
 
 
-def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_path: Path) -> None:
+def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
     folder = tmp_path / 'bags'
     folder.mkdir()
     now = time.time()
@@ -295,8 +295,8 @@ def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_pa
         (bag / f'{name}_0.mcap').write_bytes(hashlib.sha256(name.encode()).digest() * 64)
         (bag / 'metadata.yaml').write_text(f'old run {name}\n')
         taken[name] = {p.name: p.read_bytes() for p in bag.iterdir()}
-    status, output = run_node(
-        {'log.folder': str(folder), 'rate_hz': 200.0, 'omega0': 10.0, 'end_behavior': 'stop'}, 38,
+    status, output = nodes.run(
+        {'log.folder': str(folder), 'rate_hz': 200.0, 'omega0': 10.0, 'end_behavior': 'stop'},
         tmp_path / 'node.log'
     )
     assert status == 0, output
@@ -311,11 +311,11 @@ def test_a_taken_bag_name_gets_a_new_name_and_the_old_bag_stays_identical(tmp_pa
 
 
 def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_on(
-    tmp_path: Path,
+    nodes: NodeProcesses, tmp_path: Path,
 ) -> None:
     folder = tmp_path / 'bags'
     with node_with_listener(
-        {**LOOP_PARAMETERS, 'log.folder': str(folder)}, 33, tmp_path / 'node.log'
+        nodes, {**LOOP_PARAMETERS, 'log.folder': str(folder)}, tmp_path / 'node.log'
     ) as (listener, process):
         assert listener.wait_for_every_topic(), (tmp_path / 'node.log').read_text()
         writer = bag_writer_pid(process.pid)
@@ -330,8 +330,7 @@ def test_a_bag_writer_that_dies_turns_diagnostics_to_error_and_publishing_goes_o
         states_then = len(listener.received['/linkage/state'])
         assert listener.spin_until(
             lambda: len(listener.received['/linkage/state']) > states_then + 100)
-        process.send_signal(signal.SIGINT)
-        status = process.wait(timeout=PROCESS_TIMEOUT)
+        status = nodes.interrupt(process)
     output = (tmp_path / 'node.log').read_text()
     # The log could not be finalized: status 1, and the one error that says so.
     assert status == 1, output
@@ -345,7 +344,9 @@ def _limit_file_size() -> None:
     resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_SIZE_LIMIT_BYTES, FILE_SIZE_LIMIT_BYTES))
 
 
-def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path: Path) -> None:
+def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
     folder = tmp_path / 'bags'
 
     def recording_failed(got: dict) -> bool:
@@ -356,7 +357,7 @@ def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path:
         )
 
     with node_with_listener(
-        {'log.folder': str(folder), 'rate_hz': 1000.0, 'end_behavior': 'loop'}, 39,
+        nodes, {'log.folder': str(folder), 'rate_hz': 1000.0, 'end_behavior': 'loop'},
         tmp_path / 'node.log', preexec_fn=_limit_file_size,
     ) as (listener, process):
         assert listener.spin_until(lambda: recording_failed(listener.received))
@@ -364,8 +365,7 @@ def test_a_full_disk_turns_diagnostics_to_error_and_publishing_goes_on(tmp_path:
         assert listener.spin_until(
             lambda: len(listener.received['/linkage/state']) > states_at_failure + 200
         )
-        process.send_signal(signal.SIGINT)
-        process.wait(timeout=PROCESS_TIMEOUT)
+        nodes.interrupt(process)
     output = (tmp_path / 'node.log').read_text()
     assert 'File too large' in output and 'Traceback' not in output
 

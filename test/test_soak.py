@@ -12,15 +12,14 @@ from __future__ import annotations
 import math
 import os
 from pathlib import Path
-import signal
 import statistics
 import time
 
+from bag_files import bag_information, only_bag, topic_counts
 from linkage_kinematics.bag import reader as bag_reader
-from node_process import start_node, stop_process
+from node_process import NodeProcesses, TYPESTORE
 import pytest
 from rosbags.rosbag2 import Reader
-from test_bag_writer import bag_information, only_bag, topic_counts, TYPESTORE
 
 RATE_HZ = 1000.0
 SOAK_SECONDS = float(os.environ.get('LINKAGE_SOAK_SECONDS', '600'))
@@ -55,23 +54,21 @@ def missed_deadlines_by_time(bag: Path) -> list[tuple[int, int]]:
     return series
 
 
-def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(tmp_path: Path) -> None:
+def test_one_kilohertz_with_logging_keeps_deadlines_memory_and_log(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
     folder = tmp_path / 'bags'
     output = tmp_path / 'node.log'
-    process = start_node(
-        {'log.folder': str(folder), 'rate_hz': RATE_HZ, 'end_behavior': 'loop'}, 49, output
+    process = nodes.start(
+        {'log.folder': str(folder), 'rate_hz': RATE_HZ, 'end_behavior': 'loop'}, output
     )
-    try:
-        time.sleep(WARM_UP_SECONDS)
-        assert process.poll() is None, output.read_text()
-        rss_start_kib = resident_kib(process.pid)
-        time.sleep(SOAK_SECONDS - WARM_UP_SECONDS)
-        assert process.poll() is None, output.read_text()
-        rss_end_kib = resident_kib(process.pid)
-        process.send_signal(signal.SIGINT)
-        assert process.wait(timeout=60) == 0, output.read_text()
-    finally:
-        stop_process(process)
+    time.sleep(WARM_UP_SECONDS)
+    assert process.poll() is None, output.read_text()
+    rss_start_kib = resident_kib(process.pid)
+    time.sleep(SOAK_SECONDS - WARM_UP_SECONDS)
+    assert process.poll() is None, output.read_text()
+    rss_end_kib = resident_kib(process.pid)
+    assert nodes.interrupt(process) == 0, output.read_text()
     assert rss_end_kib - rss_start_kib < MAX_RSS_GROWTH_KIB, (rss_start_kib, rss_end_kib)
 
     bag = only_bag(folder)
