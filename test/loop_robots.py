@@ -47,7 +47,7 @@ Triple = tuple[float, float, float]
 
 
 def _rpy_matrix(rpy: Triple) -> np.ndarray:
-    """Rotation of URDF roll–pitch–yaw: Rz(yaw)·Ry(pitch)·Rx(roll)."""
+    """Return the rotation of URDF roll–pitch–yaw: Rz(yaw)·Ry(pitch)·Rx(roll)."""
     roll, pitch, yaw = rpy
     cr, sr = math.cos(roll), math.sin(roll)
     cp, sp = math.cos(pitch), math.sin(pitch)
@@ -60,7 +60,7 @@ def _rpy_matrix(rpy: Triple) -> np.ndarray:
 
 
 def _turn_rpy(axis: Triple, angle: float) -> Triple:
-    """rpy of a turn by ``angle`` about a coordinate axis ``axis`` (±x, ±y or ±z) of a frame."""
+    """Return the rpy of a turn by ``angle`` about a frame's coordinate axis (±x, ±y, ±z)."""
     index = [abs(component) for component in axis].index(1.0)
     rpy = [0.0, 0.0, 0.0]
     rpy[index] = math.copysign(angle, axis[index])
@@ -68,12 +68,12 @@ def _turn_rpy(axis: Triple, angle: float) -> Triple:
 
 
 def _triple(values: Triple) -> str:
-    """URDF attribute text of three floats, each written so it reads back exactly."""
+    """Write three floats as URDF attribute text, each so that it reads back exactly."""
     return ' '.join(repr(float(value)) for value in values)
 
 
 def _unit(vector: np.ndarray) -> np.ndarray:
-    """``vector`` scaled to length 1."""
+    """Scale ``vector`` to length 1."""
     return vector / np.linalg.norm(vector)
 
 
@@ -91,7 +91,7 @@ class _Drawing:
     def _origin(self, parent: str, at: Point,
                 rpy: Triple) -> tuple[str, tuple[np.ndarray, np.ndarray]]:
         """
-        Origin text for a frame at world point ``at`` turned by ``rpy`` from ``parent``.
+        Return the origin text for a frame at world point ``at`` turned by ``rpy`` from ``parent``.
 
         Also returns the frame's world pose as a reader of the text computes it (the written
         floats read back exactly, so only the reader's own float64 products round).
@@ -165,7 +165,7 @@ class _Drawing:
 
 def _in_plane(origin: Point, direction_angle: float, distance: float, depth: float,
               plane: str) -> Point:
-    """The point ``distance`` from ``origin`` at ``direction_angle`` in the ``plane`` (xy/yz)."""
+    """Return the point ``distance`` from ``origin`` at ``direction_angle`` in a plane."""
     u, v = math.cos(direction_angle) * distance, math.sin(direction_angle) * distance
     if plane == 'xy':
         return (origin[0] + u, origin[1] + v, depth)
@@ -339,7 +339,7 @@ def excavator() -> str:
     guide_link_end = (6.15, DEPTH_4 * 2, 0.35)
 
     def cylinder(base: Point, end: Point, barrel_length: float) -> tuple[Point, Triple]:
-        """The barrel end (where the rod joint sits) and the in-plane direction base→end."""
+        """Return the barrel end (where the rod joint sits) and the direction base→end."""
         direction = _unit(np.array([end[0] - base[0], 0.0, end[2] - base[2]]))
         barrel_end = (base[0] + barrel_length * direction[0], base[1],
                       base[2] + barrel_length * direction[2])
