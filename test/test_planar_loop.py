@@ -1,0 +1,188 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Planar loops of four joints solved from one known joint (``kinematics.planar_loop``).
+
+Four-bars (all revolute) are checked against a direct evaluation of the loop closure, central
+differences of the solved coordinates, and the existing four-bar solve they are mapped onto.
+"""
+
+from __future__ import annotations
+
+import math
+
+from linkage_kinematics.kinematics.closed_form import CrankRates
+from linkage_kinematics.kinematics.geometry import FourBar, GeometryError, UnreachableError
+from linkage_kinematics.kinematics.planar_loop import (
+    branch_of,
+    continued_branch_of,
+    joint_points,
+    JointKind,
+    known_joint_range,
+    PlanarLoop,
+    solve_loop,
+)
+from linkage_kinematics.kinematics.solver import DeadPointError, solve
+import pytest
+
+REVOLUTE = JointKind.REVOLUTE
+PRISMATIC = JointKind.PRISMATIC
+STEP = 1e-6  # central-difference step (rad or m)
+
+
+def loop_from_points(points: list[tuple[float, float]], kinds=(REVOLUTE,) * 4,
+                     slide=None) -> PlanarLoop:
+    """Return the loop whose joints are at ``points`` in its zero pose (all frames aligned)."""
+    links = tuple((points[(k + 1) % 4][0] - points[k][0], points[(k + 1) % 4][1] - points[k][1])
+                  for k in range(4))
+    return PlanarLoop(tuple(kinds), links, slide)
+
+
+def closure_residual(loop: PlanarLoop, coordinates: tuple[float, ...]) -> float:
+    """Return the distance (m) from joint 0 to the end of the chain 0 → 1 → 2 → 3 → 0."""
+    points, angles = joint_points(loop, coordinates)
+    theta = angles[3]
+    link_x, link_y = loop.links[3]
+    end_x = points[3][0] + math.cos(theta) * link_x - math.sin(theta) * link_y
+    end_y = points[3][1] + math.sin(theta) * link_x + math.cos(theta) * link_y
+    return math.hypot(end_x, end_y)
+
+
+def angle_sum_residual(loop: PlanarLoop, coordinates: tuple[float, ...]) -> float:
+    """Return |Σ φ_k| modulo 2π: the cut pin closes the turn."""
+    total = sum(value for value, kind in zip(coordinates, loop.kinds) if kind is REVOLUTE)
+    return abs(math.remainder(total, 2.0 * math.pi))
+
+
+def coordinate_gap(loop: PlanarLoop, first: float, second: float, joint: int) -> float:
+    """Return the difference of two values of one coordinate (wrapped for a revolute joint)."""
+    if loop.kinds[joint] is REVOLUTE:
+        return math.remainder(first - second, 2.0 * math.pi)
+    return first - second
+
+
+def assert_state_consistent(loop: PlanarLoop, known: int, value: float, branch: int,
+                            rate: float = 1.7) -> None:
+    """Check closure, the known coordinate, and the rates against central differences."""
+    state = solve_loop(loop, known, value, rate, branch)
+    assert state.coordinates[known] == value
+    assert state.rates[known] == rate
+    assert all(math.isfinite(x) for x in state.coordinates + state.rates)
+    assert closure_residual(loop, state.coordinates) <= 1e-13
+    assert angle_sum_residual(loop, state.coordinates) <= 1e-13
+    assert branch_of(loop, known, state.coordinates) == branch
+    after = solve_loop(loop, known, value + STEP, rate, branch)
+    before = solve_loop(loop, known, value - STEP, rate, branch)
+    scale = max(abs(x) for x in state.rates)
+    for joint in range(4):
+        difference = coordinate_gap(loop, after.coordinates[joint], before.coordinates[joint],
+                                    joint) / (2.0 * STEP) * rate
+        assert abs(difference - state.rates[joint]) <= 1e-6 * scale, (joint, state)
+
+
+# A crank-rocker (joint 1 turns fully), a double-rocker and a parallelogram, in zero poses.
+CRANK_ROCKER = loop_from_points([(0.0, 0.0), (0.3, 0.05), (1.1, 0.65), (0.9, -0.3)])
+DOUBLE_ROCKER = loop_from_points([(0.0, 0.0), (1.0, 0.0), (1.2, 0.5), (0.3, 0.9)])
+PARALLELOGRAM = loop_from_points([(0.0, 0.0), (1.0, 0.0), (1.3, 0.4), (0.3, 0.4)])
+FOUR_BARS = {'crank_rocker': CRANK_ROCKER, 'double_rocker': DOUBLE_ROCKER,
+             'parallelogram': PARALLELOGRAM}
+
+
+def sample_values(loop: PlanarLoop, known: int, count: int = 9) -> list[float]:
+    """Return values spread over the known joint's reachable intervals, ends excluded."""
+    reach = known_joint_range(loop, known)
+    values = []
+    for low, high in reach.intervals:
+        margin = 1e-3 * (high - low)
+        values += [low + margin + (high - low - 2 * margin) * i / (count - 1)
+                   for i in range(count)]
+    return [value for value in values if reach.change_point_distance(value) is None
+            or reach.change_point_distance(value) > 1e-4]
+
+
+@pytest.mark.parametrize('name', sorted(FOUR_BARS))
+@pytest.mark.parametrize('known', (1, 2, 3))
+@pytest.mark.parametrize('branch', (1, -1))
+def test_four_bar_closes_and_rates_match_differences(name: str, known: int, branch: int) -> None:
+    loop = FOUR_BARS[name]
+    for value in sample_values(loop, known):
+        assert_state_consistent(loop, known, value, branch)
+
+
+@pytest.mark.parametrize('name', sorted(FOUR_BARS))
+@pytest.mark.parametrize('known', (1, 2, 3))
+def test_the_zero_pose_is_solved_on_its_own_branch(name: str, known: int) -> None:
+    loop = FOUR_BARS[name]
+    branch = branch_of(loop, known, (0.0, 0.0, 0.0, 0.0))
+    state = solve_loop(loop, known, 0.0, 1.0, branch)
+    assert max(abs(x) for x in state.coordinates) <= 1e-14
+
+
+def test_four_bar_known_one_is_the_existing_solve_mapped() -> None:
+    linkage = FourBar(0.3, math.sqrt(1.09), 0.3, 1.3, 0.0)
+    zero = solve(linkage, 0.0, CrankRates(0.0, 0.0), 1)
+    # Joint 0 = C, 1 = O, 2 = A, 3 = B, body 0's frame the FourBar's.
+    loop = loop_from_points([(1.3, 0.0), (0.0, 0.0), (zero.pin_a_x, zero.pin_a_y),
+                             (zero.pin_b_x, zero.pin_b_y)])
+    assert branch_of(loop, 1, (0.0,) * 4) == 1
+    for alpha in (-0.02, 0.0, 0.4, 1.5, 3.0):
+        state = solve(linkage, alpha, CrankRates(2.0, 0.0), 1)
+        mapped = solve_loop(loop, 1, alpha, 2.0, 1)
+        coupler = state.gamma - zero.gamma
+        rocker = -(state.beta - zero.beta)
+        expected = (-rocker, alpha, coupler - alpha, rocker - coupler)
+        for got, want in zip(mapped.coordinates, expected):
+            assert abs(math.remainder(got - want, 2 * math.pi)) <= 4e-15
+        # The loop's link lengths come from differences of the pins: equal to rounding.
+        assert mapped.rates == pytest.approx((-state.omega_bc, 2.0, state.omega_ab - 2.0,
+                                              state.omega_bc - state.omega_ab), rel=1e-13)
+
+
+def test_four_bar_range_and_refusals() -> None:
+    loop = DOUBLE_ROCKER
+    reach = known_joint_range(loop, 3)
+    assert len(reach.dead_points) == 4 and not reach.full_rotation
+    dead = reach.dead_points[0]
+    assert reach.dead_point_distance(dead) == 0.0
+    branch = 1
+    with pytest.raises(DeadPointError, match='joint 3'):
+        solve_loop(loop, 3, dead, 1.0, branch)
+    outside = dead - 1e-3 if reach.contains(dead + 1e-3) else dead + 1e-3
+    with pytest.raises(UnreachableError, match='joint 3'):
+        solve_loop(loop, 3, outside, 1.0, branch)
+    assert known_joint_range(CRANK_ROCKER, 1).full_rotation
+
+
+def test_parallelogram_continues_through_its_change_points() -> None:
+    loop = PARALLELOGRAM
+    reach = known_joint_range(loop, 1)
+    assert len(reach.change_points) == 2
+    branch = branch_of(loop, 1, (0.0,) * 4)
+    # Over a whole turn the smooth branch keeps the parallelogram: φ2 = −φ1, φ3 = φ1, φ0 = −φ1.
+    for step in range(-360, 361, 5):
+        value = math.radians(step)
+        state = solve_loop(loop, 1, value, 1.0,
+                           continued_branch_of(loop, 1, 0.0, branch, value))
+        for got, want in zip(state.coordinates, (-value, value, -value, value)):
+            assert abs(math.remainder(got - want, 2 * math.pi)) <= 1e-13
+        assert state.rates == pytest.approx((-1.0, 1.0, -1.0, 1.0), abs=1e-13)
+
+
+@pytest.mark.parametrize('kinds, links, slide, problem', [
+    ((PRISMATIC,) + (REVOLUTE,) * 3, ((1.0, 0.0),) * 4, (1.0, 0.0), 'cut pin'),
+    ((REVOLUTE, PRISMATIC, PRISMATIC, REVOLUTE), ((1.0, 0.0),) * 4, (1.0, 0.0), 'at most one'),
+    ((REVOLUTE,) * 4, ((1.0, 0.0),) * 3, None, 'four finite'),
+    ((REVOLUTE,) * 4, ((1.0, 0.0),) * 3 + ((math.nan, 0.0),), None, 'four finite'),
+    ((REVOLUTE, PRISMATIC, REVOLUTE, REVOLUTE), ((1.0, 0.0),) * 4, None, 'slide'),
+    ((REVOLUTE, PRISMATIC, REVOLUTE, REVOLUTE), ((1.0, 0.0),) * 4, (2.0, 0.0), 'unit'),
+    ((REVOLUTE,) * 4, ((1.0, 0.0),) * 4, (1.0, 0.0), 'no joint is prismatic'),
+])
+def test_invalid_loops_are_refused(kinds, links, slide, problem) -> None:
+    with pytest.raises(GeometryError, match=problem):
+        PlanarLoop(kinds, links, slide)
+
+
+def test_known_joint_must_not_be_the_cut_pin() -> None:
+    with pytest.raises(ValueError, match='known joint'):
+        solve_loop(CRANK_ROCKER, 0, 0.0, 1.0, 1)
