@@ -41,6 +41,7 @@ setup(
             'linkage-sweep = linkage_kinematics.cli.sweep:main',
             'linkage-replay = linkage_kinematics.cli.replay:main',
             'linkage-demo = linkage_kinematics.cli.demo:main',
+            'linkage-check-loops = linkage_kinematics.cli.check_loops:main',
         ],
     },
 )

@@ -24,6 +24,7 @@ import sys
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.model.loop_geometry import Loop, LoopJoint
+from linkage_kinematics.model.loop_urdf import LoopError
 from linkage_kinematics.model.loops import (
     find_loops,
     LoopPlan,
@@ -31,7 +32,6 @@ from linkage_kinematics.model.loops import (
     RobotLoops,
     zero_pose_branch,
 )
-from linkage_kinematics.model.loop_urdf import LoopError
 
 PROGRAM = 'linkage-check-loops'
 EXIT_PROBLEMS = 1
@@ -83,8 +83,8 @@ def _range_lines(loop: Loop, joint: LoopJoint, branch: int) -> list[str]:
             reachable += ' (modulo 360°)'
 
     def points(values: Sequence[float]) -> str:
-        return ', '.join(_value(joint, joint.sign * value)
-                         for value in sorted(values, key=lambda value: joint.sign * value)) or 'none'
+        shown = sorted(joint.sign * value for value in values)
+        return ', '.join(_value(joint, value) for value in shown) or 'none'
 
     return [f'    reachable: {reachable}',
             f'    dead points: {points(reach.dead_points)}',
@@ -127,8 +127,8 @@ def _loop_lines(loop: Loop) -> list[str]:
 
 def report(loops: RobotLoops, plan: LoopPlan | None) -> list[str]:
     """Return the printout for ``loops``, with each loop's known joint from ``plan`` if given."""
-    lines = [f'robot {loops.robot_name!r}: {len(loops.loops)} loop(s) to close'
-             f'{", " + str(len(loops.problems)) + " constraint(s) refused" if loops.problems else ""}']
+    refused = f', {len(loops.problems)} constraint(s) refused' if loops.problems else ''
+    lines = [f'robot {loops.robot_name!r}: {len(loops.loops)} loop(s) to close{refused}']
     planned = {item.loop.constraint: item for item in plan.loops} if plan is not None else {}
     solver_of = {joint.name: item.loop.constraint
                  for item in planned.values() for joint in item.passive}
