@@ -111,8 +111,8 @@ def test_measured_joints_that_do_not_fit_are_problems(tmp_path: Path) -> None:
 
 
 def test_a_passive_mimic_joint_is_a_warning(tmp_path: Path) -> None:
-    urdf = four_bar().replace('<origin xyz="0 1 0"/><axis xyz="0 0 1"/>',
-                              '<origin xyz="0 1 0"/><axis xyz="0 0 1"/><mimic joint="crank_joint"/>')
+    coupler_axis = '<origin xyz="0 1 0"/><axis xyz="0 0 1"/>'
+    urdf = four_bar().replace(coupler_axis, coupler_axis + '<mimic joint="crank_joint"/>')
     completed = run(write(tmp_path, urdf), '--measured', 'crank_joint')
     assert completed.returncode == 0
     assert completed.stderr.splitlines() == [

@@ -322,7 +322,7 @@ def test_a_refused_sample_leaves_the_solver_as_it_was() -> None:
 
 
 def test_continuous_joints_stay_continuous_and_the_branch_holds_through_change_points() -> None:
-    """A parallelogram O, A (0, 1), B (2, 1), C (2, 0) whose crank turns twice: coupler = −crank."""
+    """A parallelogram O, A (0, 1), B (2, 1), C (2, 0) turning twice: coupler = −crank."""
     urdf = four_bar(crank_type='continuous', coupler_type='continuous',
                     rocker_type='continuous').replace(
         '<parent_origin xyz="2 0.5 0"/>', '<parent_origin xyz="2 0 0"/>').replace(
