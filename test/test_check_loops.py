@@ -120,6 +120,13 @@ def test_a_passive_mimic_joint_is_a_warning(tmp_path: Path) -> None:
         "also mimics 'crank_joint': robot_state_publisher would pose it from two sources"]
 
 
+def test_the_parsers_other_notes_are_shown_but_are_no_problem(tmp_path: Path) -> None:
+    completed = run(write(tmp_path, four_bar(extra='\n  <lab_extension/>')))
+    assert completed.returncode == 0
+    assert completed.stderr == (f'{PROGRAM}: note: urdf_parser_py: Unknown tag "lab_extension" '
+                                "in /robot[@name='test_four_bar']\n")
+
+
 def test_a_urdf_without_constraints_is_fine(tmp_path: Path) -> None:
     completed = run(write(tmp_path, parallelogram_mimic()))
     assert completed.returncode == 0

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from linkage_kinematics.kinematics.planar_loop import JointKind
+from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 from linkage_kinematics.model.loops import find_loops, LoopSampleError, LoopSolver
 import loop_reference
@@ -160,8 +160,8 @@ def test_constraint_types_other_than_revolute_are_refused(kind: str) -> None:
 
 
 def test_unknown_links_are_refused() -> None:
-    with pytest.raises(LoopError, match="constraint 'pin': child link 'rocket' is not a <link>"):
-        find_loops(four_bar(child_link='rocket'))
+    assert refusal(four_bar(child_link='rocket')) == (
+        "constraint 'pin': child link 'rocket' is not a <link> of the robot")
 
 
 def test_loops_of_other_than_three_moving_joints_are_refused() -> None:
@@ -314,6 +314,12 @@ def test_a_refused_sample_leaves_the_solver_as_it_was() -> None:
     with pytest.raises(LoopSampleError, match=r"constraint 'pin' at rocker_joint = 1\.5: .*not "
                                               'reachable'):
         solver.solve({'rocker_joint': 1.5}, {'rocker_joint': 1.0})
+    # the end of the rocker's reach: coupler and rocker in line (58.6°, sign +1)
+    loop = solver.plan.loops[0].loop
+    dead = max(value for value in known_joint_range(loop.planar, 3).dead_points if value < 1.5)
+    with pytest.raises(LoopSampleError, match="constraint 'pin' at rocker_joint = 1.02333929: "
+                                              '.*dead point'):
+        solver.solve({'rocker_joint': dead}, {'rocker_joint': 1.0})
     with pytest.raises(LoopSampleError, match='no position and velocity for measured joint'):
         solver.solve({'rocker_joint': 0.2}, {})
     with pytest.raises(LoopSampleError, match='are not both finite'):

@@ -108,6 +108,8 @@ class Robot:
     joint_above: dict[str, TreeJoint]
     links: dict[str, Pose]
     constraints: tuple[Constraint, ...]
+    # one line for each <constraint> that cannot be read (its name, and why)
+    constraint_problems: tuple[str, ...]
     # what urdf_parser_py said about the text, other than that it does not know <constraint>
     parser_messages: tuple[str, ...]
 
@@ -250,38 +252,44 @@ def _constraint_side(element: ElementTree.Element, side: str, links: dict[str, P
     return ConstraintFrame(link, frame, axis)
 
 
-def _constraints(root: ElementTree.Element, links: dict[str, Pose]) -> tuple[Constraint, ...]:
-    constraints = []
+def _constraints(root: ElementTree.Element,
+                 links: dict[str, Pose]) -> tuple[tuple[Constraint, ...], tuple[str, ...]]:
+    """Return the constraints that can be read, and one line for each that cannot."""
+    constraints, problems = [], []
     names: set[str] = set()
     for element in root.findall('constraint'):
         name = element.get('name')
-        if not name:
-            raise LoopError('a <constraint> has no name')
-        if name in names:
-            raise LoopError(f'constraint {name!r}: the name is used twice')
-        names.add(name)
         where = f'constraint {name!r}'
-        constraints.append(Constraint(
-            name, element.get('type', ''), _constraint_side(element, 'parent', links, where),
-            _constraint_side(element, 'child', links, where)))
-    return tuple(constraints)
+        try:
+            if not name:
+                raise LoopError('a <constraint> has no name')
+            if name in names:
+                raise LoopError(f'{where}: the name is used twice')
+            names.add(name)
+            constraints.append(Constraint(
+                name, element.get('type', ''), _constraint_side(element, 'parent', links, where),
+                _constraint_side(element, 'child', links, where)))
+        except LoopError as error:
+            problems.append(str(error))
+    return tuple(constraints), tuple(problems)
 
 
 def read_robot(urdf: str) -> Robot:
     """
     Read a URDF's tree at the zero pose and its ``<constraint>`` elements.
 
-    Raises LoopError, naming the element, for a text that is not a URDF robot, joints that do
-    not form a tree, or a constraint that names an unknown link or holds a malformed number.
+    Raises LoopError, naming the element, for a text that is not a URDF robot or joints that do
+    not form a tree; a constraint that names an unknown link or holds a malformed number is one
+    line of ``constraint_problems``.
     """
     # bytes: lxml refuses a str that carries an XML encoding declaration, as xacro writes one
     data = urdf.encode('utf-8')
     parsed, messages = _parse_tree(data)
     root, joints, links = _tree_joints(parsed)
-    element = ElementTree.fromstring(data)
+    constraints, problems = _constraints(ElementTree.fromstring(data), links)
     return Robot(str(parsed.name), root, joints,
-                 {joint.child: joint for joint in joints.values()}, links,
-                 _constraints(element, links), messages)
+                 {joint.child: joint for joint in joints.values()}, links, constraints, problems,
+                 messages)
 
 
 def tree_path(robot: Robot, start: str, end: str) -> list[tuple[TreeJoint, bool]]:

@@ -167,7 +167,7 @@ def find_loops(urdf: str) -> RobotLoops:
     constraints that cannot be closed are returned as ``problems``.
     """
     robot = read_robot(urdf)
-    loops, problems = [], []
+    loops, problems = [], list(robot.constraint_problems)
     for constraint in robot.constraints:
         try:
             loops.append(derive_loop(robot, constraint))
