@@ -39,6 +39,7 @@ from linkage_kinematics.kinematics.geometry import (
     wrap_angle,
 )
 from linkage_kinematics.kinematics.joint_range import KnownJointRange
+from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
 from linkage_kinematics.kinematics.solver import DeadPointError, solve
 
 __all__ = [
@@ -155,9 +156,9 @@ def _four_bar(loop: PlanarLoop, known: int) -> FourBar:
         raise GeometryError(f'the four-bar loop driven at joint {known}: {error}') from None
 
 
-def _prismatic(loop: PlanarLoop, known: int):
-    # The loops with a prismatic joint get their closed forms in the next commit.
-    raise NotImplementedError('loops with a prismatic joint are not solved yet')
+@lru_cache(maxsize=_CACHE_SIZE)
+def _prismatic(loop: PlanarLoop, known: int) -> PrismaticLoop:
+    return PrismaticLoop(loop.links, loop.slide, loop.prismatic, known)
 
 
 def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
