@@ -79,7 +79,19 @@ def test_the_excavator_says_which_loop_solves_the_bucket_link(tmp_path: Path) ->
     assert "constraint 'boom_cylinder_pin': one prismatic joint (boom_cylinder)" in lines
     assert "  known (solved by constraint 'bucket_cylinder_pin'): bucket_link_joint" in lines
     assert '  known (measured): bucket_cylinder' in lines
-    assert sum(line.startswith('  slide: along ') for line in lines) == 3
+    # the cylinders' lines run through their pivots; the plane's normal is the pins' ±y
+    assert sum(line.startswith('  slide: along ') and line.endswith(', offset 0.000000 m')
+               for line in lines) == 3
+    assert sum(line in ('  plane normal in the world: (0, 1, 0)',
+                        '  plane normal in the world: (0, -1, 0)') for line in lines) == 4
+
+
+def test_the_slider_crank_offset_is_found(tmp_path: Path) -> None:
+    """loop_robots' slide line passes 2 cm below the crank pivot, tilted −0.15 rad."""
+    completed = run(write(tmp_path, ROBOTS['slider_crank'].urdf()))
+    assert completed.returncode == 0, completed.stderr
+    assert (f'  slide: along ({math.cos(-0.15):.6g}, {math.sin(-0.15):.6g}, 0) in the world, '
+            f'offset {0.02 * math.cos(0.15):.6f} m') in completed.stdout.splitlines()
 
 
 def test_each_problem_is_one_line_and_exit_1(tmp_path: Path) -> None:

@@ -65,7 +65,8 @@ def _value(joint: LoopJoint, value: float) -> str:
 
 
 def _vector(vector: Sequence[float]) -> str:
-    return '(' + ', '.join(f'{component + 0.0:.6g}' for component in vector) + ')'
+    # a direction's rounding residue (a frame tilted by a rounded π/2) shows as 0, and −0 as 0
+    return '(' + ', '.join(f'{round(component, 12) + 0.0:.6g}' for component in vector) + ')'
 
 
 def _range_lines(loop: Loop, joint: LoopJoint, branch: int) -> list[str]:
