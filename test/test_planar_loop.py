@@ -23,7 +23,9 @@ from linkage_kinematics.kinematics.planar_loop import (
     PlanarLoop,
     solve_loop,
 )
+from linkage_kinematics.kinematics.singular_points import RATE_ACCURACY
 from linkage_kinematics.kinematics.solver import DeadPointError, solve
+from prismatic_reference import errors, input_floor, reference_dead_point, reference_state
 import pytest
 
 REVOLUTE = JointKind.REVOLUTE
@@ -241,3 +243,71 @@ def test_rrrp_zero_pose_is_solved_on_its_own_branch(name: str, known: int) -> No
     branch = branch_of(loop, known, (0.0, 0.0, 0.0, 0.0))
     state = solve_loop(loop, known, 0.0, 1.0, branch)
     assert max(abs(x) for x in state.coordinates) <= 1e-14
+
+
+# --- RRRP against the independent 50-digit reference --------------------------------------------
+
+# The results' own rounding (rad, m or relative) allowed on top of 3× the input floor.
+ROUNDING = 2e-15
+# The two numberings that between them make every case: slide p = 2 (known 1 and 3 next to it,
+# 2 the slide) and p = 1 (known 1 the slide, 2 next to it, 3 opposite it).
+REFERENCE_LOOPS = {
+    'slider_crank': (slider_crank(0.1, 0.3, 0.02, 0), slider_crank(0.1, 0.3, 0.02, 1)),
+    'cylinder': (cylinder(0), cylinder(1)),
+}
+
+
+def assert_as_accurate_as_the_input(loop: PlanarLoop, known: int, value: float,
+                                    branch: int) -> None:
+    """Check a solved state against the reference: within 3× the input floor plus rounding."""
+    state = solve_loop(loop, known, value, 1.3, branch)
+    exact = reference_state(loop, known, value, 1.3, state.coordinates)
+    coordinate_error, rate_error = errors(loop, state.coordinates, state.rates, exact)
+    coordinate_floor, rate_floor = input_floor(loop, known, value, 1.3, state.coordinates)
+    assert coordinate_error <= 3.0 * coordinate_floor + ROUNDING * max(1.0, abs(value)), value
+    assert rate_error <= 3.0 * rate_floor + ROUNDING, value
+    assert reference_side(loop, known, exact[0]) == branch
+
+
+def reference_side(loop: PlanarLoop, known: int, coordinates: list) -> int:
+    """Return the branch the library's branch_of gives for the reference's (rounded) answer."""
+    return branch_of(loop, known, tuple(float(x) for x in coordinates))
+
+
+@pytest.mark.parametrize('name', sorted(REFERENCE_LOOPS))
+@pytest.mark.parametrize('numbering', (0, 1))
+@pytest.mark.parametrize('known', (1, 2, 3))
+def test_rrrp_dead_points_at_float64s_limit(name: str, numbering: int, known: int) -> None:
+    loop = REFERENCE_LOOPS[name][numbering]
+    reach = known_joint_range(loop, known)
+    for dead in reach.dead_points:
+        exact = reference_dead_point(loop, known, dead)
+        assert abs(float(exact) - dead) <= 1e-15 * max(1.0, abs(dead))
+        inward = 1.0 if reach.contains(dead + 1e-6 * max(1.0, abs(dead))) else -1.0
+        for branch in (1, -1):
+            for relative in (1e-3, 1e-6, 1e-9, 1e-12, 1e-13, 1e-14, 1e-15):
+                distance = relative * max(1.0, abs(dead))
+                value = float(exact + inward * distance)
+                # the four-bar's rule: refuse where 1.5·ulp(value) > RATE_ACCURACY·distance
+                ratio = 1.5 * math.ulp(value) / (RATE_ACCURACY * distance)
+                if ratio > 2.0:
+                    with pytest.raises(DeadPointError):
+                        solve_loop(loop, known, value, 1.3, branch)
+                elif ratio < 0.5:
+                    assert_as_accurate_as_the_input(loop, known, value, branch)
+            with pytest.raises(UnreachableError):
+                solve_loop(loop, known, float(exact - inward * 1e-9 * max(1.0, abs(dead))),
+                           1.3, branch)
+        # the float nearest the dead point: on it (refused) or just past it (unreachable)
+        with pytest.raises((DeadPointError, UnreachableError)):
+            solve_loop(loop, known, dead, 1.3, 1)
+
+
+@pytest.mark.parametrize('name', sorted(REFERENCE_LOOPS))
+@pytest.mark.parametrize('numbering', (0, 1))
+@pytest.mark.parametrize('known', (1, 2, 3))
+def test_rrrp_over_the_reachable_range(name: str, numbering: int, known: int) -> None:
+    loop = REFERENCE_LOOPS[name][numbering]
+    for value in sample_values(loop, known, 5):
+        for branch in (1, -1):
+            assert_as_accurate_as_the_input(loop, known, value, branch)

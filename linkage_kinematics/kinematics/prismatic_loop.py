@@ -453,6 +453,7 @@ def _constants(loop: PrismaticLoop, links: tuple[Vector, ...], slide: Vector) ->
     loop.scale = float(max(loop._length_a, loop._length_c, abs(loop._m[0]),
                            abs(loop._m[1])))
 
+
 def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
     """Return the discriminant's factors for this case (module docstring)."""
     with localcontext() as context:
@@ -483,6 +484,7 @@ def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
         what = (f'the circle of radius {float(radius):.6g} m never meets the slide line')
         return (_sinusoid(radius - offset, near_length, kappa - _PI / 2, loop.sense, what),
                 _sinusoid(radius + offset, near_length, kappa + _PI / 2, loop.sense, what))
+
 
 def _range(loop: PrismaticLoop) -> KnownJointRange:
     change_points = tuple(factor.first[0] for factor in loop.factors if factor.is_change)
