@@ -31,9 +31,12 @@ along n is a constant of the geometry (zero for an exactly planar drawing, a few
 frame is tilted by a rounded π/2) that no joint changes. The square system is therefore the
 gap's two components in the plane, n × e and e for a unit e perpendicular to n, for each
 constraint: two equations per constraint, and two unknowns per loop of three tree joints of
-which one is known (measured, or solved by another loop). The projection (n, e) is taken at the
-guess and held fixed during the solve, so the equations are one smooth function whose exact
-Jacobian Newton gets.
+which one is known (measured, or solved by another loop). The plane (n, e) is the loop's plane
+as drawn, at the all-zero pose, for every configuration: the equations are then one smooth
+function, the same for :func:`solve`, :func:`velocities` and :func:`planar_residuals`, whose
+exact Jacobian Newton gets. (Taking n from the current configuration instead would mix a
+tilted frame's ~1e-17 m out-of-plane gap into the plane by its ~1e-17 rad turn, about 1e-34 m,
+which is above the 1e-40 m the solve promises.)
 """
 
 from __future__ import annotations
@@ -194,7 +197,13 @@ def parse(urdf_text: str) -> Robot:
 
 
 def _rpy_rotation(rpy: tuple[float, float, float]) -> Rotation:
-    """Return Rz(yaw)·Ry(pitch)·Rx(roll), URDF's convention."""
+    """Return Rz(yaw)·Ry(pitch)·Rx(roll), URDF's convention, at the working precision."""
+    return _rpy_rotation_at(rpy, mp.prec)
+
+
+@functools.lru_cache(maxsize=1024)
+def _rpy_rotation_at(rpy: tuple[float, float, float], precision: int) -> Rotation:
+    """Return Rz(yaw)·Ry(pitch)·Rx(roll) at ``precision`` bits (cached: Newton repeats them)."""
     roll, pitch, yaw = (mpf(angle) for angle in rpy)
     cr, sr = mp.cos(roll), mp.sin(roll)
     cp, sp = mp.cos(pitch), mp.sin(pitch)
@@ -210,10 +219,16 @@ def _unit(vector: Sequence[float | mpf]) -> Vector:
     return (mpf(vector[0]) / length, mpf(vector[1]) / length, mpf(vector[2]) / length)
 
 
+@functools.lru_cache(maxsize=1024)
+def _unit_axis(axis: tuple[float, float, float], precision: int) -> Vector:
+    """Return a written axis scaled to length 1 at ``precision`` bits (cached)."""
+    return _unit(axis)
+
+
 def _apply(rotation: Rotation, vector: Vector) -> Vector:
     """Return rotation · vector."""
-    return tuple(row[0] * vector[0] + row[1] * vector[1] + row[2] * vector[2]
-                 for row in rotation)
+    # fdot: one rounding per component, and twice as fast as three products and two sums.
+    return tuple(mp.fdot(row, vector) for row in rotation)
 
 
 def _times(left: Rotation, right: Rotation) -> Rotation:
@@ -245,7 +260,7 @@ def _scale(factor: mpf, a: Vector) -> Vector:
 
 
 def _dot(a: Vector, b: Vector) -> mpf:
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    return mp.fdot(a, b)
 
 
 def _cross(a: Vector, b: Vector) -> Vector:
@@ -290,12 +305,13 @@ def _forward(robot: Robot, values: Mapping[str, float | mpf]) -> _Kinematics:
     axes, points = {}, {}
     for joint in robot.joints.values():
         frame = links[joint.parent].then(joint.origin)
-        axis = _apply(frame.rotation, _unit(joint.axis))
+        unit_axis = _unit_axis(joint.axis, mp.prec)
+        axis = _apply(frame.rotation, unit_axis)
         axes[joint.name], points[joint.name] = axis, frame.position
         value = _joint_value(robot, values, joint.name)
         if joint.kind in ('revolute', 'continuous'):
             links[joint.child] = _Pose(_times(frame.rotation,
-                                              _axis_angle(_unit(joint.axis), value)),
+                                              _axis_angle(unit_axis, value)),
                                        frame.position)
         elif joint.kind == 'prismatic':
             links[joint.child] = _Pose(frame.rotation,
@@ -349,6 +365,16 @@ def _pin_points(kinematics: _Kinematics, constraint: Constraint) -> tuple[Vector
     parent = kinematics.links[constraint.parent].then(constraint.parent_origin)
     child = kinematics.links[constraint.child].then(constraint.child_origin)
     return parent.position, child.position
+
+
+@functools.lru_cache(maxsize=32)
+def _drawn_planes(urdf_text: str) -> Mapping[str, _Plane]:
+    """Return each loop's plane as drawn (all joints at 0), after checking it is planar."""
+    robot = parse(urdf_text)
+    with mp.workdps(DIGITS):
+        kinematics = _forward(robot, {})
+        return MappingProxyType({name: _plane(robot, kinematics, constraint)
+                                 for name, constraint in robot.constraints.items()})
 
 
 def _plane(robot: Robot, kinematics: _Kinematics, constraint: Constraint) -> _Plane:
@@ -445,9 +471,7 @@ def solve(urdf_text: str, known: Mapping[str, float | mpf], guess: Mapping[str, 
     with mp.workdps(DIGITS):
         fixed = {joint: mpf(value) for joint, value in known.items()}
         start = [mpf(guess.get(joint, 0)) for joint in unknowns]
-        start_kinematics = _forward(robot, {**fixed, **dict(zip(unknowns, start))})
-        planes = {name: _plane(robot, start_kinematics, robot.constraints[name])
-                  for name in names}
+        planes = _drawn_planes(urdf_text)
 
         @functools.lru_cache(maxsize=4)
         def kinematics_at(*x: mpf) -> _Kinematics:
@@ -477,15 +501,13 @@ def solve(urdf_text: str, known: Mapping[str, float | mpf], guess: Mapping[str, 
 
 def planar_residuals(urdf_text: str,
                      joint_values: Mapping[str, float | mpf]) -> dict[str, mpf]:
-    """Return each constraint's in-plane gap (m) in mpmath: what :func:`solve` drives to 0."""
+    """Return each constraint's gap (m) in its loop's drawn plane: what :func:`solve` zeroes."""
     robot = parse(urdf_text)
+    planes = _drawn_planes(urdf_text)
     with mp.workdps(DIGITS):
         kinematics = _forward(robot, joint_values)
-        result = {}
-        for name, constraint in robot.constraints.items():
-            plane = _plane(robot, kinematics, constraint)
-            result[name] = mp.norm(_residuals(kinematics, constraint, plane))
-        return result
+        return {name: mp.norm(_residuals(kinematics, constraint, planes[name]))
+                for name, constraint in robot.constraints.items()}
 
 
 def velocities(urdf_text: str, positions: Mapping[str, float | mpf],
@@ -502,7 +524,7 @@ def velocities(urdf_text: str, positions: Mapping[str, float | mpf],
     unknowns = _unknowns(robot, names, known_velocities)
     with mp.workdps(DIGITS):
         kinematics = _forward(robot, positions)
-        planes = {name: _plane(robot, kinematics, robot.constraints[name]) for name in names}
+        planes = _drawn_planes(urdf_text)
         known = list(known_velocities)
         passive_jacobian = _jacobian(robot, kinematics, names, planes, unknowns)
         known_jacobian = _jacobian(robot, kinematics, names, planes, known)
@@ -525,18 +547,28 @@ def _urchin_robot(urdf_text: str) -> urchin.URDF:
         return urchin.URDF.load(str(path), lazy_load_meshes=True)
 
 
+def link_poses(urdf_text: str,
+               joint_values: Mapping[str, float | mpf]) -> dict[str, np.ndarray]:
+    """
+    Return every link's world pose (4×4) by urchin's float64 forward kinematics.
+
+    Joints not given sit at 0. Mimic joints follow their joint when it is given: urchin
+    computes them from the full configuration and ignores a value given for the mimic itself.
+    """
+    return _urchin_robot(urdf_text).link_fk(
+        cfg={name: float(value) for name, value in joint_values.items()}, use_names=True)
+
+
 def closure_residuals(urdf_text: str,
                       joint_values: Mapping[str, float | mpf]) -> dict[str, float]:
     """
     Return each constraint's gap (m): the distance between its two frame origins.
 
-    Computed in float64 by urchin's forward kinematics of the links at ``joint_values``
-    (joints not given sit at 0; mimic joints follow their joint, as urchin computes them from
-    the full configuration given) and urchin's ``xyz_rpy_to_matrix`` for the constraint frames.
+    Computed in float64 from :func:`link_poses` (urchin) and urchin's ``xyz_rpy_to_matrix``
+    for the constraint frames, which urchin itself does not model.
     """
     robot = parse(urdf_text)
-    poses = _urchin_robot(urdf_text).link_fk(
-        cfg={name: float(value) for name, value in joint_values.items()}, use_names=True)
+    poses = link_poses(urdf_text, joint_values)
     gaps = {}
     for name, constraint in robot.constraints.items():
         points = []
