@@ -53,12 +53,21 @@ def test_a_good_four_bar_is_described(tmp_path: Path) -> None:
         '  link lengths (pin→coupler_joint→crank_joint→rocker_joint→pin): '
         f'{coupler:.6f} m, 1.000000 m, 2.000000 m, 1.500000 m',
     ]
-    assert '  closure residual at the zero pose: 0 m' in lines
+    assert '  closure residual at the zero pose: 0 m (in the plane 0 m)' in lines
     rocker = lines.index('  could be known: rocker_joint')
     assert lines[rocker + 1].startswith(f'    reachable: [{low:.3f}°, {high:.3f}°], ')
     assert lines[rocker + 2].startswith(f'    dead points: {low:.3f}°, {high:.3f}°, ')
     crank = lines.index('  could be known: crank_joint')
     assert lines[crank + 1:crank + 3] == ['    reachable: a full turn', '    dead points: none']
+
+
+def test_a_pin_split_in_depth_closes_in_the_plane(tmp_path: Path) -> None:
+    """The pin's frame on the rocker 5 mm deeper than on the coupler: 5 mm apart, 0 in plane."""
+    urdf = four_bar().replace('<child_origin xyz="0 1.5 0"/>', '<child_origin xyz="0 1.5 0.005"/>')
+    completed = run(write(tmp_path, urdf))
+    assert completed.returncode == 0, completed.stderr
+    assert ('  closure residual at the zero pose: 0.005 m (in the plane 0 m)'
+            in completed.stdout.splitlines())
 
 
 def test_standard_input_and_measured_joints(tmp_path: Path) -> None:

@@ -122,7 +122,10 @@ def _loop_lines(loop: Loop) -> list[str]:
         offset = (slide[0] * (before[1] + after[1]) - slide[1] * (before[0] + after[0]))
         lines.append(f'  slide: along {_vector(loop.slide_world)} in the world, offset '
                      f'{abs(offset):.6f} m')
-    lines.append(f'  closure residual at the zero pose: {loop.closure_residual:.3g} m')
+    # the distance between the two constraint frames, and its part in the plane (Σ links): a
+    # depth between them (the pin's two sides on links stacked in depth) moves nothing
+    lines.append(f'  closure residual at the zero pose: {loop.closure_residual:.3g} m '
+                 f'(in the plane {loop.planar.closure_gap:.3g} m)')
     return lines
 
 

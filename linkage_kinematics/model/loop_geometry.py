@@ -148,7 +148,7 @@ def _normal(robot: Robot, constraint: Constraint, moving: list[tuple[UrdfJointTy
 
 
 def _world(vector: np.ndarray) -> str:
-    return '(' + ', '.join(f'{component:.6g}' for component in vector) + ')'
+    return '(' + ', '.join(f'{component + 0.0:.6g}' for component in vector) + ')'
 
 
 def plane_basis(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
