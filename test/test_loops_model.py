@@ -76,6 +76,11 @@ def test_good_urdfs_are_read_without_a_word_on_stderr(capfd: pytest.CaptureFixtu
     assert capfd.readouterr().err == ''
     assert len(noted.parser_messages) == 1
     assert noted.parser_messages[0].startswith('Unknown tag "lab_extension" in /robot')
+    # only a <constraint> directly under <robot> is expected: one inside a <joint> is noted
+    misplaced = four_bar().replace('<origin xyz="0 1 0"/>', '<origin xyz="0 1 0"/><constraint/>')
+    assert find_loops(misplaced).parser_messages == (
+        'Unknown tag "constraint" in '
+        "/robot[@name='test_four_bar']/joint[@name='coupler_joint']",)
 
 
 def test_the_parser_alone_would_complain_and_its_hook_is_restored(

@@ -26,6 +26,7 @@ import contextlib
 from dataclasses import dataclass
 import enum
 import math
+import re
 import xml.etree.ElementTree as ElementTree
 
 import lxml.etree
@@ -132,8 +133,9 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
 # set_from_xml looks the name up in that module at call time. A <constraint> is not known to it,
 # so every lab's good URDF with loops would print 'Unknown tag "constraint" in /robot[...]'. The
 # parse below swaps the function for one that drops exactly that message (a <constraint> directly
-# under <robot>) and keeps every other one, which the caller gets back, then restores it.
-_CONSTRAINT_COMPLAINT = 'Unknown tag "constraint" in /robot'
+# under <robot>, whose path is /robot[@name='…']) and keeps every other one, a <constraint>
+# misplaced inside a <joint> included, which the caller gets back; then it restores the function.
+_CONSTRAINT_COMPLAINT = re.compile(r'Unknown tag "constraint" in /robot(\[@name=\'[^/]*\'\])?')
 
 
 @contextlib.contextmanager
@@ -141,7 +143,7 @@ def _parser_messages() -> Iterator[list[str]]:
     messages: list[str] = []
 
     def keep(message: str) -> None:
-        if not message.startswith(_CONSTRAINT_COMPLAINT):
+        if not _CONSTRAINT_COMPLAINT.fullmatch(message):
             messages.append(message)
 
     previous = xml_reflection_core.on_error
