@@ -18,7 +18,7 @@ across turns. Pure: no ROS graph.
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 import math
 
 from linkage_kinematics.kinematics.geometry import GeometryError
@@ -100,14 +100,7 @@ class RobotLoops:
     # one line per constraint that cannot be closed, naming it and saying why
     problems: tuple[str, ...]
     # what urdf_parser_py said about the text (its own notes, not problems of the loops)
-    parser_messages: tuple[str, ...] = field(default=())
-
-    def loop(self, constraint: str) -> Loop:
-        """Return the loop of ``constraint``; KeyError if it has none."""
-        for loop in self.loops:
-            if loop.constraint == constraint:
-                return loop
-        raise KeyError(constraint)
+    parser_messages: tuple[str, ...] = ()
 
     def plan(self, measured: Sequence[str],
              branches: Mapping[str, int] | None = None) -> LoopPlan:
@@ -118,7 +111,8 @@ class RobotLoops:
         assembly branch at the zero pose, for constraints whose zero pose is not the assembly
         wanted. Raises LoopError, one line per problem, naming the joints or constraints: an
         unknown joint or constraint name, a branch other than ±1, a loop none of whose joints is
-        known, a loop with more than one known joint.
+        known, a loop with more than one known joint. The constraints in ``problems`` have no
+        loop and are not in the plan: a caller that needs every loop refuses those first.
         """
         branches = dict(branches or {})
         problems = [f'measured joint {name!r} is not a joint of the robot'
