@@ -416,3 +416,14 @@ def test_random_rrrp_loops_against_the_reference(points, slide_angle, prismatic,
     # meet at any angle.
     assert coordinate_error <= 3.0 * coordinate_floor + 1e-14
     assert rate_error <= 3.0 * rate_floor + 1e-13
+
+
+def test_loops_compare_by_value_whatever_sequences_they_are_given_as() -> None:
+    loop = PlanarLoop(['revolute', 'revolute', 'prismatic', 'revolute'],
+                      [[0.1, 0.2], (0.3, -0.1), [-0.2, 0.0], (-0.2, -0.1)], [1, 0])
+    same = PlanarLoop((REVOLUTE, REVOLUTE, PRISMATIC, REVOLUTE),
+                      ((0.1, 0.2), (0.3, -0.1), (-0.2, 0.0), (-0.2, -0.1)), (1.0, 0.0))
+    assert loop == same and hash(loop) == hash(same)
+    assert loop.prismatic == 2
+    with pytest.raises(GeometryError, match='kinds'):
+        PlanarLoop(('revolute', 'ball', 'revolute', 'revolute'), same.links)
