@@ -256,6 +256,9 @@ ROUNDING = 2e-15
 REFERENCE_LOOPS = {
     'slider_crank': (slider_crank(0.1, 0.3, 0.02, 0), slider_crank(0.1, 0.3, 0.02, 1)),
     'cylinder': (cylinder(0), cylinder(1)),
+    # crank + offset > coupler and offset > crank − coupler: its crank and the angle between crank
+    # and coupler have dead points too (the others' turn fully)
+    'rocking_slider_crank': (slider_crank(0.3, 0.25, 0.1, 0), slider_crank(0.3, 0.25, 0.1, 1)),
 }
 
 
