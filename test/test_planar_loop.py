@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import math
 
+from hypothesis import assume, given, HealthCheck, settings
+from hypothesis import strategies as st
 from linkage_kinematics.kinematics.closed_form import CrankRates
 from linkage_kinematics.kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics.planar_loop import (
@@ -254,6 +256,9 @@ ROUNDING = 2e-15
 REFERENCE_LOOPS = {
     'slider_crank': (slider_crank(0.1, 0.3, 0.02, 0), slider_crank(0.1, 0.3, 0.02, 1)),
     'cylinder': (cylinder(0), cylinder(1)),
+    # crank + offset > coupler and offset > crank − coupler: its crank and the angle between crank
+    # and coupler have dead points too (the others' turn fully)
+    'rocking_slider_crank': (slider_crank(0.3, 0.25, 0.1, 0), slider_crank(0.3, 0.25, 0.1, 1)),
 }
 
 
@@ -311,3 +316,117 @@ def test_rrrp_over_the_reachable_range(name: str, numbering: int, known: int) ->
     for value in sample_values(loop, known, 5):
         for branch in (1, -1):
             assert_as_accurate_as_the_input(loop, known, value, branch)
+
+
+# --- change points: the two assemblies cross, the motion continues on the smooth branch ---------
+
+# Exact in binary: L_a = 0.625, L_c = 0.3125 and the slide line 0.3125 from J_b (= L_a − L_c),
+# so every case has a change point (slide known: the triangle folds flat with J_c straight below
+# J_b; opposite: the pivots next to the slide at their least distance; next: the far circle
+# touches the slide line).
+CHANGE_LOOP = loop_from_points([(0.0, 0.0), (0.2, 0.3125), (0.625, 0.3125), (0.375, 0.5)],
+                               [REVOLUTE, PRISMATIC, REVOLUTE, REVOLUTE], (1.0, 0.0))
+# Crank = coupler = 0.3125 and zero offset, exact in binary: the slider passes through the crank
+# pivot. Joint 0 the crank pin, 1 the wrist pin, 2 the slide, 3 the crank pivot.
+CRANK_ANGLE = math.atan2(0.25, 0.1875)
+ISOSCELES = loop_from_points([(0.1875, 0.25), (0.375, 0.0), (0.625, 0.0), (0.0, 0.0)],
+                             [REVOLUTE, REVOLUTE, PRISMATIC, REVOLUTE], (1.0, 0.0))
+OFFSETS = (1e-2, 1e-6, 1e-10, 1e-13, 1e-15)
+
+
+@pytest.mark.parametrize('loop, known', [(CHANGE_LOOP, 1), (CHANGE_LOOP, 2), (CHANGE_LOOP, 3),
+                                         (ISOSCELES, 1), (ISOSCELES, 3)])
+@pytest.mark.parametrize('branch', (1, -1))
+def test_rrrp_through_change_points(loop: PlanarLoop, known: int, branch: int) -> None:
+    reach = known_joint_range(loop, known)
+    assert reach.change_points
+    for point in reach.change_points:
+        start = point - 0.05
+        assert continued_branch_of(loop, known, start, branch, point + 0.05) == -branch
+        for value in [point + sign * offset for offset in OFFSETS for sign in (1, -1)]:
+            assert_as_accurate_as_the_input(
+                loop, known, value, continued_branch_of(loop, known, start, branch, value))
+        # at the change point itself the smooth branch's rates, as on either side of it
+        state = solve_loop(loop, known, point, 1.3,
+                           continued_branch_of(loop, known, start, branch, point))
+        for offset in (1e-15, -1e-15):
+            near = solve_loop(loop, known, point + offset, 1.3,
+                              continued_branch_of(loop, known, start, branch, point + offset))
+            assert near.rates == pytest.approx(state.rates, rel=1e-12, abs=1e-12)
+
+
+def test_isosceles_slider_crank_over_four_turns() -> None:
+    # The smooth motion from the zero pose mirrors the crank: the slider at 2r·cos θ; the other
+    # smooth motion keeps the wrist pin on the crank pivot, at rest. δ moves the ground (body 2)
+    # relative to the slider (body 1): δ = 2r·(cos θ₀ − cos θ), and 2r·cos θ₀ = 0.375 at rest.
+    branch = branch_of(ISOSCELES, 3, (0.0,) * 4)
+    change = known_joint_range(ISOSCELES, 3).change_points[0]
+    for step in range(-160, 161):
+        value = change + step * math.pi / 40  # lands on the change points every 20 steps
+        mirror = solve_loop(ISOSCELES, 3, value, 1.3,
+                            continued_branch_of(ISOSCELES, 3, 0.0, branch, value))
+        crank = CRANK_ANGLE + value
+        assert abs(mirror.coordinates[2] - 0.625 * (0.6 - math.cos(crank))) <= 1e-15
+        assert abs(mirror.rates[2] - 0.625 * math.sin(crank) * 1.3) <= 1e-15
+        assert abs(math.remainder(mirror.coordinates[0] + 2.0 * value, 2 * math.pi)) <= 1e-14
+        still = solve_loop(ISOSCELES, 3, value, 1.3,
+                           continued_branch_of(ISOSCELES, 3, 0.0, -branch, value))
+        assert abs(still.coordinates[2] - 0.375) <= 1e-15
+        assert abs(still.rates[2]) <= 1e-15
+
+
+def test_pin_through_the_pivot_is_refused() -> None:
+    # Slide known on the isosceles slider-crank: the wrist pin meets the crank pivot at δ = 0.375
+    # where coupler and crank can turn together: refused, as the four-bar's pin A through C.
+    with pytest.raises(DeadPointError, match='meet'):
+        solve_loop(ISOSCELES, 2, 0.375, 1.0, 1)
+    assert_state_consistent(ISOSCELES, 2, 0.2, 1)
+
+
+# --- random loops -------------------------------------------------------------------------------
+
+coordinate = st.floats(-1.0, 1.0, allow_nan=False)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@given(points=st.lists(st.tuples(coordinate, coordinate), min_size=4, max_size=4),
+       slide_angle=st.floats(-math.pi, math.pi), prismatic=st.sampled_from((1, 2, 3)),
+       known=st.sampled_from((1, 2, 3)), where=st.floats(0.05, 0.95),
+       branch=st.sampled_from((1, -1)))
+def test_random_rrrp_loops_against_the_reference(points, slide_angle, prismatic, known, where,
+                                                 branch) -> None:
+    kinds = [REVOLUTE] * 4
+    kinds[prismatic] = PRISMATIC
+    pivots = [points[(prismatic + k) % 4] for k in (-1, 1, 2)]
+    assume(min(math.dist(pivots[i], pivots[j]) for i, j in ((0, 1), (1, 2), (0, 2))) > 0.05)
+    try:
+        loop = loop_from_points(points, kinds, (math.cos(slide_angle), math.sin(slide_angle)))
+        reach = known_joint_range(loop, known)
+    except GeometryError:
+        assume(False)
+    low, high = max(reach.intervals, key=lambda interval: interval[1] - interval[0])
+    assume(high - low > 1e-3)
+    value = low + where * (high - low)
+    assume(reach.change_point_distance(value) is None or reach.change_point_distance(value) > 0.01)
+    state = solve_loop(loop, known, value, 1.3, branch)
+    assert closure_residual(loop, state.coordinates) <= 1e-13
+    assert angle_sum_residual(loop, state.coordinates) <= 1e-13
+    assert branch_of(loop, known, state.coordinates) == branch
+    exact = reference_state(loop, known, value, 1.3, state.coordinates)
+    coordinate_error, rate_error = errors(loop, state.coordinates, state.rates, exact)
+    coordinate_floor, rate_floor = input_floor(loop, known, value, 1.3, state.coordinates)
+    # A few more roundings than the chosen geometries: the links here are up to 2.8 m long and
+    # meet at any angle.
+    assert coordinate_error <= 3.0 * coordinate_floor + 1e-14
+    assert rate_error <= 3.0 * rate_floor + 1e-13
+
+
+def test_loops_compare_by_value_whatever_sequences_they_are_given_as() -> None:
+    loop = PlanarLoop(['revolute', 'revolute', 'prismatic', 'revolute'],
+                      [[0.1, 0.2], (0.3, -0.1), [-0.2, 0.0], (-0.2, -0.1)], [1, 0])
+    same = PlanarLoop((REVOLUTE, REVOLUTE, PRISMATIC, REVOLUTE),
+                      ((0.1, 0.2), (0.3, -0.1), (-0.2, 0.0), (-0.2, -0.1)), (1.0, 0.0))
+    assert loop == same and hash(loop) == hash(same)
+    assert loop.prismatic == 2
+    with pytest.raises(GeometryError, match='kinds'):
+        PlanarLoop(('revolute', 'ball', 'revolute', 'revolute'), same.links)

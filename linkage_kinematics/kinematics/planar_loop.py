@@ -68,22 +68,33 @@ class PlanarLoop:
     slide: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
-        if len(self.kinds) != 4 or not all(isinstance(kind, JointKind) for kind in self.kinds):
+        # Normalised to JointKind members and tuples of floats, so that loops compare and hash by
+        # value whatever sequences they were given as.
+        try:
+            kinds = tuple(JointKind(kind) for kind in self.kinds)
+        except (TypeError, ValueError):
+            kinds = ()
+        if len(kinds) != 4:
             raise GeometryError(f'kinds must be four JointKind values, got {self.kinds!r}')
+        object.__setattr__(self, 'kinds', kinds)
+        links = _vectors(self.links)
+        if links is None or len(links) != 4:
+            raise GeometryError(f'links must be four finite 2-vectors (m), got {self.links!r}')
+        object.__setattr__(self, 'links', links)
         if self.kinds[0] is not JointKind.REVOLUTE:
             raise GeometryError('joint 0 (the cut pin) must be revolute')
         if self.kinds.count(JointKind.PRISMATIC) > 1:
             raise GeometryError('a loop of four joints with one degree of freedom has at most one '
                                 f'prismatic joint, got kinds {[str(k) for k in self.kinds]}')
-        if len(self.links) != 4 or not all(_is_vector(link) for link in self.links):
-            raise GeometryError(f'links must be four finite 2-vectors (m), got {self.links!r}')
         if self.prismatic is None:
             if self.slide is not None:
                 raise GeometryError('slide is given but no joint is prismatic')
             return
-        if self.slide is None or not _is_vector(self.slide):
+        slide = None if self.slide is None else _vectors((self.slide,))
+        if slide is None:
             raise GeometryError(f'the prismatic joint needs a finite slide vector, got '
                                 f'{self.slide!r}')
+        object.__setattr__(self, 'slide', slide[0])
         if abs(math.hypot(*self.slide) - 1.0) > SLIDE_NORM_TOLERANCE:
             raise GeometryError(f'slide must be a unit vector, got {self.slide!r}')
 
@@ -99,10 +110,18 @@ class PlanarLoop:
                           sum(link[1] for link in self.links))
 
 
-def _is_vector(value: object) -> bool:
-    return (isinstance(value, tuple) and len(value) == 2
-            and all(isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
-                    for x in value))
+def _vectors(values: object) -> tuple[tuple[float, float], ...] | None:
+    """Return ``values`` as a tuple of finite 2-vectors of floats, None if they are not."""
+    try:
+        vectors = tuple(tuple(values[i]) for i in range(len(values)))
+    except (TypeError, KeyError):
+        return None
+    for vector in vectors:
+        if len(vector) != 2 or not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                for x in vector):
+            return None
+    return tuple((float(vector[0]), float(vector[1])) for vector in vectors)
 
 
 @dataclass(frozen=True, slots=True)
