@@ -21,7 +21,7 @@ setup(
         ('share/' + package_name + '/interfaces/tf2_msgs/msg',
          glob('interfaces/tf2_msgs/msg/*')),
     ],
-    install_requires=['setuptools', 'numpy'],
+    install_requires=['setuptools', 'numpy', 'urdfdom-py'],
     # The test suite's own dependencies (requirements.txt pins them; package.xml names them for
     # rosdep). Naming pytest here makes `colcon test` run the suite with pytest.
     extras_require={
@@ -41,6 +41,7 @@ setup(
             'linkage-sweep = linkage_kinematics.cli.sweep:main',
             'linkage-replay = linkage_kinematics.cli.replay:main',
             'linkage-demo = linkage_kinematics.cli.demo:main',
+            'linkage-check-loops = linkage_kinematics.cli.check_loops:main',
         ],
     },
 )

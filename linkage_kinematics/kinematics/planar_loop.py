@@ -1,0 +1,295 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A single-degree-of-freedom planar loop of four joints, solved in closed form from one joint.
+
+Conventions (in the loop's plane, counterclockwise about its normal; metres and radians):
+
+* Joints 0..3 in cyclic order; body k joins joint k to joint k + 1 (indices mod 4); body 0 is
+  the reference (angle 0). Joint 0 is the cut pin: revolute, never the known joint.
+* Revolute joint k has φ_k = θ_k − θ_{k−1}, the angle of body k relative to body k − 1. The
+  prismatic joint p has δ_p: the point of joint p on body p is the point of joint p on body p − 1
+  plus δ_p·ŝ, ŝ = ``slide``/|``slide``| in body p − 1's frame (θ_p = θ_{p−1}).
+* ``links[k]`` is the vector from joint k's point to joint k + 1's point, in body k's frame. All
+  frames are aligned where every coordinate is 0 (the URDF's zero pose, so Σ links ≈ 0).
+
+A loop of four revolute joints is the four-bar, solved by the existing closed form
+(``kinematics.solver.solve``) after mapping: known joint k → ground = body k − 1, crank = body k
+about joint k (crank angle α = φ_k exactly, the FourBar's frame turned so that φ_k = 0 puts pin
+A at its lowest position), coupler = body k + 1, rocker = body k + 2; C is joint k − 1. Its branch
+is the FourBar's: +1 where joint k + 2 lies left of the directed line joint k + 1 → joint k − 1.
+A loop with one prismatic joint has its own closed forms (``prismatic_loop``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import Decimal, localcontext
+from enum import StrEnum
+from functools import lru_cache
+import math
+
+from linkage_kinematics.kinematics.closed_form import CrankRates
+from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
+from linkage_kinematics.kinematics.geometry import (
+    FourBar,
+    GeometryError,
+    UnreachableError,
+    wrap_angle,
+)
+from linkage_kinematics.kinematics.joint_range import KnownJointRange
+from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
+from linkage_kinematics.kinematics.solver import DeadPointError, solve
+
+__all__ = [
+    'branch_of', 'continued_branch_of', 'joint_points', 'JointKind', 'known_joint_range',
+    'KnownJointRange', 'LoopState', 'PlanarLoop', 'solve_loop',
+]
+
+# |slide| must be 1 to this relative tolerance (a unit vector written as floats).
+SLIDE_NORM_TOLERANCE = 1e-9
+_CACHE_SIZE = 256
+
+
+class JointKind(StrEnum):
+    """What a joint of the loop lets its two bodies do relative to each other."""
+
+    REVOLUTE = 'revolute'
+    PRISMATIC = 'prismatic'
+
+
+@dataclass(frozen=True)
+class PlanarLoop:
+    """A single-degree-of-freedom planar loop of four joints in cyclic order (module docstring)."""
+
+    kinds: tuple[JointKind, JointKind, JointKind, JointKind]
+    links: tuple[tuple[float, float], ...]
+    slide: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        # Normalised to JointKind members and tuples of floats, so that loops compare and hash by
+        # value whatever sequences they were given as.
+        try:
+            kinds = tuple(JointKind(kind) for kind in self.kinds)
+        except (TypeError, ValueError):
+            kinds = ()
+        if len(kinds) != 4:
+            raise GeometryError(f'kinds must be four JointKind values, got {self.kinds!r}')
+        object.__setattr__(self, 'kinds', kinds)
+        links = _vectors(self.links)
+        if links is None or len(links) != 4:
+            raise GeometryError(f'links must be four finite 2-vectors (m), got {self.links!r}')
+        object.__setattr__(self, 'links', links)
+        if self.kinds[0] is not JointKind.REVOLUTE:
+            raise GeometryError('joint 0 (the cut pin) must be revolute')
+        if self.kinds.count(JointKind.PRISMATIC) > 1:
+            raise GeometryError('a loop of four joints with one degree of freedom has at most one '
+                                f'prismatic joint, got kinds {[str(k) for k in self.kinds]}')
+        if self.prismatic is None:
+            if self.slide is not None:
+                raise GeometryError('slide is given but no joint is prismatic')
+            return
+        slide = None if self.slide is None else _vectors((self.slide,))
+        if slide is None:
+            raise GeometryError(f'the prismatic joint needs a finite slide vector, got '
+                                f'{self.slide!r}')
+        object.__setattr__(self, 'slide', slide[0])
+        if abs(math.hypot(*self.slide) - 1.0) > SLIDE_NORM_TOLERANCE:
+            raise GeometryError(f'slide must be a unit vector, got {self.slide!r}')
+
+    @property
+    def prismatic(self) -> int | None:
+        """Index of the prismatic joint, None for a four-bar."""
+        return self.kinds.index(JointKind.PRISMATIC) if JointKind.PRISMATIC in self.kinds else None
+
+    @property
+    def closure_gap(self) -> float:
+        """|Σ links| (m): how far the all-zero pose is from closing (the exporter's rounding)."""
+        return math.hypot(sum(link[0] for link in self.links),
+                          sum(link[1] for link in self.links))
+
+
+def _vectors(values: object) -> tuple[tuple[float, float], ...] | None:
+    """Return ``values`` as a tuple of finite 2-vectors of floats, None if they are not."""
+    try:
+        vectors = tuple(tuple(values[i]) for i in range(len(values)))
+    except (TypeError, KeyError):
+        return None
+    for vector in vectors:
+        if len(vector) != 2 or not all(
+                isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+                for x in vector):
+            return None
+    return tuple((float(vector[0]), float(vector[1])) for vector in vectors)
+
+
+@dataclass(frozen=True, slots=True)
+class LoopState:
+    """
+    The loop's coordinates (φ in rad, δ in m) of joints 0..3 and their time derivatives.
+
+    ``branch`` is the assembly the state lies on (+1 or −1, see ``branch_of``).
+    """
+
+    coordinates: tuple[float, float, float, float]
+    rates: tuple[float, float, float, float]
+    branch: int
+
+
+def _check_known(loop: PlanarLoop, known: int) -> None:
+    if known not in (1, 2, 3):
+        raise ValueError(f'the known joint must be 1, 2 or 3 (joint 0 is the cut pin), got '
+                         f'{known!r}')
+
+
+def _angle(vector: tuple[float, float]) -> float:
+    return math.atan2(vector[1], vector[0])
+
+
+@lru_cache(maxsize=_CACHE_SIZE)
+def _four_bar(loop: PlanarLoop, known: int) -> FourBar:
+    """
+    Return the four-bar seen from body known − 1 (module docstring), crank angle α = φ_known.
+
+    C = joint known − 1 relative to O = joint known is −links[known − 1]; in the FourBar's frame,
+    where the crank vector links[known] points straight down, it is (u × c, −u·c) with u the
+    crank's unit vector: computed exactly and rounded once.
+    """
+    crank = loop.links[known]
+    ground = loop.links[known - 1]
+    try:
+        with localcontext() as context:
+            context.prec = 40
+            crank_x, crank_y = Decimal(crank[0]), Decimal(crank[1])
+            to_c_x, to_c_y = -Decimal(ground[0]), -Decimal(ground[1])
+            length = (crank_x * crank_x + crank_y * crank_y).sqrt()
+            if length == 0:
+                raise GeometryError(f'joint {known + 1} coincides with joint {known}: the crank '
+                                    'has no length')
+            ground_x = float((crank_x * to_c_y - crank_y * to_c_x) / length)
+            ground_y = float(-(crank_x * to_c_x + crank_y * to_c_y) / length)
+        return FourBar(float(length), math.hypot(*loop.links[(known + 1) % 4]),
+                       math.hypot(*loop.links[(known + 2) % 4]), ground_x, ground_y)
+    except GeometryError as error:
+        raise GeometryError(f'the four-bar loop driven at joint {known}: {error}') from None
+
+
+@lru_cache(maxsize=_CACHE_SIZE)
+def _prismatic(loop: PlanarLoop, known: int) -> PrismaticLoop:
+    return PrismaticLoop(loop.links, loop.slide, loop.prismatic, known)
+
+
+def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
+               branch: int) -> LoopState:
+    """
+    Return the loop's coordinates and rates with joint ``known`` at ``value`` moving at ``rate``.
+
+    ``branch`` names the assembly at ``value`` (``branch_of``). Raises DeadPointError at a dead
+    point of the known joint (where a one-ulp change of ``value`` would move the exact
+    accelerations by more than ``singular_points.RATE_ACCURACY``) and UnreachableError where the
+    loop does not close at ``value``. Never returns NaN.
+    """
+    _check_known(loop, known)
+    check_branch(branch)
+    if not math.isfinite(value) or not math.isfinite(rate):
+        raise UnreachableError(f'joint {known}: value and rate must be finite, got {value!r}, '
+                               f'{rate!r}')
+    if loop.prismatic is not None:
+        coordinates, rates = _prismatic(loop, known).solve(value, rate, branch)
+        return LoopState(coordinates, rates, branch)
+    linkage = _four_bar(loop, known)
+    try:
+        state = solve(linkage, value, CrankRates(rate, 0.0), branch)
+    except (DeadPointError, UnreachableError) as error:
+        raise type(error)(f'joint {known}: {error}') from None
+    links = loop.links
+    # The FourBar's frame is body known − 1's turned by arg(links[known]) + π/2.
+    turn = _angle(links[known]) + 0.5 * math.pi
+    coupler = state.gamma + turn - _angle(links[(known + 1) % 4])  # θ_{k+1} − θ_{k−1}
+    rocker = -state.beta + turn - _angle(links[(known + 2) % 4])  # θ_{k+2} − θ_{k−1}
+    coordinates = [0.0] * 4
+    rates = [0.0] * 4
+    coordinates[known] = value
+    coordinates[(known + 1) % 4] = wrap_angle(coupler - value)
+    coordinates[(known + 2) % 4] = wrap_angle(rocker - coupler)
+    coordinates[(known + 3) % 4] = wrap_angle(-rocker)
+    rates[known] = rate
+    rates[(known + 1) % 4] = state.omega_ab - rate
+    rates[(known + 2) % 4] = state.omega_bc - state.omega_ab
+    rates[(known + 3) % 4] = -state.omega_bc
+    return LoopState(tuple(coordinates), tuple(rates), branch)
+
+
+def joint_points(loop: PlanarLoop, coordinates: tuple[float, ...]
+                 ) -> tuple[tuple[tuple[float, float], ...], tuple[float, ...]]:
+    """
+    Return the joints' points (joint k's on body k) and the bodies' angles θ_k, in body 0's frame.
+
+    The forward kinematics of the open chain joint 0 → 1 → 2 → 3; joint 0 is at the origin. The
+    loop closes where the chain's end, joint 3's point plus body 3's link, is back at the origin.
+    """
+    points = [(0.0, 0.0)]
+    angles = [0.0]
+    for joint in (1, 2, 3):
+        theta = angles[-1]
+        cosine, sine = math.cos(theta), math.sin(theta)
+        link_x, link_y = loop.links[joint - 1]
+        if loop.kinds[joint] is JointKind.PRISMATIC:
+            link_x += coordinates[joint] * loop.slide[0]
+            link_y += coordinates[joint] * loop.slide[1]
+        else:
+            theta += coordinates[joint]
+        previous_x, previous_y = points[-1]
+        points.append((previous_x + cosine * link_x - sine * link_y,
+                       previous_y + sine * link_x + cosine * link_y))
+        angles.append(theta)
+    return tuple(points), tuple(angles)
+
+
+def branch_of(loop: PlanarLoop, known: int, coordinates: tuple[float, ...]) -> int:
+    """
+    Return the assembly branch (+1 or −1) that ``coordinates`` lie on, joint ``known`` driving.
+
+    Four-bar: +1 where joint known + 2 lies left of the directed line joint known + 1 → joint
+    known − 1. Loops with a prismatic joint: ``prismatic_loop.PrismaticLoop.side``. Where the two
+    assemblies meet (a dead or change point: the side is zero) the result is +1.
+    """
+    _check_known(loop, known)
+    points, angles = joint_points(loop, coordinates)
+    if loop.prismatic is not None:
+        side = _prismatic(loop, known).side(points, angles)
+    else:
+        origin = points[(known + 1) % 4]
+        to_line = _difference(points[(known + 3) % 4], origin)
+        to_pin = _difference(points[(known + 2) % 4], origin)
+        side = to_line[0] * to_pin[1] - to_line[1] * to_pin[0]
+    return -1 if side < 0.0 else 1
+
+
+def _difference(point: tuple[float, float], origin: tuple[float, float]) -> tuple[float, float]:
+    return point[0] - origin[0], point[1] - origin[1]
+
+
+def continued_branch_of(loop: PlanarLoop, known: int, value_from: float, branch: int,
+                        value_to: float) -> int:
+    """
+    Return the branch at ``value_to`` of a smooth motion of joint ``known`` from ``value_from``.
+
+    The motion has ``branch`` at ``value_from``; it continues through change points on the smooth
+    branch, so the branch flips at each change point passed (``kinematics.continued_branch``).
+    """
+    _check_known(loop, known)
+    if loop.prismatic is not None:
+        return _prismatic(loop, known).continued_branch(value_from, branch, value_to)
+    return int(continued_branch(_four_bar(loop, known), value_from, branch, value_to))
+
+
+def known_joint_range(loop: PlanarLoop, known: int) -> KnownJointRange:
+    """Return where joint ``known`` can go when it drives the loop, its dead and change points."""
+    _check_known(loop, known)
+    if loop.prismatic is not None:
+        return _prismatic(loop, known).range
+    reachability = _four_bar(loop, known).reachability
+    return KnownJointRange(known, True, reachability.intervals, reachability.dead_points,
+                           reachability.change_points)
