@@ -239,13 +239,16 @@ def joint_points(loop: PlanarLoop, coordinates: tuple[float, ...]
     """
     points = [(0.0, 0.0)]
     angles = [0.0]
+    if loop.prismatic is not None:
+        norm = math.hypot(*loop.slide)
+        slide = (loop.slide[0] / norm, loop.slide[1] / norm)  # ŝ, as the closed forms take it
     for joint in (1, 2, 3):
         theta = angles[-1]
         cosine, sine = math.cos(theta), math.sin(theta)
         link_x, link_y = loop.links[joint - 1]
         if loop.kinds[joint] is JointKind.PRISMATIC:
-            link_x += coordinates[joint] * loop.slide[0]
-            link_y += coordinates[joint] * loop.slide[1]
+            link_x += coordinates[joint] * slide[0]
+            link_y += coordinates[joint] * slide[1]
         else:
             theta += coordinates[joint]
         previous_x, previous_y = points[-1]
