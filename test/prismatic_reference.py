@@ -164,12 +164,15 @@ def _exact_gap(moved: tuple[list, list], exact: tuple[list, list]) -> tuple[floa
 
 def reference_dead_point(loop: PlanarLoop, known: int, guess: float) -> mpf:
     """
-    Return the exact dead point of joint ``known`` nearest ``guess`` (a loop with a slide).
+    Return the exact dead point of joint ``known`` nearest ``guess``.
 
-    The known joint is the slide: |J_c − J_b| = L_a ± L_c. Next to it: the far pivot's circle
-    touches the slide line (its centre's distance from the line = the radius). Opposite:
-    |J_c − J_b| equals the slide line's distance from J_b.
+    A four-bar: joints known + 1 and known − 1 are L_{k+1} ± L_{k+2} apart (the two far links
+    collinear). With a slide, the known joint is the slide: |J_c − J_b| = L_a ± L_c. Next to it:
+    the far pivot's circle touches the slide line (its centre's distance from the line = the
+    radius). Opposite: |J_c − J_b| equals the slide line's distance from J_b.
     """
+    if JointKind.PRISMATIC not in loop.kinds:
+        return _four_bar_dead_point(loop, known, guess)
     p = loop.kinds.index(JointKind.PRISMATIC)
     with mp.workdps(DIGITS):
         slide = _slide(loop)
@@ -204,3 +207,19 @@ def reference_dead_point(loop: PlanarLoop, known: int, guess: float) -> mpf:
                 distance = abs(offset + cross(_rotate(sense * angle, near)))
                 return distance - radius
         return mp.findroot(condition, mpf(guess), tol=mpf(10) ** (6 - 2 * DIGITS))
+
+
+def _four_bar_dead_point(loop: PlanarLoop, known: int, guess: float) -> mpf:
+    with mp.workdps(DIGITS):
+        links = [tuple(mpf(x) for x in link) for link in loop.links]
+        far = (mp.hypot(*links[(known + 1) % 4]), mp.hypot(*links[(known + 2) % 4]))
+
+        def distance(angle: mpf) -> mpf:
+            # joint known + 1 relative to joint known − 1, in body known − 1's frame
+            crank = _rotate(angle, links[known])
+            return mp.hypot(links[known - 1][0] + crank[0], links[known - 1][1] + crank[1])
+
+        reach = min((far[0] + far[1], abs(far[0] - far[1])),
+                    key=lambda length: abs(distance(mpf(guess)) - length))
+        return mp.findroot(lambda angle: distance(angle) - reach, mpf(guess),
+                           tol=mpf(10) ** (6 - 2 * DIGITS))

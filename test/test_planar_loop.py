@@ -279,11 +279,8 @@ def reference_side(loop: PlanarLoop, known: int, coordinates: list) -> int:
     return branch_of(loop, known, tuple(float(x) for x in coordinates))
 
 
-@pytest.mark.parametrize('name', sorted(REFERENCE_LOOPS))
-@pytest.mark.parametrize('numbering', (0, 1))
-@pytest.mark.parametrize('known', (1, 2, 3))
-def test_rrrp_dead_points_at_float64s_limit(name: str, numbering: int, known: int) -> None:
-    loop = REFERENCE_LOOPS[name][numbering]
+def assert_dead_points_at_float64s_limit(loop: PlanarLoop, known: int) -> None:
+    """Approach every dead point of joint ``known`` from its reachable side, both branches."""
     reach = known_joint_range(loop, known)
     for dead in reach.dead_points:
         exact = reference_dead_point(loop, known, dead)
@@ -306,6 +303,25 @@ def test_rrrp_dead_points_at_float64s_limit(name: str, numbering: int, known: in
         # the float nearest the dead point: on it (refused) or just past it (unreachable)
         with pytest.raises((DeadPointError, UnreachableError)):
             solve_loop(loop, known, dead, 1.3, 1)
+
+
+@pytest.mark.parametrize('name', sorted(REFERENCE_LOOPS))
+@pytest.mark.parametrize('numbering', (0, 1))
+@pytest.mark.parametrize('known', (1, 2, 3))
+def test_rrrp_dead_points_at_float64s_limit(name: str, numbering: int, known: int) -> None:
+    assert_dead_points_at_float64s_limit(REFERENCE_LOOPS[name][numbering], known)
+
+
+# A four-bar whose pivots are at no special angles: its link lengths are no floats.
+TILTED = loop_from_points([(0.0, 0.0), (0.93, 0.21), (1.17, 0.77), (0.31, 0.83)])
+
+
+@pytest.mark.parametrize('loop, known', [(CRANK_ROCKER, 2), (CRANK_ROCKER, 3),
+                                         (DOUBLE_ROCKER, 3), (TILTED, 3)])
+def test_four_bar_dead_points_at_float64s_limit(loop: PlanarLoop, known: int) -> None:
+    # The FourBar's singular points are the loop's exact ones (geometry.from_exact), not those
+    # of its float lengths: without that, the error was up to 7× the input floor here.
+    assert_dead_points_at_float64s_limit(loop, known)
 
 
 @pytest.mark.parametrize('name', sorted(REFERENCE_LOOPS))

@@ -344,19 +344,20 @@ def _closure_constants(linkage: FourBar, closure: LoopClosure) -> LoopClosure:
     return replace(closure, constants=constants)
 
 
-def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
+def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
+                  ) -> tuple[LoopClosure, Reachability]:
     """
     Return the factors of the loop closure and the reachable crank angles.
 
-    Both come from exact arithmetic.
+    Both come from exact arithmetic: on the float dimensions, or on ``exact`` (OA, AB, BC, x_C,
+    y_C), the dimensions the floats are roundings of where those are known (``from_exact``).
     """
     with localcontext() as context:
         context.prec = _DIGITS
-        r = Decimal(linkage.crank_length)
-        b = Decimal(linkage.coupler_length)
-        c = Decimal(linkage.rocker_length)
-        x_c = Decimal(linkage.ground_x)
-        y_c = Decimal(linkage.ground_y)
+        r, b, c, x_c, y_c = exact if exact is not None else (
+            Decimal(linkage.crank_length), Decimal(linkage.coupler_length),
+            Decimal(linkage.rocker_length), Decimal(linkage.ground_x),
+            Decimal(linkage.ground_y))
         ground_squared = x_c * x_c + y_c * y_c
         if ground_squared == 0:
             # O and C coincide: |C − A| = OA for every α, so the loop closes everywhere or nowhere.
@@ -407,7 +408,10 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
 
         stretched = factor(lowest_cosine, -1, opposite, b + c)
         folded = factor(highest_cosine, 1, direction, abs(b - c))
-        passes_through_pivot = folded.is_change and b == c
+        # (within the touching tolerance: exact lengths from a loop's link vectors that are equal
+        # in the typed decimals differ by their roundings)
+        passes_through_pivot = (folded.is_change
+                                and abs(b - c) <= Decimal(TOUCH_TOLERANCE) * (b + c))
     dead_points = tuple(
         angle for part in (stretched, folded) if part.kind == _ROOTS
         for angle in (part.first, part.second)
@@ -417,6 +421,23 @@ def _loop_closure(linkage: FourBar) -> tuple[LoopClosure, Reachability]:
                           _split(direction), _split(opposite), dead_points, change_points,
                           passes_through_pivot)
     return closure, _reachability(closure)
+
+
+def from_exact(dimensions: tuple[Decimal, Decimal, Decimal, Decimal, Decimal]) -> FourBar:
+    """
+    Return the FourBar nearest the exact ``dimensions`` (OA, AB, BC, x_C, y_C; 60-digit decimals).
+
+    Its singular points (dead points, change points, reachability) are those of the exact
+    dimensions, not of their float roundings: a four-bar mapped from a loop's link vectors (whose
+    lengths no float holds) then meets its dead points where the loop does, to rounding of the
+    crank angle, instead of up to a few ulp of the geometry away.
+    """
+    linkage = FourBar(*(float(value) for value in dimensions))
+    closure, reachability = _loop_closure(linkage, dimensions)
+    # The same frozen value, its derived constants taken from the exact dimensions.
+    object.__setattr__(linkage, 'closure', _closure_constants(linkage, closure))
+    object.__setattr__(linkage, 'reachability', reachability)
+    return linkage
 
 
 def _reachability(closure: LoopClosure) -> Reachability:

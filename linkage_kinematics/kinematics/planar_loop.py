@@ -33,7 +33,9 @@ import math
 from linkage_kinematics.kinematics.closed_form import CrankRates
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
 from linkage_kinematics.kinematics.geometry import (
+    _DIGITS,
     FourBar,
+    from_exact,
     GeometryError,
     UnreachableError,
     wrap_angle,
@@ -152,27 +154,33 @@ def _four_bar(loop: PlanarLoop, known: int) -> FourBar:
     """
     Return the four-bar seen from body known − 1 (module docstring), crank angle α = φ_known.
 
-    C = joint known − 1 relative to O = joint known is −links[known − 1]; in the FourBar's frame,
-    where the crank vector links[known] points straight down, it is (u × c, −u·c) with u the
-    crank's unit vector: computed exactly and rounded once.
+    C = joint known − 1 relative to O = joint known is c = −links[known − 1]; in the FourBar's
+    frame, where the crank vector links[known] points straight down, it is (u × c, −u·c) with u
+    the crank's unit vector. The dimensions are exact (60-digit decimals), and the FourBar's
+    singular points are theirs (``geometry.from_exact``).
     """
     crank = loop.links[known]
     ground = loop.links[known - 1]
     try:
         with localcontext() as context:
-            context.prec = 40
+            context.prec = _DIGITS
             crank_x, crank_y = Decimal(crank[0]), Decimal(crank[1])
             to_c_x, to_c_y = -Decimal(ground[0]), -Decimal(ground[1])
-            length = (crank_x * crank_x + crank_y * crank_y).sqrt()
+            length = _length(crank)
             if length == 0:
                 raise GeometryError(f'joint {known + 1} coincides with joint {known}: the crank '
                                     'has no length')
-            ground_x = float((crank_x * to_c_y - crank_y * to_c_x) / length)
-            ground_y = float(-(crank_x * to_c_x + crank_y * to_c_y) / length)
-        return FourBar(float(length), math.hypot(*loop.links[(known + 1) % 4]),
-                       math.hypot(*loop.links[(known + 2) % 4]), ground_x, ground_y)
+            dimensions = (length, _length(loop.links[(known + 1) % 4]),
+                          _length(loop.links[(known + 2) % 4]),
+                          (crank_x * to_c_y - crank_y * to_c_x) / length,
+                          -(crank_x * to_c_x + crank_y * to_c_y) / length)
+            return from_exact(dimensions)
     except GeometryError as error:
         raise GeometryError(f'the four-bar loop driven at joint {known}: {error}') from None
+
+
+def _length(vector: tuple[float, float]) -> Decimal:
+    return (Decimal(vector[0]) ** 2 + Decimal(vector[1]) ** 2).sqrt()
 
 
 @lru_cache(maxsize=_CACHE_SIZE)
@@ -231,13 +239,16 @@ def joint_points(loop: PlanarLoop, coordinates: tuple[float, ...]
     """
     points = [(0.0, 0.0)]
     angles = [0.0]
+    if loop.prismatic is not None:
+        norm = math.hypot(*loop.slide)
+        slide = (loop.slide[0] / norm, loop.slide[1] / norm)  # ŝ, as the closed forms take it
     for joint in (1, 2, 3):
         theta = angles[-1]
         cosine, sine = math.cos(theta), math.sin(theta)
         link_x, link_y = loop.links[joint - 1]
         if loop.kinds[joint] is JointKind.PRISMATIC:
-            link_x += coordinates[joint] * loop.slide[0]
-            link_y += coordinates[joint] * loop.slide[1]
+            link_x += coordinates[joint] * slide[0]
+            link_y += coordinates[joint] * slide[1]
         else:
             theta += coordinates[joint]
         previous_x, previous_y = points[-1]

@@ -240,19 +240,20 @@ class PrismaticLoop:
             values.append(result)
         return tuple(values)
 
-    def _analytic_sign(self, branch: int, factor: Factor, value: float) -> tuple[float, float]:
+    def _analytic_sign(self, branch: int, factor: Factor, value: float) -> float:
         """
-        Return σ_a and the unit m of a change factor: the root continued through the point.
+        Return σ_a, the sign that continues the root of a change factor through its point.
 
-        The side named by ``branch`` at ``value`` is the sign of σ_a·m, m = sin(½(φ − ρ)) or
-        δ − ρ; at m = 0 itself the side just past it (m's derivative's sign).
+        The root is σ_a·√(2B)·m·√(other factor), m = sin(½(φ − ρ)) or δ − ρ: its sign is the
+        side named by ``branch`` at ``value``, so σ_a = branch·sign(m); at m = 0 itself, where
+        the sides meet, the side just past it (the sign of m's derivative).
         """
         unit = factor.unit(value, factor.first)
         if unit != 0.0:
-            return branch * math.copysign(1.0, unit), unit
+            return branch * math.copysign(1.0, unit)
         if factor.periodic:
-            return branch * math.copysign(1.0, math.cos(0.5 * (value - factor.first[0]))), unit
-        return float(branch), unit
+            return branch * math.copysign(1.0, math.cos(0.5 * (value - factor.first[0])))
+        return float(branch)
 
     def solve(self, value: float, rate: float, branch: int
               ) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -305,7 +306,7 @@ class PrismaticLoop:
         folded_factor = self.factors[1]
         if folded_factor.is_change:
             # σh = H·t: the vanishing t divided out of numerators and denominators alike.
-            sign, _ = self._analytic_sign(branch, folded_factor, delta)
+            sign = self._analytic_sign(branch, folded_factor, delta)
             ratio = sign * math.sqrt(stretched) / (2.0 * length)
             lead = x + ratio * across
             rate_c = speed * lead / (ratio * squared)
@@ -335,11 +336,11 @@ class PrismaticLoop:
         second_unit = abs(second.unit(angle, second.first)) if second.is_change else math.inf
         # Q = e'/t, finite through a change point where e' and t vanish together
         if first_unit <= second_unit and first.is_change:
-            sign, _ = self._analytic_sign(branch, first, angle)
+            sign = self._analytic_sign(branch, first, angle)
             half_cosine = math.cos(0.5 * (angle - first.first[0]))
             ratio = -math.sqrt(first.scale) * half_cosine / (sign * math.sqrt(upper))
         elif second.is_change:
-            sign, _ = self._analytic_sign(branch, second, angle)
+            sign = self._analytic_sign(branch, second, angle)
             half_cosine = math.cos(0.5 * (angle - second.first[0]))
             ratio = math.sqrt(second.scale) * half_cosine / (sign * math.sqrt(lower))
         else:
@@ -365,7 +366,7 @@ class PrismaticLoop:
         v_y = sine * link_a[0] + cosine * link_a[1]
         along = branch * math.sqrt(value)  # t
         if factor.is_change:
-            sign, _ = self._analytic_sign(branch, factor, angle)
+            sign = self._analytic_sign(branch, factor, angle)
             slope = sign * math.sqrt(factor.scale) * math.cos(0.5 * (angle - factor.first[0]))
             slope *= 0.5
         else:
