@@ -107,6 +107,14 @@ def chain(transforms: list[Transform], root: str) -> dict[str, np.ndarray]:
     return poses
 
 
+def moving_transforms(robot: RobotTransforms, positions: dict[str, float]) -> list[Transform]:
+    """Return the transforms of ``robot.moving`` at ``positions`` (joint name → rad or m)."""
+    moving = robot.moving(list(positions))
+    values = moving.values(positions.values())
+    return [Transform(parent, child, values[start:start + 3], values[start + 3:start + 7])
+            for start, (parent, child) in zip(range(0, len(values), 7), moving.frames)]
+
+
 def urchin_poses(urdf: str, positions: dict[str, float], prefix: str) -> dict[str, np.ndarray]:
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / 'robot.urdf'
@@ -142,7 +150,7 @@ def test_transforms_chain_to_urchins_forward_kinematics(
 ) -> None:
     robot = RobotTransforms(EVERY_JOINT_URDF, prefix)
     fixed = robot.fixed_transforms()
-    moving = robot.moving_transforms(positions)
+    moving = moving_transforms(robot, positions)
     # kdl_parser makes floating joints fixed; the mimic follows arm_joint.
     assert [t.child_frame for t in fixed] == [prefix + name for name in ('free', 'mount', 'tool')]
     assert [t.child_frame for t in moving] == [prefix + name for name in (
@@ -157,7 +165,7 @@ def test_transforms_chain_to_urchins_forward_kinematics(
 
 def test_only_joints_named_in_the_joint_state_move_and_a_named_mimic_keeps_its_value() -> None:
     robot = RobotTransforms(EVERY_JOINT_URDF)
-    moving = robot.moving_transforms({'wheel_joint': 1.0, 'follower_joint': 0.5, 'other': 3.0})
+    moving = moving_transforms(robot, {'wheel_joint': 1.0, 'follower_joint': 0.5, 'other': 3.0})
     assert [t.child_frame for t in moving] == ['follower', 'wheel']
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / 'robot.urdf'
@@ -204,10 +212,12 @@ def test_shipped_tfmessage_is_rosbag2s_schema_and_type_hash() -> None:
 
 def test_tf_message_encoders_write_what_rosbags_serializes() -> None:
     robot = RobotTransforms(EVERY_JOINT_URDF, 'p/')
-    moving = robot.moving_transforms({'arm_joint': 0.4, 'slider_joint': 0.1, 'wheel_joint': 2.0})
+    positions = {'arm_joint': 0.4, 'slider_joint': 0.1, 'wheel_joint': 2.0}
+    prepared = robot.moving(list(positions))
     stamp = 1_790_000_000_123_456_789
-    data = messages.TFMessageEncoder(
-        [(t.parent_frame, t.child_frame) for t in moving]).encode(moving, stamp)
+    data = messages.TFMessageEncoder(prepared.frames).encode(
+        prepared.values(positions.values()), stamp)
+    moving = moving_transforms(robot, positions)
     assert data == encode_cdr(messages.tf_message(moving, stamp))
     decoded = TYPESTORE.deserialize_cdr(data, TF_TYPE)
     assert TYPESTORE.serialize_cdr(decoded, TF_TYPE) == data

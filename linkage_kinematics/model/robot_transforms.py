@@ -15,7 +15,9 @@ as robot_state_publisher (Jazzy) does through kdl_parser and KDL,
   rotation by q about the joint's unit axis, or a translation by q along it; published on /tf
   with the joint state's stamp. A ``mimic`` joint follows its joint as
   multiplier · q + offset, as robot_state_publisher adds it whenever the mimicked joint is in the
-  message (unless the message names the mimic joint itself).
+  message (unless the message names the mimic joint itself). ``RobotTransforms.moving``
+  prepares them once for a joint state's names (``MovingTransforms``): per state only the
+  motion's terms are computed.
 
 Both prefix their frame ids with ``frame_prefix`` (robot_state_publisher's parameter, a plain
 string prepended to the link names). Transforms come out ordered by joint name, as
@@ -24,10 +26,11 @@ robot_state_publisher's maps hold them.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 import enum
 import math
+from typing import Any
 import xml.etree.ElementTree as ElementTree
 
 Vector = tuple[float, float, float]
@@ -89,23 +92,9 @@ class UrdfJoint:
     def movable(self) -> bool:
         return self.joint_type in MOVABLE_TYPES
 
-    def transform(self, position: float, frame_prefix: str) -> Transform:
-        """Return the child link's frame in the parent link's at joint ``position`` (rad or m)."""
-        translation = self.origin_translation
-        rotation = self.origin_rotation
-        if self.joint_type in (JointType.REVOLUTE, JointType.CONTINUOUS):
-            half = 0.5 * position
-            sine = math.sin(half)
-            motion = (self.axis[0] * sine, self.axis[1] * sine, self.axis[2] * sine,
-                      math.cos(half))
-            rotation = quaternion_product(rotation, motion)
-        elif self.joint_type == JointType.PRISMATIC:
-            along = rotate(rotation, self.axis)
-            translation = (translation[0] + along[0] * position,
-                           translation[1] + along[1] * position,
-                           translation[2] + along[2] * position)
-        return Transform(frame_prefix + self.parent, frame_prefix + self.child, translation,
-                         rotation)
+    @property
+    def revolute(self) -> bool:
+        return self.joint_type in (JointType.REVOLUTE, JointType.CONTINUOUS)
 
 
 def quaternion_product(first: Quaternion, second: Quaternion) -> Quaternion:
@@ -232,22 +221,93 @@ class RobotTransforms:
 
     def fixed_transforms(self) -> list[Transform]:
         """Return the transforms of every fixed joint (robot_state_publisher's /tf_static)."""
-        return [joint.transform(0.0, self.frame_prefix)
+        prefix = self.frame_prefix
+        return [Transform(prefix + joint.parent, prefix + joint.child, joint.origin_translation,
+                          joint.origin_rotation)
                 for joint in self.joints.values() if not joint.movable]
 
-    def moving_transforms(self, positions: Mapping[str, float]) -> list[Transform]:
+    def moving(self, names: Sequence[str]) -> MovingTransforms:
         """
-        Return the transforms of the movable joints at ``positions`` (joint name → rad or m).
+        Return the movable joints' transforms for joint states of ``names`` (unique), prepared.
 
-        Those of the joints named in ``positions`` and the mimic joints that follow them
-        (robot_state_publisher's /tf for one joint state; a mimic joint named in ``positions``
-        keeps that position); other names are ignored.
+        Those of the joints named and the mimic joints that follow them (robot_state_publisher's
+        /tf for one joint state; a mimic joint named keeps the joint state's position); other
+        names are ignored.
         """
-        positions = dict(positions)
+        slots = {name: index for index, name in enumerate(names)}
+        # Mimic positions are appended to the joint state's in joint name order, as
+        # robot_state_publisher adds them from its map of mimic joints: a mimic of a mimic
+        # follows it only if the mimicked joint's name sorts first.
+        mimics = []
         for name, joint in self.joints.items():
-            if (joint.mimic is not None and joint.mimic.joint in positions
-                    and name not in positions):
-                positions[joint.name] = (joint.mimic.multiplier * positions[joint.mimic.joint]
-                                         + joint.mimic.offset)
-        return [joint.transform(positions[name], self.frame_prefix)
-                for name, joint in self.joints.items() if joint.movable and name in positions]
+            if joint.mimic is not None and joint.mimic.joint in slots and name not in slots:
+                mimics.append((slots[joint.mimic.joint], joint.mimic.multiplier,
+                               joint.mimic.offset))
+                slots[name] = len(slots)
+        prefix = self.frame_prefix
+        moved = [joint for name, joint in self.joints.items()
+                 if joint.movable and name in slots]
+        return MovingTransforms(
+            tuple((prefix + joint.parent, prefix + joint.child) for joint in moved),
+            tuple(mimics),
+            tuple((joint.revolute, slots[joint.name], *joint.origin_translation,
+                   *joint.origin_rotation,
+                   *(joint.axis if joint.revolute
+                     else rotate(joint.origin_rotation, joint.axis)))
+                  for joint in moved),
+        )
+
+
+class MovingTransforms:
+    """
+    The transforms of the movable joints of one joint state's names, all but their motion fixed.
+
+    Made once per URDF and names by ``RobotTransforms.moving``; ``frames`` are the (parent,
+    child) frames of the transforms, ordered by joint name. Everything that does not depend on
+    the positions is computed here once: each joint's origin as a translation and a quaternion,
+    its unit axis, and for a prismatic joint the axis turned by the origin (the direction it
+    slides in its parent's frame); so a state costs only the motion's terms: per revolute joint
+    one sine, one cosine and one quaternion product, per prismatic joint three products.
+    """
+
+    def __init__(
+        self,
+        frames: tuple[tuple[str, str], ...],
+        mimics: tuple[tuple[int, float, float], ...],
+        joints: tuple[tuple[Any, ...], ...],
+    ) -> None:
+        self.frames = frames
+        # (the mimicked joint's slot, multiplier, offset): appended to the positions in order
+        self._mimics = mimics
+        # (revolute, slot, origin translation xyz, origin rotation xyzw, axis xyz; for a
+        # prismatic joint the axis in the parent's frame)
+        self._joints = joints
+
+    def values(self, positions: Iterable[float]) -> tuple[float, ...]:
+        """
+        Return translation xyz and rotation xyzw of each transform in turn, 7 floats each.
+
+        At ``positions`` (rad or m), the positions of the names the transforms were made for,
+        in that order.
+        """
+        slots = list(positions)
+        for source, multiplier, offset in self._mimics:
+            slots.append(multiplier * slots[source] + offset)
+        values: list[float] = []
+        for revolute, slot, tx, ty, tz, x, y, z, w, ax, ay, az in self._joints:
+            position = slots[slot]
+            if revolute:
+                half = 0.5 * position
+                sine = math.sin(half)
+                mx, my, mz, mw = ax * sine, ay * sine, az * sine, math.cos(half)
+                # origin · (a·sin(q/2), cos(q/2)): quaternion_product's terms in its order,
+                # written out (a call per joint costs more than its arithmetic)
+                values += (tx, ty, tz,
+                           w * mx + x * mw + y * mz - z * my,
+                           w * my - x * mz + y * mw + z * mx,
+                           w * mz + x * my - y * mx + z * mw,
+                           w * mw - x * mx - y * my - z * mz)
+            else:
+                values += (tx + ax * position, ty + ay * position, tz + az * position,
+                           x, y, z, w)
+        return tuple(values)

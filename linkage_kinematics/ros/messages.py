@@ -252,7 +252,7 @@ class TFMessageEncoder:
     """
     The bytes of ``tf_message`` (encode_cdr) for one list of parent and child frames.
 
-    Straight from the transforms.
+    Straight from the transforms' values, as ``MovingTransforms.values`` gives them.
     """
 
     def __init__(self, frames: Sequence[tuple[str, str]]) -> None:
@@ -262,24 +262,23 @@ class TFMessageEncoder:
              for parent, child in self.frames],
             0,
         )
-        varying = []
-        for index in range(len(self.frames)):
-            varying += _stamp_paths(f'transforms[{index}].')
-            varying += [f'transforms[{index}].transform.{part}.{axis}'
-                        for part, axes in (('translation', 'xyz'), ('rotation', 'xyzw'))
-                        for axis in axes]
+        # every stamp first, then every transform, so that a message's values are the stamp
+        # repeated and the transforms' values as they come
+        indices = range(len(self.frames))
+        varying = [path for index in indices for path in _stamp_paths(f'transforms[{index}].')]
+        varying += [f'transforms[{index}].transform.{part}.{axis}' for index in indices
+                    for part, axes in (('translation', 'xyz'), ('rotation', 'xyzw'))
+                    for axis in axes]
         self._encoder = FixedShapeEncoder(template, varying)
 
-    def encode(self, transforms: Sequence[Transform], stamp_ns: int) -> bytes:
-        """Return the message of ``transforms`` (between ``frames``, in that order)."""
-        stamp = divmod(stamp_ns, 1_000_000_000)
-        values: list[float] = []
-        for (parent, child), transform in zip(self.frames, transforms, strict=True):
-            if (transform.parent_frame, transform.child_frame) != (parent, child):
-                raise ValueError(f'{transform.parent_frame} → {transform.child_frame} is not '
-                                 f'the encoder’s {parent} → {child}')
-            values += (*stamp, *transform.translation, *transform.rotation)
-        return self._encoder.encode(tuple(values))
+    def encode(self, values: tuple[float, ...], stamp_ns: int) -> bytes:
+        """
+        Return the message of the transforms between ``frames``, each stamped ``stamp_ns``.
+
+        ``values``: translation xyz and rotation xyzw of each transform in turn.
+        """
+        return self._encoder.encode(
+            divmod(stamp_ns, 1_000_000_000) * len(self.frames) + values)
 
 
 class RobotStateTransforms:
@@ -287,15 +286,14 @@ class RobotStateTransforms:
     The /tf_static and /tf messages robot_state_publisher publishes for one URDF, as bytes.
 
     With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
-    robot_transforms.UrdfError for a URDF it cannot read.
+    robot_transforms.UrdfError for a URDF it cannot read. The /tf of a joint state is written
+    from the joints' prepared transforms (``RobotTransforms.moving``) and a prepared message,
+    both made again only when the joint state's names change.
     """
 
     def __init__(self, urdf: str, frame_prefix: str) -> None:
         self._robot = RobotTransforms(urdf, frame_prefix)
-        moving = self._robot.moving_transforms(
-            {name: 0.0 for name, joint in self._robot.joints.items() if joint.movable})
-        self._encoder = TFMessageEncoder(
-            [(transform.parent_frame, transform.child_frame) for transform in moving])
+        self._names: tuple[str, ...] | None = None
 
     def static_message(self, stamp_ns: int) -> bytes:
         """Return /tf_static: the fixed joints, stamped ``stamp_ns``."""
@@ -303,8 +301,14 @@ class RobotStateTransforms:
 
     def message(self, positions: Mapping[str, float], stamp_ns: int) -> bytes:
         """
-        Return /tf for a joint state of every movable joint, stamped ``stamp_ns``.
+        Return /tf for a joint state, stamped ``stamp_ns``.
 
-        ``positions`` maps each movable joint's name to its position (rad or m).
+        ``positions`` maps joint names to positions (rad or m); the transforms are those of
+        ``RobotTransforms.moving`` for its names.
         """
-        return self._encoder.encode(self._robot.moving_transforms(positions), stamp_ns)
+        names = tuple(positions)
+        if names != self._names:
+            self._moving = self._robot.moving(names)
+            self._encoder = TFMessageEncoder(self._moving.frames)
+            self._names = names
+        return self._encoder.encode(self._moving.values(positions.values()), stamp_ns)
