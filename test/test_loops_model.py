@@ -13,9 +13,13 @@ from __future__ import annotations
 
 import math
 
+from linkage_kinematics.kinematics.continuation import continued_branch
+from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
+from linkage_kinematics.kinematics.solver import CrankRates, solve
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 from linkage_kinematics.model.loops import find_loops, LoopSampleError, LoopSolver
+from linkage_kinematics.model.urdf import urdf_text
 import loop_reference
 from loop_robots import DEPTH_1, ROBOTS
 import numpy as np
@@ -372,6 +376,34 @@ def test_continuous_joints_stay_continuous_and_the_branch_holds_through_change_p
         assert positions['coupler_joint'] == pytest.approx(-crank, abs=1e-12)
         assert positions['rocker_joint'] == pytest.approx(crank, abs=1e-12)
         assert velocities['coupler_joint'] == pytest.approx(-2.0, abs=1e-9)
+
+
+def test_a_wrapping_encoder_keeps_the_branch_where_a_turn_has_one_change_point() -> None:
+    """
+    A kite (OA = OC, AB = BC) turned twice by its crank, read wrapped at ±π.
+
+    A turn of its crank passes one change point, so its smooth motion repeats every two turns:
+    the solver goes the short way between samples and stays on the branch the four-bar's closed
+    form continues to over whole turns.
+    """
+    kite = FourBar(0.3, 1.0, 1.0, 0.3, 0.0)
+    start = -1.5
+    # the zero pose's branch from which the solver reaches +1 at the first sample
+    zero_branch = int(continued_branch(kite, start, 1, 0.0))
+    solver = LoopSolver(find_loops(urdf_text(kite)).plan(('crank_joint',),
+                                                         {'pivot_c': zero_branch}))
+    for step in range(240):
+        alpha = start + math.radians(3.0 * step)
+        wrapped = math.remainder(alpha, 2.0 * math.pi)
+        turns = round((alpha - wrapped) / (2.0 * math.pi))
+        positions, velocities = solver.solve({'crank_joint': wrapped}, {'crank_joint': 1.0})
+        branch = int(continued_branch(kite, start, 1, wrapped, turns=turns))
+        state = solve(kite, wrapped, CrankRates(1.0, 0.0), branch)
+        coupler = math.remainder(positions['coupler_joint'] - (state.gamma - state.alpha),
+                                 2.0 * math.pi)
+        assert coupler == pytest.approx(0.0, abs=TOLERANCE)
+        assert velocities['coupler_joint'] == pytest.approx(state.omega_ab - state.omega,
+                                                            abs=TOLERANCE)
 
 
 def test_the_branch_override_picks_the_other_assembly() -> None:

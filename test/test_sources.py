@@ -17,6 +17,7 @@ import math
 from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.model.joints import TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.sources import (
     DriveLawTimer,
@@ -85,6 +86,7 @@ class FakeHost(RunStatus):
         self.clock_ns = START_NS
         self.state: LinkageState | None = None
         self.motion_started = False
+        self.joints: TreeValues | None = None
         self.record: list[tuple] = []
         self.timers: list[FakeTimer] = []
         self.subscriptions: dict[str, Callable[[Any], None]] = {}
@@ -110,7 +112,9 @@ class FakeHost(RunStatus):
         self.subscriptions[topic] = callback
         return topic
 
-    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
+                      joints: TreeValues | None = None) -> None:
+        self.joints = joints
         if not self.motion_started:
             self.motion_started = True
             self.show_waiting(state, stamp_ns)
@@ -251,6 +255,8 @@ def test_the_measured_source_takes_a_new_configuration_through_its_follower():
     assert freshness.timer_period_ns == 250_000_000
     follow(joint_state(1.0, 0.3))
     assert host.take()[-1] == ('state', pytest.approx(0.3), 1_000_000_000, 0.0)
+    # the follower's joints go with the state (its loop's passive joints, test_node_loop.py)
+    assert host.joints[0][0] == 0.3
 
     new = configuration(source='measured', **{'measured.timeout': 2.0, 'measured.max_jump': 0.1})
     host.config = new

@@ -87,9 +87,11 @@ class JointMap:
         return tuple(self[link].name for link in links)
 
 
-def tree_values(
-    state: LinkageState, driver: Driver
-) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+# A tree's joint positions (rad) and velocities (rad/s), root first.
+TreeValues = tuple[tuple[float, float, float], tuple[float, float, float]]
+
+
+def tree_values(state: LinkageState, driver: Driver) -> TreeValues:
     """
     Return the joint positions (rad) and velocities (rad/s) of ``driver``'s tree, root first.
 

@@ -21,12 +21,13 @@ from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.kinematics.geometry import GeometryError
+from linkage_kinematics.kinematics.geometry import GeometryError, TWO_PI
 from linkage_kinematics.kinematics.planar_loop import (
     branch_of,
     continued_branch_of,
     DeadPointError,
     JointKind,
+    known_joint_range,
     solve_loop,
     UnreachableError,
 )
@@ -178,11 +179,18 @@ class LoopSolver:
     Each loop starts on its planned branch at the zero pose and follows the known joint's motion
     from sample to sample (``continued_branch_of``), so that it stays on its assembly through
     change points; revolute and continuous joints are kept within π of their previous value
-    (at first, of the zero pose). A refused sample leaves that state as it was.
+    (at first, of the zero pose), and a revolute known joint is followed across whole turns. A
+    refused sample leaves that state as it was.
     """
 
     def __init__(self, plan: LoopPlan) -> None:
         self.plan = plan
+        # the loops whose revolute known joint meets an odd number of change points per turn
+        self._odd_turns = frozenset(
+            planned.loop.constraint for planned in plan.loops
+            if planned.known.kind is JointKind.REVOLUTE
+            and len(known_joint_range(planned.loop.planar, planned.known.index).change_points)
+            % 2)
         self.reset()
 
     def reset(self) -> None:
@@ -219,6 +227,12 @@ class LoopSolver:
                 branch = continued_branch_of(planar, known.index,
                                              self._known_values[constraint],
                                              self._branches[constraint], value)
+                # A revolute known joint is followed across whole turns (an encoder that wraps
+                # at ±π): the motion went the short way, the whole turns between it and the way
+                # just counted holding an odd number of change points each where it flips.
+                if (known.kind is JointKind.REVOLUTE and constraint in self._odd_turns
+                        and round((self._known_values[constraint] - value) / TWO_PI) % 2):
+                    branch = -branch
                 state = solve_loop(planar, known.index, value, known.sign * rates[known.name],
                                    branch)
             except (DeadPointError, UnreachableError) as error:

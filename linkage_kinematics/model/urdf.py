@@ -21,6 +21,13 @@ Each joint carries the lab's name, and its lab value q = direction · node value
 it: the joint's axis is direction·z and its origin is turned by −direction·offset about z, so
 that the child frame turns by direction·(q − offset), the node's value, as above.
 
+The pivot the tree leaves open is written as the loop's cut joint, a revolute ``<constraint>``
+(urdfdom PR #264, as ``model.loops`` reads it; robot_state_publisher's parser ignores it) named
+``pivot_c`` or ``pivot_o``: its parent frame is the pivot on the root link, its child frame the
+chain's end, (BC, 0, 0) in the rocker or (OA, 0, 0) in the disk, turned so that the two frames
+are parallel at the zero pose. They coincide wherever the loop closes; the zero pose (every
+joint at 0) is in general not such a pose, so there they differ by its closure gap.
+
 The root link (``frame_id``, by default ``linkage_base``) shows both ground pivots.
 Regenerate the installed file with ``python -m linkage_kinematics.model.urdf > urdf/linkage.urdf``.
 """
@@ -90,6 +97,29 @@ def _joint(joint: JointMapping, parent: str, child: str, xyz: str) -> str:
         f'    <origin xyz="{xyz}" rpy="0 0 {yaw}"/>\n'
         f'    <axis xyz="0 0 {joint.direction}"/>\n'
         '  </joint>\n'
+    )
+
+
+def _constraint(name: str, parent: str, pivot: str, child: str, end: str,
+                joints: tuple[JointMapping, ...]) -> str:
+    """
+    Return the ``<constraint>`` that pins ``end`` of link ``child`` to ``pivot`` on ``parent``.
+
+    ``joints`` are the tree's joints from ``parent`` to ``child``: at the zero pose each origin
+    turns the chain by −direction·offset, so the child frame is turned back by their sum to be
+    parallel to the parent frame.
+    """
+    turn = sum(joint.direction * joint.offset for joint in joints)
+    yaw = _number(turn) if turn else '0'
+    return (
+        f'  <constraint name="{name}" type="revolute">\n'
+        f'    <parent link="{parent}"/>\n'
+        f'    <parent_origin xyz="{pivot}" rpy="0 0 0"/>\n'
+        '    <parent_axis xyz="0 0 1"/>\n'
+        f'    <child link="{child}"/>\n'
+        f'    <child_origin xyz="{end}" rpy="0 0 {yaw}"/>\n'
+        '    <child_axis xyz="0 0 1"/>\n'
+        '  </constraint>\n'
     )
 
 
@@ -168,6 +198,10 @@ def urdf_text(
             + _joint(joints.coupler, 'disk', 'coupler', _xyz(0.0, -crank, 0.0))
             + _joint(joints.rocker, 'coupler', 'rocker', _xyz(coupler, 0.0, 0.0))
         )
+        # cut at C: the rocker's end meets the ground pivot
+        cut = _constraint('pivot_c', frame_id, _xyz(linkage.ground_x, linkage.ground_y, 0.0),
+                          'rocker', _xyz(rocker, 0.0, 0.0),
+                          (joints.crank, joints.coupler, joints.rocker))
     else:
         # The disk's frame has its x axis from A to O, so O is at (OA, 0, 0) in it.
         disk = (
@@ -183,6 +217,9 @@ def urdf_text(
             + _joint(joints.coupler, 'rocker', 'coupler', _xyz(rocker, 0.0, 0.0))
             + _joint(joints.crank, 'coupler', 'disk', _xyz(coupler, 0.0, 0.0))
         )
+        # cut at O: the disk's far end meets the root's origin
+        cut = _constraint('pivot_o', frame_id, _xyz(0.0, 0.0, 0.0), 'disk',
+                          _xyz(crank, 0.0, 0.0), (joints.rocker, joints.coupler, joints.crank))
     return (
         '<?xml version="1.0"?>\n'
         '<robot name="linkage">\n'
@@ -192,6 +229,7 @@ def urdf_text(
         + coupler_link
         + rocker_link
         + chain
+        + cut
         + '</robot>\n'
     )
 

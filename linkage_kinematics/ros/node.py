@@ -25,6 +25,7 @@ import sys
 from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.model.joints import TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
 from linkage_kinematics.ros.parameters import (
@@ -222,9 +223,10 @@ class LinkageNode(RunStatus, Node):
         self.outputs.publish_description(stamp_ns)
         self.publish_diagnostics()
 
-    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
+                      joints: TreeValues | None = None) -> None:
         """
-        Publish a state stamped ``stamp_ns``.
+        Publish a state stamped ``stamp_ns`` (and the tree's joints, if the source solved them).
 
         The first of a motion comes after its scene (so a viewer knows the frame before anything
         refers to it), the URDF if the geometry is new, and the status that says it moves.
@@ -238,7 +240,7 @@ class LinkageNode(RunStatus, Node):
             self.publish_markers()
             self.outputs.publish_description(stamp_ns)
             self.publish_diagnostics()
-        self.outputs.publish_state(state, stamp_ns, motion_time)
+        self.outputs.publish_state(state, stamp_ns, motion_time, joints)
         if self._status_schedule.due(stamp_ns):
             self.publish_diagnostics()
 

@@ -23,7 +23,7 @@ from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
-from linkage_kinematics.model.joints import JointMap, JointStream
+from linkage_kinematics.model.joints import JointMap, JointStream, TreeValues
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros import messages
 from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration, SourceKind
@@ -160,10 +160,16 @@ class NodeOutputs:
             self._joint_state_encoder = messages.JointStateEncoder(self._joints.names)
             self._streamed = self.config.joints
 
-    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
-        """Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``."""
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
+                      joints: TreeValues | None = None) -> None:
+        """
+        Publish the joint states and ``linkage/state`` of ``state``, stamped ``stamp_ns``.
+
+        ``joints``: the tree's lab values where the source solved them (the measured source's
+        loop), else the four-bar's (``JointStream``).
+        """
         self._prepare()
-        positions, velocities = self._joints.values(state)
+        positions, velocities = joints if joints is not None else self._joints.values(state)
         published = self._joints.published
         self.send(self._publishers.joint_states,
                   self._joint_state_encoder.encode(stamp_ns, positions[published],

@@ -18,7 +18,7 @@ import math
 from typing import Any, Protocol
 
 from linkage_kinematics.kinematics.solver import LinkageState
-from linkage_kinematics.model.joints import Link
+from linkage_kinematics.model.joints import Link, TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.run.configuration import EndBehavior, RunConfiguration
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
@@ -125,8 +125,13 @@ class SourceHost(Protocol):
                             callback: Callable[[Any], None], qos_profile: QoSProfile) -> object:
         """Subscribe ``callback`` to ``topic`` (relative to the node's namespace)."""
 
-    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float) -> None:
-        """Publish a state; the first of a motion after its scene, URDF and status."""
+    def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
+                      joints: TreeValues | None = None) -> None:
+        """
+        Publish a state; the first of a motion after its scene, URDF and status.
+
+        ``joints``: the tree's lab joint values, where the source solved them.
+        """
 
     def show_waiting(self, state: LinkageState, stamp_ns: int) -> None:
         """Publish the scene of ``state``, the URDF if new, and the status; no state."""
@@ -423,7 +428,8 @@ class MeasuredSubscription:
             self.stale = False
             self._host.forget_state()  # publish the scene and the status with the next state
         self._host.set_activity(f'following {self._driver_name}')
-        self._host.publish_state(followed.state, followed.stamp_ns, followed.motion_time)
+        self._host.publish_state(followed.state, followed.stamp_ns, followed.motion_time,
+                                 followed.joints)
 
     def _check_freshness(self) -> None:
         """Report at once when the measured data goes stale."""

@@ -9,6 +9,13 @@ positions, velocities), picks the driver joint by its lab name, maps it to the n
 convention (``joints.JointMapping.from_lab``), unwraps it across turns and solves the linkage
 at it: the crank directly, the rocker through the mechanism seen from C (``inversion``).
 
+The passive joints come the general way, as from a lab's URDF: the node's own URDF for the
+configuration (``model.urdf``, whose ``<constraint>`` closes its loop) is read by
+``model.loops``, planned with the driver measured, and its ``LoopSolver`` turns the driver's lab
+value and velocity into the passive joints' lab values and velocities. The four-bar's
+``LinkageState`` (``linkage/state``, the scene, diagnostics) still comes from its closed form:
+it holds the accelerations and pins the loop solver does not compute.
+
 What is measured, exact or estimated:
 
 * the driver's angle is measured; every position (β, γ, α or θ_BC, the pins, the passive
@@ -37,6 +44,7 @@ import math
 
 from linkage_kinematics.kinematics.geometry import TWO_PI, UnreachableError
 from linkage_kinematics.kinematics.inversion import solve_from_rocker
+from linkage_kinematics.kinematics.planar_loop import continued_branch_of
 from linkage_kinematics.kinematics.solver import (
     continued_branch,
     CrankRates,
@@ -45,8 +53,20 @@ from linkage_kinematics.kinematics.solver import (
     solve,
     unwrap_near,
 )
-from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER
+from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER, TreeValues
+from linkage_kinematics.model.loops import (
+    find_loops,
+    LoopPlan,
+    LoopSampleError,
+    LoopSolver,
+    RobotLoops,
+)
+from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.run.configuration import RunConfiguration
+
+# Far below any distance between two change points, far above the rounding of the loop's
+# geometry (rad): where the four-bar's and the loop's change points are told apart.
+_CHANGE_POINT_CLEARANCE = 1e-9
 
 
 class Rejection(StrEnum):
@@ -74,7 +94,8 @@ class FollowedSample:
 
     ``state.alpha`` is the unwrapped crank angle; ``driver_angle`` the unwrapped driver angle in
     the node's convention (α, or θ_BC = π − β for the rocker); ``motion_time`` the stamp's time
-    since the first sample followed (s).
+    since the first sample followed (s); ``joints`` the lab's positions and velocities of the
+    driver's tree, root (the driver, unwrapped) first, the passive joints from the node's loop.
     """
 
     stamp_ns: int
@@ -82,6 +103,7 @@ class FollowedSample:
     driver_angle: float
     velocity: Estimate
     motion_time: float
+    joints: TreeValues
 
 
 @dataclass(frozen=True)
@@ -105,16 +127,29 @@ class MeasuredFollower:
         self._mapping = config.joints[Link(config.driver.value)]
         # Messages that hold only the joints this node publishes are its own output coming
         # back (it may listen on the topic it publishes to): ignored, not counted.
-        self._own_names = frozenset(config.joints.names(TREE_ORDER[config.driver][1:]))
+        self._passive = tuple(config.joints[link] for link in TREE_ORDER[config.driver][1:])
+        self._own_names = frozenset(mapping.name for mapping in self._passive)
+        self._loops = _node_loops(config)
+        # The passive joints published last (lab values), kept across restarts so that they
+        # stay continuous; at first the node's zero, as every joint stream starts.
+        self._previous = tuple(mapping.offset for mapping in self._passive)
         self.restart()
 
     def restart(self) -> None:
         """Forget the motion: the next valid sample starts it again on ``branch``."""
         self._first: _Anchor | None = None
         self._last: _Anchor | None = None
+        self._solver: LoopSolver | None = None  # planned at the motion's first sample
 
     def reconfigure(self, config: RunConfiguration) -> None:
-        """Take new thresholds (timeout, jump, filter) while following the same motion."""
+        """
+        Take a new configuration of the same joints.
+
+        New thresholds (timeout, jump, filter) go on following the same motion; a new geometry
+        (a new loop) comes with a restart of the motion.
+        """
+        if config.linkage != self.config.linkage:
+            self._loops = _node_loops(config)
         self.config = config
 
     def follow(
@@ -152,14 +187,59 @@ class MeasuredFollower:
         omega, omega_dot, estimate = self._rates(stamp_ns, angle, measured_velocity)
         try:
             state = self._solve(encoder_angle, turns, omega, omega_dot)
-        except (DeadPointError, UnreachableError):
+            joints = self._complete(encoder_angle, measured_angle,
+                                    self._mapping.direction * omega)
+        except (DeadPointError, UnreachableError, LoopSampleError):
             return Rejection.UNREACHABLE
         anchor = _Anchor(stamp_ns, angle, encoder_angle, turns, state.alpha, omega, omega_dot)
         if self._first is None:
             self._first = anchor
         self._last = anchor
+        self._previous = joints[0]
         return FollowedSample(
-            stamp_ns, state, angle, estimate, (stamp_ns - self._first.stamp_ns) * 1e-9)
+            stamp_ns, state, angle, estimate, (stamp_ns - self._first.stamp_ns) * 1e-9,
+            ((self._mapping.to_lab(angle), *joints[0]),
+             (self._mapping.direction * omega, *joints[1])))
+
+    def _complete(self, encoder_angle: float, lab_angle: float, lab_velocity: float
+                  ) -> tuple[tuple[float, float], tuple[float, float]]:
+        """
+        Return the passive joints' lab positions and velocities at the driver's lab values.
+
+        ``encoder_angle`` is ``lab_angle`` in the node's convention. Solved by the node's loop
+        (module docstring); raises LoopSampleError where it does not close. The solver is kept
+        only once it has solved a sample, so that a refused first sample leaves the motion
+        unstarted.
+        """
+        solver = self._solver or LoopSolver(self._plan(encoder_angle))
+        name = self._mapping.name
+        positions, velocities = solver.solve({name: lab_angle}, {name: lab_velocity})
+        self._solver = solver
+        return (
+            tuple(unwrap_near(positions[mapping.name], previous)
+                  for mapping, previous in zip(self._passive, self._previous)),
+            tuple(velocities[mapping.name] for mapping in self._passive),
+        )
+
+    def _plan(self, encoder_angle: float) -> LoopPlan:
+        """
+        Return the node's loop planned to start on ``branch`` at the first sample.
+
+        ``branch`` names the assembly at the driver's ``encoder_angle`` as the four-bar's closed
+        form does (at a change point, the one just counterclockwise of it). The loop's geometry,
+        read back from the URDF's rounded numbers, may put that change point an ulp to the other
+        side of the sample, so the branch is carried a hair counterclockwise, where the two agree,
+        and continued from there to the zero pose, where a LoopSolver starts (the continuation
+        is symmetric: from the zero pose it comes back to this branch).
+        """
+        config = self.config
+        nearby = encoder_angle + _CHANGE_POINT_CLEARANCE
+        branch = continued_branch(config.driven_linkage, encoder_angle, config.branch, nearby)
+        (loop,) = self._loops.loops
+        known = loop.joint(self._mapping.name)
+        branch = continued_branch_of(loop.planar, known.index,
+                                     known.sign * self._mapping.to_lab(nearby), branch, 0.0)
+        return self._loops.plan([known.name], {loop.constraint: branch})
 
     def _rates(
         self, stamp_ns: int, angle: float, measured_velocity: float | None
@@ -207,3 +287,8 @@ class MeasuredFollower:
             return state
         # The crank driven by the rocker may turn fully (a double crank): α stays continuous.
         return replace(state, alpha=unwrap_near(state.alpha, self._last.crank_angle))
+
+
+def _node_loops(config: RunConfiguration) -> RobotLoops:
+    """Return the loop of the node's own URDF for ``config`` (one four-bar, ``model.urdf``)."""
+    return find_loops(urdf_text(config.linkage, config.frame_id, config.joints, config.driver))
