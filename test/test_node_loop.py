@@ -37,6 +37,11 @@ import numpy as np
 import pytest
 import urchin
 
+# The kite (a change-point linkage) is solved from its URDF, whose link vectors are rounded
+# components at the zero pose: within a few degrees of its change point the rates amplify that
+# rounding, and the two paths' velocities differ by up to 1.0e-12 there (1° from it; each is
+# within 7e-13 of the 50-digit reference of the parameters' kite).
+KITE_VELOCITY_TOLERANCE = 4e-12
 TOLERANCE = 1e-12
 # config/measured_lab.yaml's knee, and the same with its rocker joint reversed
 LAB = JointMap(JointMapping('knee_motor', -1, 0.4), JointMapping('knee_link', 1, -0.2),
@@ -121,7 +126,10 @@ def test_robot_state_publishers_reading_is_that_of_the_text_without_the_constrai
     with_constraint = RobotTransforms(urdf)
     plain = RobotTransforms(without)
     assert with_constraint.fixed_transforms() == plain.fixed_transforms()
-    assert with_constraint.moving_transforms(values) == plain.moving_transforms(values)
+    names = list(values)
+    moving, plain_moving = with_constraint.moving(names), plain.moving(names)
+    assert moving.frames == plain_moving.frames
+    assert moving.values(values.values()) == plain_moving.values(values.values())
 
 
 # --- the measured follower's passive joints: the general loop path against the four-bar's ------
@@ -200,8 +208,9 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
         assert turns == first_turns
         for solved, mapped, shift in zip(followed.joints[0][1:], positions[1:], turns):
             assert solved - shift * TWO_PI == pytest.approx(mapped, abs=TOLERANCE)
+        velocity_tolerance = KITE_VELOCITY_TOLERANCE if geometry == 'kite' else TOLERANCE
         for solved, mapped in zip(followed.joints[1], velocities):
-            assert solved == pytest.approx(mapped, abs=TOLERANCE * max(1.0, abs(mapped)))
+            assert solved == pytest.approx(mapped, abs=velocity_tolerance * max(1.0, abs(mapped)))
         assert followed.joints[1][0] == velocities[0]
         assert angle_gap(followed.joints[0][0], positions[0]) < TOLERANCE
 

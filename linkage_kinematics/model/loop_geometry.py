@@ -36,12 +36,12 @@ from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, PlanarLoop
 from linkage_kinematics.model.loop_urdf import (
     Constraint,
+    JointType,
     LoopError,
     MOVING_TYPES,
     Robot,
     ROTATING_TYPES,
     tree_path,
-    UrdfJointType,
 )
 import numpy as np
 
@@ -102,12 +102,12 @@ def _lean(direction: np.ndarray, normal: np.ndarray, along: bool) -> float:
 
 
 def _moving_path(robot: Robot, constraint: Constraint,
-                 where: str) -> list[tuple[UrdfJointType, str, bool]]:
+                 where: str) -> list[tuple[JointType, str, bool]]:
     if constraint.parent.link == constraint.child.link:
         raise LoopError(f'{where}: joins link {constraint.parent.link!r} to itself')
     path = tree_path(robot, constraint.parent.link, constraint.child.link)
     free = [joint.name for joint, _ in path
-            if joint.joint_type in (UrdfJointType.FLOATING, UrdfJointType.PLANAR)]
+            if joint.joint_type in (JointType.FLOATING, JointType.PLANAR)]
     if free:
         raise LoopError(f'{where}: the loop holds floating or planar joints {free}, which have '
                         'no single coordinate to solve')
@@ -117,14 +117,14 @@ def _moving_path(robot: Robot, constraint: Constraint,
         raise LoopError(f'{where}: the loop has {len(moving)} moving joints '
                         f'{[name for _, name, _ in moving]}, not 3: only a four-bar (or a '
                         'slider-crank) loop can be closed')
-    prismatic = [name for joint_type, name, _ in moving if joint_type is UrdfJointType.PRISMATIC]
+    prismatic = [name for joint_type, name, _ in moving if joint_type is JointType.PRISMATIC]
     if len(prismatic) > 1:
         raise LoopError(f'{where}: the loop has {len(prismatic)} prismatic joints {prismatic}; '
                         'at most one is supported')
     return moving
 
 
-def _normal(robot: Robot, constraint: Constraint, moving: list[tuple[UrdfJointType, str, bool]],
+def _normal(robot: Robot, constraint: Constraint, moving: list[tuple[JointType, str, bool]],
             where: str) -> np.ndarray:
     """Return the loop's unit normal, after checking every axis against it."""
     if constraint.parent.axis is not None:
@@ -190,7 +190,7 @@ def derive_loop(robot: Robot, constraint: Constraint) -> Loop:
     for index, (joint_type, name, forward) in enumerate(moving, start=1):
         tree_joint = robot.joints[name]
         crossing = 1 if forward else -1
-        if joint_type is UrdfJointType.PRISMATIC:
+        if joint_type is JointType.PRISMATIC:
             kind, sign = JointKind.PRISMATIC, crossing
             slide_world = tree_joint.axis - (tree_joint.axis @ normal) * normal
             slide_world /= np.linalg.norm(slide_world)
@@ -200,7 +200,7 @@ def derive_loop(robot: Robot, constraint: Constraint) -> Loop:
             sign = crossing * (1 if tree_joint.axis @ normal > 0.0 else -1)
         kinds.append(kind)
         joints.append(LoopJoint(name, index, kind, sign,
-                                joint_type is UrdfJointType.CONTINUOUS, tree_joint.mimic))
+                                joint_type is JointType.CONTINUOUS, tree_joint.mimic))
     try:
         planar = PlanarLoop(kinds=tuple(kinds), links=links, slide=slide)
     except GeometryError as error:

@@ -24,11 +24,11 @@ from __future__ import annotations
 from collections.abc import Iterator
 import contextlib
 from dataclasses import dataclass
-import enum
 import math
 import re
 import xml.etree.ElementTree as ElementTree
 
+from linkage_kinematics.model.robot_transforms import JointType
 import lxml.etree
 import numpy as np
 from urdf_parser_py import urdf as urdf_parser
@@ -39,19 +39,8 @@ class LoopError(ValueError):
     """A URDF, or one of its loops, that cannot be closed; the message names it and says why."""
 
 
-class UrdfJointType(enum.Enum):
-    """URDF joint types."""
-
-    FIXED = 'fixed'
-    REVOLUTE = 'revolute'
-    CONTINUOUS = 'continuous'
-    PRISMATIC = 'prismatic'
-    FLOATING = 'floating'
-    PLANAR = 'planar'
-
-
-ROTATING_TYPES = frozenset({UrdfJointType.REVOLUTE, UrdfJointType.CONTINUOUS})
-MOVING_TYPES = ROTATING_TYPES | {UrdfJointType.PRISMATIC}
+ROTATING_TYPES = frozenset({JointType.REVOLUTE, JointType.CONTINUOUS})
+MOVING_TYPES = ROTATING_TYPES | {JointType.PRISMATIC}
 
 
 @dataclass(frozen=True)
@@ -71,7 +60,7 @@ class TreeJoint:
     """A URDF joint at the zero pose: its world frame, unit world axis and mimic, if any."""
 
     name: str
-    joint_type: UrdfJointType
+    joint_type: JointType
     parent: str
     child: str
     frame: Pose
@@ -212,7 +201,7 @@ def _tree_joints(robot: urdf_parser.Robot) -> tuple[str, dict[str, TreeJoint], d
                 np.array(origin.xyz if origin is not None else (0.0, 0.0, 0.0), dtype=float),
                 np.array(origin.rpy if origin is not None else (0.0, 0.0, 0.0), dtype=float))
             try:
-                joint_type = UrdfJointType(joint.type)
+                joint_type = JointType(joint.type)
             except ValueError:
                 raise LoopError(f'{where}: unknown type {joint.type!r}') from None
             axis = np.array(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), float)
