@@ -39,6 +39,15 @@ START_NS = 1_000_000_000
 PERIOD_NS = 10_000_000
 KNEE = ROBOTS['four_bar_knee']
 EXCAVATOR = ROBOTS['excavator']
+# A joint outside the loops, which the input carries, and a fixed one below it: the bag's /tf
+# poses the whole robot.
+ANKLE = 0.5
+FOOT = ('  <link name="foot"/>\n  <link name="sole"/>\n'
+        '  <joint name="ankle" type="revolute"><parent link="shank"/><child link="foot"/>'
+        '<origin xyz="0.01 -0.1 0.0" rpy="0.0 0.0 0.3"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>\n'
+        '  <joint name="sole_joint" type="fixed"><parent link="foot"/><child link="sole"/>'
+        '<origin xyz="0.05 0.0 0.0" rpy="0.0 0.0 0.0"/></joint>\n</robot>')
 
 
 @pytest.fixture(scope='module')
@@ -142,10 +151,10 @@ def follow_sweep(node: LoopNode, robot_name: str, count: int,
             velocities = {name: 0.0 if previous is None
                           else (measured[name] - previous[name]) / (PERIOD_NS * 1e-9)
                           for name in names}
-            node.send(stamp, ['unrelated_joint', *names], [0.5, *measured.values()])
+            node.send(stamp, ['ankle', *names], [ANKLE, *measured.values()])
         else:
             velocities = rates
-            node.send(stamp, ['unrelated_joint', *names], [0.5, *measured.values()],
+            node.send(stamp, ['ankle', *names], [ANKLE, *measured.values()],
                       [0.0, *(rates[name] for name in names)])
         fed.append((stamp, measured, velocities))
         previous = measured
@@ -177,7 +186,7 @@ def assert_matches_the_reference(node: LoopNode, urdf: str, passive: Sequence[st
 
 def test_the_knee_from_the_topic_matches_the_reference_and_is_logged(context, nodes, tmp_path):
     """The knee's description on the topic; measured velocities; a jump dropped; the bag."""
-    urdf = KNEE.urdf()
+    urdf = KNEE.urdf().replace('</robot>', FOOT)
     with loop_node(context, nodes, tmp_path) as node:
         node.status('robot loops', lambda status: 'waiting for the robot description' in (
             status.message))
@@ -222,7 +231,8 @@ def assert_bag_holds_the_whole_robot(bag: Path, urdf: str, fed: list, outputs: l
     stamp, measured, _ = fed[-1]
     published = {stamp_ns(message): dict(zip(message.name, message.position))
                  for message in outputs}[stamp]
-    expected = loop_reference.link_poses(urdf, {**measured, **published})
+    expected = loop_reference.link_poses(urdf, {**measured, **published, 'ankle': ANKLE})
+    assert {'foot', 'sole'} <= set(expected)
     transforms = {item.child_frame_id: item
                   for item in static[1].transforms + tf[-1][1].transforms}
     poses = {}

@@ -164,10 +164,11 @@ class RobotLoopsSubscription:
             logger.warning(warning)
 
     def _report(self, problem: str) -> None:
-        """Make the status ERROR with ``problem``, and log it once."""
-        if problem != self._problem:
-            self._host.get_logger().error(problem)
+        """Make the status ERROR with ``problem``: logged and reported at once, when it is new."""
+        if problem == self._problem:
+            return  # e.g. every message that cannot be planned: once, not at the input's rate
         self._problem = problem
+        self._host.get_logger().error(problem)
         self._host.publish_diagnostics()
 
     def _on_description(self, message: String) -> None:
