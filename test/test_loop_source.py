@@ -23,6 +23,10 @@ from std_msgs.msg import String
 from test_sources import configuration, FakeHost, FakeLogger, START_NS
 
 KNEE = ROBOTS['four_bar_knee'].urdf()
+# the parallelogram's coupler joint also mimics the crank
+MIMIC = ROBOTS['parallelogram'].urdf().replace(
+    '<axis xyz="0.0 0.0 -1.0"/>',
+    '<axis xyz="0.0 0.0 -1.0"/><mimic joint="crank_joint" multiplier="1.0"/>', 1)
 PERIOD_NS = 10_000_000
 
 
@@ -153,3 +157,14 @@ def test_descriptions_from_the_topic_are_read_afresh_and_bad_ones_reported() -> 
     host.subscriptions['robot_description'](String(data=KNEE))
     assert node_status(host, source).level is Level.OK
     assert outputs.logged.count('robot') == 2
+
+
+def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None:
+    host = LoopsHost(robot_description=MIMIC)
+    source = RobotLoopsSubscription(host, FakeOutputs(), ClosedRobot(MIMIC, host.config))
+    source.start()
+    message = JointState(name=['crank_joint'], position=[0.1])
+    host.subscriptions['measured_joint_states'](serialize_message(message))
+    assert ('log warning', "joint 'coupler_joint' (constraint 'follower_pin') is solved by its "
+            "loop but also mimics 'crank_joint': robot_state_publisher would pose it from two "
+            'sources') in host.record

@@ -20,7 +20,6 @@ import math
 from typing import Any, Callable, Protocol
 
 from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.loops import mimic_warnings
 from linkage_kinematics.model.robot_transforms import RobotTransforms, UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
@@ -160,7 +159,7 @@ class RobotLoopsSubscription:
         logger = self._host.get_logger()
         logger.info(f"measured joints {', '.join(plan.measured)}; publishing "
                     + ', '.join(plan.passive))
-        for warning in mimic_warnings(self._robot.follower.loops.loops, plan.measured):
+        for warning in plan.warnings:  # passive loop joints that also mimic
             logger.warning(warning)
 
     def _report(self, problem: str) -> None:
