@@ -286,6 +286,21 @@ def test_the_excavator_from_the_parameter_with_estimated_velocities(context, nod
     assert_matches_the_reference(node, urdf, EXCAVATOR.passive_joints, fed)
 
 
+@pytest.mark.parametrize('robot_name', ['slider_crank', 'balancer', 'parallelogram'])
+def test_the_other_test_robots_close_through_the_node(context, nodes, tmp_path, robot_name):
+    """A slider-crank, a balancer cylinder and a parallelogram: each matches the reference."""
+    robot = ROBOTS[robot_name]
+    urdf = robot.urdf()
+    with loop_node(context, nodes, tmp_path,
+                   {'robot_description': urdf, 'log.enabled': False}) as node:
+        fed = follow_sweep(node, robot_name, 7, dict.fromkeys(robot.measured_joints, 0.4))
+        node.status('robot loops', lambda status: values(status).get(
+            'valid samples') == str(len(fed)))
+        assert nodes.interrupt(node.process) == 0
+        node.listener.drain()
+    assert_matches_the_reference(node, urdf, robot.passive_joints, fed)
+
+
 def test_bad_samples_are_dropped_and_counted_per_loop(context, nodes, tmp_path):
     """Missing, NaN, old, unreachable: dropped, counted for the loops they concern, no NaN out."""
     names = list(EXCAVATOR.measured_joints)  # boom, stick, bucket cylinders
