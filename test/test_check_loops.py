@@ -70,6 +70,19 @@ def test_a_pin_split_in_depth_closes_in_the_plane(tmp_path: Path) -> None:
             in completed.stdout.splitlines())
 
 
+def test_a_zero_pose_that_is_not_assembled_is_warned_about(tmp_path: Path) -> None:
+    """The rocker's pin frame 2 cm off in the plane: the zero-pose branch may be the wrong one."""
+    urdf = four_bar().replace('<child_origin xyz="0 1.5 0"/>', '<child_origin xyz="0.02 1.5 0"/>')
+    completed = run(write(tmp_path, urdf))
+    assert completed.returncode == 0, completed.stderr  # a warning, not a problem
+    assert completed.stderr.splitlines() == [
+        "linkage-check-loops: warning: constraint 'pin': the zero pose is not assembled (its "
+        'pin is 0.02 m open in the plane), so the assembly branch taken there may not be the '
+        "robot's; check it, and give the node loops.branches if it is not"]
+    assembled = run(write(tmp_path, four_bar()))
+    assert (assembled.returncode, assembled.stderr) == (0, '')
+
+
 def test_standard_input_and_measured_joints(tmp_path: Path) -> None:
     completed = run('-', '--measured', 'knee_front', stdin=ROBOTS['four_bar_knee'].urdf())
     assert completed.returncode == 0, completed.stderr

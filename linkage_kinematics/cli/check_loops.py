@@ -31,6 +31,7 @@ from linkage_kinematics.model.loops import (
     mimic_warnings,
     RobotLoops,
     zero_pose_branch,
+    zero_pose_warnings,
 )
 
 PROGRAM = 'linkage-check-loops'
@@ -175,7 +176,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     else:
         print('\n'.join(report(loops, plan)))
     warnings = (plan.warnings if plan is not None
-                else mimic_warnings(loops.loops, arguments.measured or ()))
+                else zero_pose_warnings(loops.loops) + mimic_warnings(loops.loops, ()))
     for message in loops.parser_messages:
         print(f'{PROGRAM}: note: urdf_parser_py: {message}', file=sys.stderr)
     for message in warnings:

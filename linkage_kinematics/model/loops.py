@@ -36,6 +36,9 @@ from linkage_kinematics.model.loop_geometry import derive_loop, Loop, LoopJoint
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 
 BRANCHES = (-1, 1)
+# A pin open by more than this fraction of the loop's longest link at the zero pose: not an
+# assembled pose (an exporter's rounding is some 1e-16 of it, six printed digits 1e-6).
+ASSEMBLED_TOLERANCE = 1e-5
 
 
 class LoopSampleError(ValueError):
@@ -88,6 +91,22 @@ def zero_pose_branch(loop: Loop, known: LoopJoint) -> int:
     except (DeadPointError, UnreachableError, GeometryError) as error:
         raise LoopError(f'constraint {loop.constraint!r}: no assembly branch at the zero pose '
                         f'with {known.name!r} known: {error}') from None
+
+
+def zero_pose_warnings(loops: Sequence[Loop]) -> tuple[str, ...]:
+    """
+    Return a warning for each loop whose zero pose is not assembled.
+
+    Its assembly branch at the zero pose (the default) is then only the nearer of the two,
+    which may not be the one the robot is built in.
+    """
+    return tuple(
+        f'constraint {loop.constraint!r}: the zero pose is not assembled (its pin is '
+        f'{loop.planar.closure_gap:.3g} m open in the plane), so the assembly branch taken there '
+        "may not be the robot's; check it, and give the node loops.branches if it is not"
+        for loop in loops
+        if loop.planar.closure_gap > ASSEMBLED_TOLERANCE * max(
+            math.hypot(*link) for link in loop.planar.links))
 
 
 def mimic_warnings(loops: Sequence[Loop], known: Collection[str]) -> tuple[str, ...]:
@@ -159,7 +178,8 @@ class RobotLoops:
                      'measured or solved by another loop' for loop in remaining]
         if problems:
             raise LoopError('\n'.join(problems))
-        return LoopPlan(tuple(ordered), tuple(measured), mimic_warnings(self.loops, measured))
+        return LoopPlan(tuple(ordered), tuple(measured),
+                        zero_pose_warnings(self.loops) + mimic_warnings(self.loops, measured))
 
 
 def find_loops(urdf: str) -> RobotLoops:
