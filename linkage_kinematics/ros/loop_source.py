@@ -159,7 +159,7 @@ class RobotLoopsSubscription:
         logger = self._host.get_logger()
         logger.info(f"measured joints {', '.join(plan.measured)}; publishing "
                     + ', '.join(plan.passive))
-        for warning in plan.warnings:  # passive loop joints that also mimic
+        for warning in plan.warnings:  # zero poses not assembled, passive joints that mimic
             logger.warning(warning)
 
     def _report(self, problem: str) -> None:
