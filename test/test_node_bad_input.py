@@ -54,7 +54,7 @@ DEFAULTS = {spec.name: spec.default for spec in parameter_specs('paper')}
 
 BAD_CLASSES = ('wrong type', 'bool', 'nan', '+inf', '-inf', 'zero', 'negative', 'huge', '-huge')
 # A value of the wrong type, by the type of the parameter's default.
-WRONG_TYPE = {float: 'fast', int: 'fast', str: 1.5, bool: 'true'}
+WRONG_TYPE = {float: 'fast', int: 'fast', str: 1.5, bool: 'true', list: 'fast'}
 # Where -1 is not the telling negative value: one that is valid for the parameter.
 NEGATIVE = {'alpha_start': -0.01, 'alpha_end': -0.01, 'omega0': -1.0, 'ground_y': -0.1}
 # Other values under which a parameter's case is judged (a clockwise drive needs a lower end).
@@ -99,6 +99,10 @@ ACCEPTED = {
     'measured.timeout': set(),               # in (0, 3600] s
     'measured.max_jump': set(),              # in (0, π] rad
     'measured.acceleration_time_constant': {'zero'},  # 0 is the raw difference
+    'loops': set(),
+    'loops.measured_joints': set(),          # a list of strings
+    'loops.branches': set(),
+    'robot_description': set(),              # any string, '' for the topic
     'autostart': set(),
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).

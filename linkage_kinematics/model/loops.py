@@ -38,7 +38,15 @@ BRANCHES = (-1, 1)
 
 
 class LoopSampleError(ValueError):
-    """A sample the loops cannot be closed at (a dead point, out of reach, a missing joint)."""
+    """
+    A sample the loops cannot be closed at (a dead point, out of reach, a missing joint).
+
+    ``constraint`` names the loop that could not be closed (None: the sample itself is bad).
+    """
+
+    def __init__(self, message: str, constraint: str | None = None) -> None:
+        super().__init__(message)
+        self.constraint = constraint
 
 
 @dataclass(frozen=True)
@@ -223,7 +231,8 @@ class LoopSolver:
                                    branch)
             except (DeadPointError, UnreachableError) as error:
                 raise LoopSampleError(f'constraint {constraint!r} at {known.name} = '
-                                      f'{values[known.name]:.9g}: {error}') from None
+                                      f'{values[known.name]:.9g}: {error}',
+                                      constraint) from None
             known_values[constraint], branches[constraint] = value, state.branch
             for joint in planned.passive:
                 position = joint.sign * state.coordinates[joint.index]

@@ -26,6 +26,7 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.ros.exit_codes import ExitCode
+from linkage_kinematics.ros.loop_source import robot_from_parameter, RobotLoopsSubscription
 from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
 from linkage_kinematics.ros.parameters import (
     add_ranges,
@@ -42,6 +43,7 @@ from linkage_kinematics.ros.sources import (
 from linkage_kinematics.run.configuration import (
     build_configuration,
     ConfigurationError,
+    LoopsSource,
     NODE_NAME,
     RunConfiguration,
     SourceKind,
@@ -99,6 +101,9 @@ class LinkageNode(RunStatus, Node):
         self._status_schedule = StatusSchedule()
         self._placement = CpuPlacement()
         self._place(config.cpu_affinity)
+        loops = config.loops is LoopsSource.ROBOT_DESCRIPTION
+        # A description given as a parameter is read before anything is published or written.
+        robot = robot_from_parameter(config) if loops else None
         self.outputs = NodeOutputs(self, config, self.parameter_values(),
                                    self._placement.bag_writer_cpus)
         if self.outputs.recorder is not None:
@@ -109,9 +114,13 @@ class LinkageNode(RunStatus, Node):
         self.add_pre_set_parameters_callback(keep_declared_types)
         self.add_on_set_parameters_callback(self._validate_change)
         self.add_post_set_parameters_callback(self._apply_change)
-        self._source: Source = (
-            MeasuredSubscription(self) if config.source is SourceKind.MEASURED
-            else DriveLawTimer(self))
+        self._source: Source
+        if loops:
+            self._source = RobotLoopsSubscription(self, self.outputs, robot)
+        elif config.source is SourceKind.MEASURED:
+            self._source = MeasuredSubscription(self)
+        else:
+            self._source = DriveLawTimer(self)
         for name, act in (('pause', self._source.pause), ('resume', self._source.resume),
                           ('reset', self._source.reset)):
             self.create_service(Trigger, f'~/{name}', self._answer(act))
@@ -267,7 +276,7 @@ class LinkageNode(RunStatus, Node):
         self._rate_meter.update(now_ns)
         self._status_schedule.sent(at_ns)
         recorder = self.outputs.recorder
-        level, text, values = report(StatusInputs(
+        inputs = StatusInputs(
             config=self.config,
             run_state=self.control.state,
             state=self._state,
@@ -279,7 +288,12 @@ class LinkageNode(RunStatus, Node):
             problem=event or self.problem or self.outputs.recording_error,
             health=self._source.health,
             now_ns=now_ns,
-        ))
+        )
+        statuses = self._source.statuses(inputs)
+        if statuses is not None:
+            self.outputs.publish_statuses(at_ns, statuses)
+            return
+        level, text, values = report(inputs)
         self.outputs.publish_diagnostics(at_ns, level, text, values)
 
 

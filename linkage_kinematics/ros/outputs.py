@@ -26,8 +26,14 @@ from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros import messages
-from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration, SourceKind
+from linkage_kinematics.run.configuration import (
+    ConfigurationError,
+    LoopsSource,
+    RunConfiguration,
+    SourceKind,
+)
 from linkage_kinematics.run.diagnostics import Level
+from linkage_kinematics.run.loop_diagnostics import Status
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -50,6 +56,11 @@ TF_STATIC_QOS = QoSProfile(
 ROBOT_DESCRIPTION_QOS = QoSProfile(
     depth=1, durability=DurabilityPolicy.TRANSIENT_LOCAL, reliability=ReliabilityPolicy.RELIABLE
 )
+# The measured input: deep enough that a burst of encoder samples waiting for one slow callback
+# is never lost.
+MEASURED_QOS = QoSProfile(depth=100)
+MEASURED_TOPIC = 'measured_joint_states'
+ROBOT_DESCRIPTION_TOPIC = 'robot_description'
 
 
 class StartupError(Exception):
@@ -60,10 +71,12 @@ class Publishers(NamedTuple):
     """The node's publishers by what they carry, in the order they are made and recorded."""
 
     joint_states: Publisher
-    state: Publisher
-    markers: Publisher
+    # None with loops robot_description: they describe the node's own four-bar
+    state: Publisher | None
+    markers: Publisher | None
     diagnostics: Publisher
-    robot_description: Publisher | None  # None with publish_robot_description false
+    # None with publish_robot_description false, and with loops robot_description
+    robot_description: Publisher | None
 
     def present(self) -> tuple[Publisher, ...]:
         """Return the publishers the node has, in order."""
@@ -85,15 +98,21 @@ class NodeOutputs:
                  bag_writer_cpus: set[int] | None) -> None:
         self._node = node
         self.config = config
+        four_bar = config.loops is LoopsSource.PARAMETERS
         self._publishers = Publishers(
             joint_states=node.create_publisher(JointState, 'joint_states', DATA_QOS),
-            state=node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS),
-            markers=node.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS),
+            state=(node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS)
+                   if four_bar else None),
+            markers=(node.create_publisher(MarkerArray, 'linkage/markers', DATA_QOS)
+                     if four_bar else None),
             diagnostics=node.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
             robot_description=(
-                node.create_publisher(String, 'robot_description', ROBOT_DESCRIPTION_QOS)
-                if config.publish_robot_description else None),
+                node.create_publisher(String, ROBOT_DESCRIPTION_TOPIC, ROBOT_DESCRIPTION_QOS)
+                if config.publish_robot_description and four_bar else None),
         )
+        # loops robot_description: the input and the lab's description are logged too
+        self.input_topic = node.resolve_topic_name(MEASURED_TOPIC)
+        self.description_topic = node.resolve_topic_name(ROBOT_DESCRIPTION_TOPIC)
         self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
         self._encoded: FourBar | None = None
@@ -120,6 +139,11 @@ class NodeOutputs:
         # and the TF robot_state_publisher would publish, logged only (docs/logging.md)
         topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
+        if self.config.loops is LoopsSource.ROBOT_DESCRIPTION:
+            topics.append((self.description_topic, String, ROBOT_DESCRIPTION_QOS, None))
+            # Heard on the topic the node publishes to, the input goes to that topic's record.
+            if self.input_topic != self._publishers.joint_states.topic_name:
+                topics.append((self.input_topic, JointState, MEASURED_QOS, None))
         try:
             return Recorder(
                 self.config.log_folder, topics=topics, metadata=metadata, cpus=cpus,
@@ -190,7 +214,7 @@ class NodeOutputs:
         """
         config = self.config
         described = (config.linkage, config.joints)
-        if self._described == described:
+        if self._described == described or config.loops is LoopsSource.ROBOT_DESCRIPTION:
             return
         self._described = described
         text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
@@ -201,6 +225,44 @@ class NodeOutputs:
             self._robot_transforms = messages.RobotStateTransforms(text, config.frame_prefix)
             self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(stamp_ns),
                          stamp_ns)
+
+    # loops robot_description: the lab's description, its closed loops and their input
+
+    def publish_joint_states(self, names: tuple[str, ...], positions: tuple[float, ...],
+                             velocities: tuple[float, ...], stamp_ns: int) -> None:
+        """Publish (and log) one ``joint_states`` message of ``names``, stamped ``stamp_ns``."""
+        message = JointState(name=list(names), position=list(positions),
+                             velocity=list(velocities))
+        message.header.stamp = Time(sec=stamp_ns // 1_000_000_000,
+                                    nanosec=stamp_ns % 1_000_000_000)
+        self.send(self._publishers.joint_states, encode_cdr(message), stamp_ns)
+
+    def record_input(self, data: bytes, stamp_ns: int) -> None:
+        """Log one input message's bytes as received, at its stamp."""
+        self._record(self.input_topic, data, stamp_ns)
+
+    def record_robot(self, urdf: str, transforms: messages.RobotStateTransforms,
+                     stamp_ns: int) -> None:
+        """Log a lab's description and its /tf_static; its /tf goes with each state (record_tf)."""
+        self._robot_transforms = transforms
+        self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
+        self._record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
+
+    def record_tf(self, positions: dict[str, float], stamp_ns: int) -> None:
+        """Log the /tf robot_state_publisher would publish at ``positions`` (joint → value)."""
+        if self.recorder is not None and self._robot_transforms is not None:
+            self._record(TF_TOPIC, self._robot_transforms.message(positions, stamp_ns), stamp_ns)
+
+    def publish_statuses(self, stamp_ns: int, statuses: tuple[Status, ...]) -> None:
+        """Publish several statuses in one array, each named '<node>: <task>'."""
+        stamp = Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000)
+        arrays = [messages.diagnostic_array(stamp, f'{self._node.get_name()}: {status.task}',
+                                            status.hardware_id, bytes([status.level]),
+                                            status.message, status.values)
+                  for status in statuses]
+        message = arrays[0]
+        message.status = [status for array in arrays for status in array.status]
+        self.send(self._publishers.diagnostics, encode_cdr(message), stamp_ns)
 
     def publish_diagnostics(self, stamp_ns: int, level: Level, text: str,
                             values: dict[str, str]) -> None:

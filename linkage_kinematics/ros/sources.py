@@ -20,9 +20,11 @@ from typing import Any, Protocol
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import Link
 from linkage_kinematics.ros.exit_codes import ExitCode
+from linkage_kinematics.ros.outputs import MEASURED_QOS, MEASURED_TOPIC
 from linkage_kinematics.run.configuration import EndBehavior, RunConfiguration
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
-from linkage_kinematics.run.diagnostics import MeasuredHealth
+from linkage_kinematics.run.diagnostics import MeasuredHealth, StatusInputs
+from linkage_kinematics.run.loop_diagnostics import Status
 from linkage_kinematics.run.measured import MeasuredFollower, Rejection
 from linkage_kinematics.run.motion import (
     dead_point_problem,
@@ -32,9 +34,6 @@ from linkage_kinematics.run.motion import (
 )
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
-
-# Deep enough that a burst of encoder samples waiting for one slow callback is never lost.
-MEASURED_QOS = QoSProfile(depth=100)
 
 
 class Source(Protocol):
@@ -69,6 +68,9 @@ class Source(Protocol):
 
     def reset(self) -> ServiceAnswer:
         """Act on ``~/reset``."""
+
+    def statuses(self, inputs: StatusInputs) -> tuple[Status, ...] | None:
+        """Return the source's own statuses; None: the four-bar's (``diagnostics.report``)."""
 
 
 class SourceTimer(Protocol):
@@ -222,6 +224,11 @@ class DriveLawTimer:
         """Return the deadlines missed since the start (``DriveLawRun``)."""
         return self.run.missed_deadlines
 
+    @staticmethod
+    def statuses(_inputs: StatusInputs) -> None:
+        """Return None: the drive law's status is the four-bar's (``diagnostics.report``)."""
+        return None
+
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration; the motion changes at ``restart``."""
         self.run.config = new
@@ -349,7 +356,7 @@ class MeasuredSubscription:
             f'paused: {self._driver_name} is not followed until ~/resume' if host.control.paused
             else f'waiting for {self._driver_name} on measured_joint_states')
         host.create_subscription(
-            JointState, 'measured_joint_states', self._on_message, MEASURED_QOS)
+            JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS)
         self._freshness_timer = host.create_timer(0.25 * config.measured_timeout,
                                                   self._check_freshness)
 
@@ -357,6 +364,11 @@ class MeasuredSubscription:
         """Publish the URDF (before the first sample, for robot_state_publisher) and status."""
         self._host.publish_description()
         self._host.publish_diagnostics()
+
+    @staticmethod
+    def statuses(_inputs: StatusInputs) -> None:
+        """Return None: the measured four-bar's status is ``diagnostics.report``'s."""
+        return None
 
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: thresholds, and the lab's names and mapping."""

@@ -36,6 +36,7 @@ from linkage_kinematics.run.limits import MIN_PASS_DURATION
 from linkage_kinematics.run.parameter_specs import (
     EndBehavior,
     Kind,
+    LoopsSource,
     MotionMode,
     NODE_NAME,
     ParameterSpec,
@@ -110,6 +111,12 @@ class RunConfiguration:
     measured_timeout: float
     max_jump: float
     acceleration_time_constant: float
+    # loops robot_description: the measured joints (empty: those of the first message), each
+    # constraint's assembly branch override (name, ±1), and the URDF ('': from the topic)
+    loops: LoopsSource
+    loop_measured_joints: tuple[str, ...]
+    loop_branches: tuple[tuple[str, int], ...]
+    robot_description: str
     autostart: bool
     direction: int
     segment_end: float
@@ -204,6 +211,19 @@ def _choice(spec: ParameterSpec, value: object) -> StrEnum:
     return choices(value)
 
 
+def _texts(spec: ParameterSpec, value: object) -> list[str]:
+    # rclpy declares an empty list default as an empty byte array: both are an empty list here.
+    if not isinstance(value, (list, tuple)) or not all(isinstance(item, str) for item in value):
+        raise ConfigurationError(
+            spec.name, f'must be a list of strings, got {describe_value(value)}')
+    if '' in value:
+        raise ConfigurationError(spec.name, 'must not hold an empty string')
+    duplicates = sorted({item for item in value if value.count(item) > 1})
+    if duplicates:
+        raise ConfigurationError(spec.name, f'names {duplicates} more than once')
+    return list(value)
+
+
 _CHECKS = {
     Kind.REAL: _real,
     Kind.INTEGER: _integer,
@@ -211,6 +231,7 @@ _CHECKS = {
     Kind.FLAG: _flag,
     Kind.TEXT: _text,
     Kind.CHOICE: _choice,
+    Kind.TEXTS: _texts,
 }
 
 
@@ -258,6 +279,35 @@ def _joints(checked: Mapping[str, Any]) -> JointMap:
             'joints.crank.name, joints.coupler.name, joints.rocker.name',
             f"the three joint names must differ, got {', '.join(names)}")
     return joints
+
+
+def _loop_branches(entries: list[str]) -> tuple[tuple[str, int], ...]:
+    """Return ``loops.branches`` as (constraint, ±1) pairs."""
+    branches = []
+    for entry in entries:
+        name, _, value = entry.rpartition('=')
+        if not name or value not in ('1', '-1', '+1'):
+            raise ConfigurationError(
+                'loops.branches', f'entry {entry!r} is not CONSTRAINT=1 or CONSTRAINT=-1')
+        branches.append((name, int(value)))
+    names = [name for name, _ in branches]
+    if len(set(names)) < len(names):
+        raise ConfigurationError('loops.branches', 'gives a constraint more than one branch')
+    return tuple(branches)
+
+
+def _check_loops(checked: Mapping[str, Any]) -> None:
+    """Refuse loop settings that the chosen ``loops`` and ``source`` do not use."""
+    if checked['loops'] is LoopsSource.ROBOT_DESCRIPTION:
+        if checked['source'] is not SourceKind.MEASURED:
+            raise ConfigurationError(
+                'loops', 'robot_description closes the loops of measured joints: it needs '
+                f"source measured, got source {checked['source'].value}")
+        return
+    for name in ('loops.measured_joints', 'loops.branches'):
+        if checked[name]:
+            raise ConfigurationError(
+                name, f"is used only with loops robot_description, got loops {checked['loops']}")
 
 
 def _motion(
@@ -335,6 +385,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     preset_name, linkage = _geometry(values)
     checked = {name: parameter_value(values, name) for name in SPECS}
     joints = _joints(checked)
+    _check_loops(checked)
     drive = DriveLaw(checked['omega0'], checked['k'])
     blocked_at, segment_duration, segment_end, step_count = _pass(checked, linkage, drive)
     alpha_start, alpha_end = checked['alpha_start'], checked['alpha_end']
@@ -368,6 +419,10 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
         measured_timeout=checked['measured.timeout'],
         max_jump=checked['measured.max_jump'],
         acceleration_time_constant=checked['measured.acceleration_time_constant'],
+        loops=checked['loops'],
+        loop_measured_joints=tuple(checked['loops.measured_joints']),
+        loop_branches=_loop_branches(checked['loops.branches']),
+        robot_description=checked['robot_description'],
         autostart=checked['autostart'],
         direction=1 if segment_end > alpha_start else -1,
         segment_end=segment_end,

@@ -67,6 +67,23 @@ class Estimate(StrEnum):
     FIRST_SAMPLE = 'estimated (0: first sample without velocity)'
 
 
+def joint_velocity(stamp_ns: int, value: float, measured: float | None,
+                   last: tuple[int, float] | None) -> tuple[float, Estimate]:
+    """
+    Return a measured joint's velocity at ``value`` (stamp ``stamp_ns``) and how it was obtained.
+
+    ``measured`` when the message carries it; else the backward difference from ``last``
+    (its stamp in ns and its value, unwrapped to ``value``'s turn) over the header stamps, and 0
+    for a first sample (``last`` None).
+    """
+    if measured is not None:
+        return measured, Estimate.MEASURED
+    if last is None:
+        return 0.0, Estimate.FIRST_SAMPLE
+    last_stamp_ns, last_value = last
+    return (value - last_value) / ((stamp_ns - last_stamp_ns) * 1e-9), Estimate.BACKWARD_DIFFERENCE
+
+
 @dataclass(frozen=True)
 class FollowedSample:
     """
@@ -166,14 +183,10 @@ class MeasuredFollower:
     ) -> tuple[float, float, Estimate]:
         """Return the driver's ω and ω̇ (node convention) and how ω was obtained."""
         last = self._last
-        if measured_velocity is not None:
-            omega = self._mapping.direction * measured_velocity
-            estimate = Estimate.MEASURED
-        elif last is None:
-            omega, estimate = 0.0, Estimate.FIRST_SAMPLE
-        else:
-            omega = (angle - last.angle) / ((stamp_ns - last.stamp_ns) * 1e-9)
-            estimate = Estimate.BACKWARD_DIFFERENCE
+        omega, estimate = joint_velocity(
+            stamp_ns, angle,
+            None if measured_velocity is None else self._mapping.direction * measured_velocity,
+            None if last is None else (last.stamp_ns, last.angle))
         if last is None:
             return omega, 0.0, estimate
         interval = (stamp_ns - last.stamp_ns) * 1e-9

@@ -8,8 +8,9 @@ Pure, no ROS: one small function per group of parameters (geometry, motion, outp
 measured input and joints), in the order the node declares them. Each spec says what a value
 must be (its kind, unit, range, the choices of a closed set) once: ``configuration`` checks
 values against it and ``ros.parameters`` turns it into the ROS descriptor. The closed sets of
-values (``EndBehavior``, ``MotionMode``, ``SourceKind``) are defined here, with the parameters they
-are the values of, so that ``configuration`` imports this module and not the other way round.
+values (``EndBehavior``, ``MotionMode``, ``SourceKind``, ``LoopsSource``) are defined here, with
+the parameters they are the values of, so that ``configuration`` imports this module and not the
+other way round.
 """
 
 from __future__ import annotations
@@ -66,6 +67,13 @@ class SourceKind(StrEnum):
     MEASURED = 'measured'  # the driver joint of each measured_joint_states message
 
 
+class LoopsSource(StrEnum):
+    """Which loops the measured source closes: parameter ``loops``, by its value."""
+
+    PARAMETERS = 'parameters'  # the node's own four-bar, from the geometry parameters
+    ROBOT_DESCRIPTION = 'robot_description'  # every <constraint> loop of a lab's URDF
+
+
 class Kind(Enum):
     """What a parameter's values are, and so how ``configuration`` checks one."""
 
@@ -75,6 +83,7 @@ class Kind(Enum):
     FLAG = 'flag'  # true or false
     TEXT = 'text'  # a string, empty only where ``allow_empty``
     CHOICE = 'choice'  # a string, one of the values of the enum ``choices``
+    TEXTS = 'texts'  # a list of non-empty strings, possibly empty
 
 
 @dataclass(frozen=True)
@@ -319,6 +328,28 @@ def _measured_specs() -> tuple[ParameterSpec, ...]:
     )
 
 
+def _loop_specs() -> tuple[ParameterSpec, ...]:
+    """Return which loops the measured source closes, and how (README, Closing a robot's loops)."""
+    return (
+        ParameterSpec('loops', LoopsSource.PARAMETERS.value,
+                      'parameters: the four-bar of the geometry parameters; robot_description: '
+                      "every <constraint> loop of the robot's URDF (source measured only)",
+                      Kind.CHOICE, read_only=True, choices=LoopsSource),
+        ParameterSpec('loops.measured_joints', [],
+                      'with loops robot_description: the measured joints; empty: the loop '
+                      'joints the first measured_joint_states message carries',
+                      Kind.TEXTS, read_only=True),
+        ParameterSpec('loops.branches', [],
+                      'with loops robot_description: CONSTRAINT=1 or CONSTRAINT=-1, the assembly '
+                      "branch of that constraint's loop; by default the zero pose's",
+                      Kind.TEXTS, read_only=True),
+        ParameterSpec('robot_description', '',
+                      "with loops robot_description: the robot's URDF (as robot_state_publisher's "
+                      "parameter); '': from the robot_description topic",
+                      Kind.TEXT, read_only=True, allow_empty=True),
+    )
+
+
 def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
     """All parameters; the geometry defaults come from ``preset_name`` ('' → no defaults)."""
     return (
@@ -328,6 +359,7 @@ def parameter_specs(preset_name: str) -> tuple[ParameterSpec, ...]:
         *_logging_specs(),
         *_joint_specs(),
         *_measured_specs(),
+        *_loop_specs(),
         ParameterSpec('autostart', True,
                       'start the motion at once; false: publish the scene at alpha_start, the '
                       'URDF and the status, then wait for ~/resume',

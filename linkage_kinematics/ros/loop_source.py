@@ -1,0 +1,306 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The measured source of ``loops:=robot_description``: every loop of a lab's URDF, closed on ROS.
+
+``RobotLoopsSubscription`` is a ``Source``: it reads the robot description (the parameter
+``robot_description``, or the relative ``robot_description`` topic as robot_state_publisher
+publishes it), feeds each ``measured_joint_states`` message to a ``run.robot_loops``
+``RobotLoopsFollower`` and publishes the passive loop joints it solves on ``joint_states``,
+stamped as the input. The node publishes no URDF, ``linkage/state`` or markers of its own
+then: those describe its own four-bar. Its bag holds the input, the completed joint states,
+the description and the /tf robot_state_publisher would publish for the whole robot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+import math
+from typing import Any, Callable, Protocol
+
+from linkage_kinematics.model.loop_urdf import LoopError
+from linkage_kinematics.model.robot_transforms import RobotTransforms, UrdfError
+from linkage_kinematics.ros.messages import RobotStateTransforms
+from linkage_kinematics.ros.outputs import (
+    MEASURED_QOS,
+    MEASURED_TOPIC,
+    NodeOutputs,
+    ROBOT_DESCRIPTION_QOS,
+    ROBOT_DESCRIPTION_TOPIC,
+    StartupError,
+)
+from linkage_kinematics.ros.sources import SourceHost
+from linkage_kinematics.run.configuration import RunConfiguration
+from linkage_kinematics.run.control import ServiceAnswer
+from linkage_kinematics.run.diagnostics import RateMeter, StatusInputs, StatusSchedule
+from linkage_kinematics.run.loop_diagnostics import (
+    loop_statuses,
+    LoopsHealth,
+    LoopsView,
+    Status,
+)
+from linkage_kinematics.run.robot_loops import (
+    LoopDrop,
+    LoopRejection,
+    read_loops,
+    RobotLoopsFollower,
+)
+from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+
+
+class LoopsHost(SourceHost, Protocol):
+    """What this source asks of the node beyond ``SourceHost``: its logger, raw subscriptions."""
+
+    def get_logger(self) -> Any:
+        """Return the node's logger."""
+
+    def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
+                            qos_profile: Any, *, raw: bool = False) -> object:
+        """Subscribe ``callback`` to ``topic``; ``raw``: it receives the message's bytes."""
+
+
+class ClosedRobot:
+    """A robot description whose loops close: its follower and robot_state_publisher's TF."""
+
+    def __init__(self, urdf: str, config: RunConfiguration) -> None:
+        """Read ``urdf``; LoopError or UrdfError, one line naming the problem, if it cannot."""
+        loops = read_loops(urdf)
+        self.urdf = urdf
+        self.follower = RobotLoopsFollower(loops, config.loop_measured_joints,
+                                           dict(config.loop_branches), config.max_jump)
+        self.transforms = RobotStateTransforms(urdf, config.frame_prefix)
+        # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
+        self.tree_joints = tuple(name for name, joint in RobotTransforms(urdf).joints.items()
+                                 if joint.movable and joint.mimic is None)
+
+
+def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
+    """
+    Return the robot of the ``robot_description`` parameter, None when it is empty (the topic).
+
+    Raises StartupError, one line naming the problem, for a description that cannot be closed.
+    """
+    if not config.robot_description:
+        return None
+    try:
+        return ClosedRobot(config.robot_description, config)
+    except (LoopError, UrdfError) as error:
+        raise StartupError('cannot close the loops of parameter robot_description: '
+                           + str(error).replace('\n', '; ')) from None
+
+
+class RobotLoopsSubscription:
+    """The source of ``loops:=robot_description``: descriptions and measured joints in."""
+
+    missed_deadlines = 0  # no deadlines: the input sets the pace
+    health = None  # no four-bar: its statuses are this source's own (``statuses``)
+
+    def __init__(self, host: LoopsHost, outputs: NodeOutputs, robot: ClosedRobot | None) -> None:
+        self._host = host
+        self._outputs = outputs
+        self._robot: ClosedRobot | None = None
+        self._loops_health = LoopsHealth(host.now_ns())
+        self._rate_meter = RateMeter()
+        self._schedule = StatusSchedule()
+        self._problem: str | None = None
+        self._input_positions: dict[str, float] = {}  # joints outside the loops, as last heard
+        self.stale = False
+        self._following = False  # a message of this motion followed since the last start
+        self._description_from = f'topic {outputs.description_topic}'
+        if robot is not None:
+            self._description_from = 'parameter robot_description'
+            self._take(robot)
+        else:
+            host.create_subscription(String, ROBOT_DESCRIPTION_TOPIC, self._on_description,
+                                     ROBOT_DESCRIPTION_QOS)
+        host.create_subscription(JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS,
+                                 raw=True)
+        self._freshness_timer = host.create_timer(0.25 * host.config.measured_timeout,
+                                                  self._check_freshness)
+        self._show_activity()
+
+    def start(self) -> None:
+        """Publish the first status (the description's, and what the node waits for)."""
+        self._host.publish_diagnostics()
+
+    def _show_activity(self) -> None:
+        host, robot = self._host, self._robot
+        if host.control.paused:
+            activity = 'paused: the measured joints are not followed until ~/resume'
+        elif robot is None:
+            activity = f'waiting for the robot description on {self._description_from}'
+        elif robot.follower.plan is None or not self._following:
+            joints = ('the loop joints' if robot.follower.plan is None
+                      else ', '.join(robot.follower.plan.measured))
+            activity = f'waiting for {joints} on {self._outputs.input_topic}'
+        else:
+            activity = 'following ' + ', '.join(robot.follower.plan.measured)
+        host.set_activity(activity)
+
+    def _take(self, robot: ClosedRobot) -> None:
+        """Follow ``robot`` from now on, and log it with its /tf_static."""
+        self._robot = robot
+        self._problem = None
+        self._following = False
+        self._outputs.record_robot(robot.urdf, robot.transforms, self._host.now_ns())
+        loops = robot.follower.loops
+        self._host.get_logger().info(
+            f'closing the loops of robot {loops.robot_name!r}: constraints '
+            + ', '.join(loop.constraint for loop in loops.loops))
+        if robot.follower.plan is not None:
+            self._planned()
+
+    def _planned(self) -> None:
+        """Say which joints the loops are closed from, and warn of passive mimic joints."""
+        plan = self._robot.follower.plan
+        logger = self._host.get_logger()
+        logger.info(f"measured joints {', '.join(plan.measured)}; publishing "
+                    + ', '.join(plan.passive))
+        for warning in plan.warnings:  # passive loop joints that also mimic
+            logger.warning(warning)
+
+    def _report(self, problem: str) -> None:
+        """Make the status ERROR with ``problem``: logged and reported at once, when it is new."""
+        if problem == self._problem:
+            return  # e.g. every message that cannot be planned: once, not at the input's rate
+        self._problem = problem
+        self._host.get_logger().error(problem)
+        self._host.publish_diagnostics()
+
+    def _on_description(self, message: String) -> None:
+        """Read a description afresh; one that cannot be closed leaves the last one followed."""
+        try:
+            robot = ClosedRobot(message.data, self._host.config)
+        except (LoopError, UrdfError) as error:
+            self._report(f'cannot close the loops of the robot description on '
+                         f'{self._outputs.description_topic}: '
+                         + str(error).replace('\n', '; '))
+            return
+        self._take(robot)
+        self._show_activity()
+        self._host.publish_diagnostics()
+
+    def statuses(self, inputs: StatusInputs) -> tuple[Status, ...]:
+        """Return the node's status and one per loop (``loop_diagnostics``)."""
+        robot = self._robot
+        self._rate_meter.update(inputs.now_ns)
+        return loop_statuses(
+            replace(inputs, problem=inputs.problem or self._problem,
+                    achieved_rate=self._rate_meter.rate),
+            LoopsView(robot_name=None if robot is None else robot.follower.loops.robot_name,
+                      description_from=self._description_from,
+                      plan=None if robot is None else robot.follower.plan,
+                      health=self._loops_health))
+
+    def reconfigure(self, new: RunConfiguration) -> None:
+        """Take the node's new configuration: the thresholds (timeout, jump)."""
+        if self._robot is not None:
+            self._robot.follower.max_jump = new.max_jump
+        self._host.destroy_timer(self._freshness_timer)
+        self._freshness_timer = self._host.create_timer(0.25 * new.measured_timeout,
+                                                        self._check_freshness)
+
+    def restart(self) -> None:
+        """Forget the motion: the next valid message starts it afresh on the planned branches."""
+        self._following = False
+        if self._robot is not None:
+            self._robot.follower.restart()
+
+    # ~/pause, ~/resume, ~/reset
+
+    def pause(self) -> ServiceAnswer:
+        """Ignore the input until ~/resume."""
+        host = self._host
+        if not host.control.pause(None, None).success:
+            return ServiceAnswer(False, 'already paused; ~/resume goes on')
+        self._show_activity()
+        host.publish_diagnostics()
+        return ServiceAnswer(True, 'paused: the measured joints are ignored')
+
+    def resume(self) -> ServiceAnswer:
+        """Follow again from the next message, the motion started afresh."""
+        host = self._host
+        answer, _ = host.control.resume()
+        if not answer.success:
+            return answer
+        # What the mechanism did meanwhile is unknown: its next sample starts the motion afresh.
+        self.restart()
+        self._show_activity()
+        host.publish_diagnostics()
+        return ServiceAnswer(True, 'following the measured joints again from their next sample')
+
+    def reset(self) -> ServiceAnswer:
+        """Start the motion afresh at the next valid message."""
+        self.restart()
+        paused = self._host.control.paused
+        return ServiceAnswer(True, 'the motion starts afresh at the next valid sample' + (
+            '; paused: ~/resume follows it' if paused else ''))
+
+    def _on_message(self, data: bytes) -> None:
+        host = self._host
+        if host.control.paused:
+            return  # ~/pause: not followed, not counted
+        message = deserialize_message(data, JointState)
+        stamp = message.header.stamp
+        stamp_ns = stamp.sec * 1_000_000_000 + stamp.nanosec
+        robot = self._robot
+        if robot is None:
+            self._outputs.record_input(data, stamp_ns)
+            self._loops_health.drop(LoopDrop(LoopRejection.NO_DESCRIPTION, (), ''))
+            return
+        follower = robot.follower
+        planned = follower.plan is not None
+        try:
+            followed = follower.follow(stamp_ns, message.name, message.position,
+                                       message.velocity)
+        except LoopError as error:
+            self._outputs.record_input(data, stamp_ns)
+            self._loops_health.drop(LoopDrop(LoopRejection.NOT_PLANNED, (), str(error)))
+            self._report('the measured joints cannot close the loops: '
+                         + str(error).replace('\n', '; '))
+            return
+        if followed is None:
+            return  # none of the measured joints: e.g. this node's own output, heard back
+        self._outputs.record_input(data, stamp_ns)
+        self._note_other_joints(message, follower)
+        if not planned:
+            self._problem = None
+            self._planned()
+        if isinstance(followed, LoopDrop):
+            self._loops_health.drop(followed)
+            return
+        self._loops_health.accept(host.now_ns(), followed)
+        self._rate_meter.tick()
+        first = not self._following
+        self._following, self.stale = True, False
+        self._outputs.publish_joint_states(followed.names, followed.positions,
+                                           followed.velocities, stamp_ns)
+        # The whole robot as robot_state_publisher would pose it: the loops as closed, every
+        # other joint as the input last gave it (0 before that).
+        self._outputs.record_tf(
+            {name: followed.joints.get(name, self._input_positions.get(name, 0.0))
+             for name in robot.tree_joints}, stamp_ns)
+        if first:
+            self._show_activity()
+        if self._schedule.due(stamp_ns) or first:
+            self._schedule.sent(stamp_ns)
+            host.publish_diagnostics(at_ns=stamp_ns)
+
+    def _note_other_joints(self, message: JointState, follower: RobotLoopsFollower) -> None:
+        """Keep the input's last finite value of each joint outside the loops (for /tf)."""
+        loop_joints = follower.loop_joints
+        for name, position in zip(message.name, message.position):
+            if name not in loop_joints and math.isfinite(position):
+                self._input_positions[name] = position
+
+    def _check_freshness(self) -> None:
+        """Report at once when the measured data goes stale."""
+        host = self._host
+        if not self.stale and self._loops_health.is_stale(host.now_ns(),
+                                                          host.config.measured_timeout):
+            self.stale = True
+            self.restart()  # a long gap: the next valid message starts afresh
+            host.publish_diagnostics()

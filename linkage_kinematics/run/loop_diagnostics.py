@@ -1,0 +1,244 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+What the node's diagnostics say with ``loops:=robot_description``, without ROS.
+
+``LoopsHealth`` is the source's record: dropped messages by reason, overall and per loop, the
+time since the last valid one, and how each measured joint's velocity was obtained.
+``loop_statuses`` turns it, with the ``StatusInputs`` the node has at that moment, into the
+node's status (waiting for the description or the input, following, problems) and one status
+per loop (its kind, its known joint, what is estimated, its drops, the distance of its known
+joint to its nearest dead point), in ``diagnostics``' style.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import math
+
+from linkage_kinematics.kinematics.planar_loop import JointKind
+from linkage_kinematics.model.loops import LoopPlan, PlannedLoop
+from linkage_kinematics.run.diagnostics import Level, LOG_DISABLED, NOT_MEASURED, StatusInputs
+from linkage_kinematics.run.measured import Estimate
+from linkage_kinematics.run.robot_loops import (
+    dead_point_distances,
+    LoopDrop,
+    LoopRejection,
+    LoopSample,
+)
+
+NODE_TASK = 'robot loops'
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic_msgs/DiagnosticStatus: its task (after the node's name) and content."""
+
+    task: str
+    hardware_id: str
+    level: Level
+    message: str
+    values: dict[str, str]
+
+
+def _counts() -> dict[LoopRejection, int]:
+    return dict.fromkeys(LoopRejection, 0)
+
+
+def _dropped(count: int, reason: LoopRejection) -> str:
+    return f'dropped {count} message{"s" if count > 1 else ""} {reason.value}'
+
+
+class LoopsHealth:
+    """
+    Dropped messages by reason (overall and per loop), and how fresh the data is.
+
+    Drops since the previous status make the node's status (and the loops they concern) WARN;
+    no valid message for ``measured.timeout`` (node clock) makes the node's status ERROR.
+    """
+
+    def __init__(self, start_ns: int) -> None:
+        self.totals = _counts()
+        self._window = _counts()
+        self.per_loop: dict[str, dict[LoopRejection, int]] = {}
+        self._loop_window: dict[str, dict[LoopRejection, int]] = {}
+        self.accepted = 0
+        self.last_valid_ns: int | None = None
+        self._start_ns = start_ns
+        self.last: LoopSample | None = None
+
+    def drop(self, drop: LoopDrop) -> None:
+        """Count a dropped message, for the node and for each loop it concerned."""
+        self.totals[drop.reason] += 1
+        self._window[drop.reason] += 1
+        for constraint in drop.constraints:
+            for counts in (self.per_loop, self._loop_window):
+                counts.setdefault(constraint, _counts())[drop.reason] += 1
+
+    def accept(self, now_ns: int, sample: LoopSample) -> None:
+        """Note a message followed at node-clock time ``now_ns``."""
+        self.accepted += 1
+        self.last_valid_ns = now_ns
+        self.last = sample
+
+    def is_stale(self, now_ns: int, timeout: float) -> bool:
+        """Whether no valid message came for ``timeout`` seconds (since the start, at first)."""
+        since = self.last_valid_ns if self.last_valid_ns is not None else self._start_ns
+        return (now_ns - since) * 1e-9 > timeout
+
+    def problem(self, now_ns: int, timeout: float) -> str | None:
+        """Return the ERROR message when the data is stale, else None."""
+        if not self.is_stale(now_ns, timeout):
+            return None
+        if self.last_valid_ns is None:
+            return f'no valid measured sample received yet (timeout {timeout:g} s)'
+        age = (now_ns - self.last_valid_ns) * 1e-9
+        return f'no valid measured sample for {age:.3f} s (timeout {timeout:g} s)'
+
+    def take_warnings(self) -> tuple[tuple[str, ...], dict[str, tuple[str, ...]]]:
+        """Return the drops since the last call (the node's, each loop's) and start anew."""
+        node = tuple(_dropped(count, reason) for reason, count in self._window.items() if count)
+        loops = {constraint: tuple(_dropped(count, reason)
+                                   for reason, count in counts.items() if count)
+                 for constraint, counts in self._loop_window.items()}
+        self._window, self._loop_window = _counts(), {}
+        return node, loops
+
+
+@dataclass(frozen=True, kw_only=True)
+class LoopsView:
+    """What the source knows beyond ``StatusInputs``: its robot, plan and health."""
+
+    robot_name: str | None  # None: no description closed yet
+    description_from: str  # 'parameter robot_description' or the topic's resolved name
+    plan: LoopPlan | None
+    health: LoopsHealth
+
+
+def _estimated_joints(plan: LoopPlan, sample: LoopSample | None) -> set[str]:
+    """Return the joints whose velocity is an estimate: unmeasured ones, and what they drive."""
+    if sample is None:
+        return set()
+    estimated = {name for name, how in sample.estimates.items() if how is not Estimate.MEASURED}
+    for planned in plan.loops:  # in solve order, so a loop's known joint is settled before it
+        if planned.known.name in estimated:
+            estimated.update(joint.name for joint in planned.passive)
+    return estimated
+
+
+def _value_text(planned: PlannedLoop, value: float | None) -> str:
+    if value is None:
+        return 'none (no dead point)'
+    if planned.known.kind is JointKind.REVOLUTE:
+        return f'{math.degrees(value):.6f} deg'
+    return f'{value:.9f} m'
+
+
+def _loop_status(inputs: StatusInputs, view: LoopsView, planned: PlannedLoop,
+                 solver_of: dict[str, str], warnings: tuple[str, ...]) -> Status:
+    """Return one loop's status."""
+    constraint, known = planned.loop.constraint, planned.known
+    health, sample = view.health, view.health.last
+    prismatic = planned.loop.prismatic
+    estimated = _estimated_joints(view.plan, sample)
+    distance = None
+    if sample is not None:
+        distance = dead_point_distances(view.plan, sample.known_values).get(constraint)
+    values = {
+        'kind': ('four-bar' if prismatic is None
+                 else f'one prismatic joint ({prismatic.name})'),
+        'known joint': (f'{known.name} (measured)' if planned.measured
+                        else f'{known.name} (solved by loop {solver_of[known.name]})'),
+        'solves': ', '.join(joint.name for joint in planned.passive),
+        'branch': f'{planned.branch:+d}',
+        'estimated': (
+            'none' if sample is None or known.name not in estimated
+            else 'velocities of ' + ', '.join(joint.name for joint in planned.passive)
+            + f' (from an estimated velocity of {known.name})'),
+        'dead point distance': ('not followed yet' if sample is None
+                                else _value_text(planned, distance)),
+    }
+    counts = health.per_loop.get(constraint, _counts())
+    values['dropped samples'] = str(sum(counts.values()))
+    values.update({f'dropped {reason.value}': str(count) for reason, count in counts.items()
+                   if reason is not LoopRejection.NO_DESCRIPTION})
+    notes = list(warnings)
+    if (distance is not None and known.kind is JointKind.REVOLUTE
+            and distance < inputs.config.dead_point_warning):
+        notes.append(f'{known.name} is {math.degrees(distance):.3f}° from a dead point')
+    if notes:
+        level, message = Level.WARN, '; '.join(notes)
+    elif sample is None:
+        level, message = Level.OK, f'waiting for {known.name}'
+    else:
+        level, message = Level.OK, f'closed from {known.name}'
+    return Status(f'loop {constraint}', f'robot {view.robot_name}', level, message, values)
+
+
+def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
+    """Return the node's status's key values."""
+    health, plan = view.health, view.plan
+    values = {
+        'source': 'measured',
+        'loops': 'robot_description',
+        'robot': 'not received yet' if view.robot_name is None else view.robot_name,
+        'description from': view.description_from,
+        'measured joints': ('not known yet' if plan is None else ', '.join(plan.measured)),
+        'passive joints': ('not known yet' if plan is None else ', '.join(plan.passive)),
+        'valid samples': str(health.accepted),
+        'dropped samples': str(sum(health.totals.values())),
+    }
+    values.update({f'dropped {reason.value}': str(count)
+                   for reason, count in health.totals.items()})
+    values['last valid sample age (s)'] = (
+        'none yet' if health.last_valid_ns is None
+        else f'{(inputs.now_ns - health.last_valid_ns) * 1e-9:.3f}')
+    sample = health.last
+    estimated = [] if sample is None else [
+        f'{name} velocity ({how.value})'
+        for name, how in sample.estimates.items() if how is not Estimate.MEASURED]
+    values['measured'] = ('every measured joint position' + (
+        ', every measured joint velocity' if sample is not None and not estimated else ''))
+    values['exact functions of the measured'] = 'every passive position, and velocities ' \
+        'of measured velocities'
+    values['estimated'] = ', '.join(estimated) + (
+        ' and the velocities solved from them' if estimated else 'none')
+    values['achieved rate (Hz)'] = (
+        NOT_MEASURED if inputs.achieved_rate is None else f'{inputs.achieved_rate:.1f}')
+    if inputs.log_file is not None and inputs.log_size is not None:
+        values['log size (bytes)'] = str(int(inputs.log_size))
+    values['log file'] = LOG_DISABLED if inputs.log_file is None else inputs.log_file
+    values['run state'] = inputs.run_state.value
+    return values
+
+
+def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
+    """
+    Return the node's status and one per loop (README, Diagnostics).
+
+    The node's: ERROR for ``inputs.problem`` (a description that cannot be closed, the log
+    failed) or stale data, WARN for drops since the last status, else OK with the activity.
+    """
+    health = view.health
+    node_warnings, loop_warnings = health.take_warnings()
+    stale = health.problem(inputs.now_ns, inputs.config.measured_timeout)
+    if stale is not None and inputs.activity.startswith('waiting'):
+        stale = f'{stale}; {inputs.activity}'  # say what the node still waits for
+    problem = inputs.problem or stale
+    if problem is not None:
+        level, message = Level.ERROR, problem
+    elif node_warnings:
+        level, message = Level.WARN, '; '.join(node_warnings)
+    else:
+        level, message = Level.OK, inputs.activity
+    hardware_id = ('robot description not received yet' if view.robot_name is None
+                   else f'robot {view.robot_name}')
+    statuses = [Status(NODE_TASK, hardware_id, level, message, _node_values(inputs, view))]
+    if view.plan is not None:
+        solver_of = {joint.name: planned.loop.constraint
+                     for planned in view.plan.loops for joint in planned.passive}
+        statuses += [_loop_status(inputs, view, planned, solver_of,
+                                  loop_warnings.get(planned.loop.constraint, ()))
+                     for planned in view.plan.loops]
+    return tuple(statuses)

@@ -1,0 +1,205 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The measured source of ``loops:=robot_description``: a robot's loops closed message by message.
+
+``RobotLoopsFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
+positions, velocities), picks the measured joints by name and closes every ``<constraint>``
+loop of the robot's URDF from them (``model.loops``: ``find_loops``, ``RobotLoops.plan``,
+``LoopSolver``). It returns a ``LoopSample``, the passive loop joints' positions and velocities
+(URDF units, rad or m), or a ``LoopDrop``, why the message was dropped and which loops it
+concerned. A measured joint without a velocity gets the measured mode's estimate
+(``measured.joint_velocity``: the backward difference over the header stamps, 0 for a first
+sample). A revolute measured joint is unwrapped across turns, as the measured mode's driver is,
+and ``measured.max_jump`` (rad) applies to it; a prismatic one's length (m) has no such bound.
+No ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from enum import StrEnum
+import math
+
+from linkage_kinematics.kinematics.geometry import TWO_PI
+from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
+from linkage_kinematics.model.loop_urdf import LoopError
+from linkage_kinematics.model.loops import (
+    find_loops,
+    LoopPlan,
+    LoopSampleError,
+    LoopSolver,
+    RobotLoops,
+)
+from linkage_kinematics.run.measured import Estimate, joint_velocity
+
+
+class LoopRejection(StrEnum):
+    """Why an input message was dropped (the text names it in diagnostics)."""
+
+    NO_DESCRIPTION = 'before the robot description was closed'
+    NOT_PLANNED = 'while the measured joints cannot close the loops'
+    NO_JOINT = 'without every measured joint'
+    NON_FINITE = 'with a NaN or infinite position or velocity'
+    STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
+    UNREACHABLE = 'at joint values a loop cannot reach (or at a dead point)'
+    JUMP = 'jumping further than measured.max_jump'
+
+
+@dataclass(frozen=True)
+class LoopDrop:
+    """A dropped message: why, the loops it concerned (none: every loop) and the detail."""
+
+    reason: LoopRejection
+    constraints: tuple[str, ...]
+    detail: str
+
+
+@dataclass(frozen=True)
+class LoopSample:
+    """
+    The passive loop joints at one message, in solve order, and what came with them.
+
+    ``joints`` holds every measured and solved loop joint's position (for /tf);
+    ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
+    loop's known joint value (URDF units), by constraint.
+    """
+
+    stamp_ns: int
+    names: tuple[str, ...]
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    joints: dict[str, float]
+    estimates: dict[str, Estimate]
+    known_values: dict[str, float]
+
+
+def read_loops(urdf: str) -> RobotLoops:
+    """
+    Return a robot description's loops; LoopError, one line, if any cannot be closed.
+
+    The line names every problem (the parser's, each constraint's); a robot without any
+    ``<constraint>`` is refused too: there is nothing to close.
+    """
+    loops = find_loops(urdf)
+    if loops.problems:
+        raise LoopError('; '.join(loops.problems))
+    if not loops.loops:
+        raise LoopError(f'robot {loops.robot_name!r} has no <constraint> loop to close')
+    return loops
+
+
+class RobotLoopsFollower:
+    """
+    Follows the measured joints of one robot description; ``restart`` forgets the motion.
+
+    Construction raises LoopError (one line per problem, naming the joints or constraints)
+    when ``measured`` is given and cannot close the loops; with ``measured`` empty the loop
+    joints the first message carries are planned then (``follow`` raises LoopError then).
+    """
+
+    def __init__(self, loops: RobotLoops, measured: Sequence[str],
+                 branches: Mapping[str, int], max_jump: float) -> None:
+        self.loops = loops
+        self.max_jump = max_jump
+        self._branches = dict(branches)
+        self.loop_joints = frozenset(name for loop in loops.loops for name in loop.names)
+        self.solver: LoopSolver | None = None
+        if measured:
+            self._plan(tuple(measured))
+        self.restart()
+
+    @property
+    def plan(self) -> LoopPlan | None:
+        """Return the loops in solve order, None until the measured joints are known."""
+        return None if self.solver is None else self.solver.plan
+
+    def _plan(self, measured: tuple[str, ...]) -> None:
+        plan = self.loops.plan(measured, self._branches)
+        self.solver = LoopSolver(plan)
+        self._revolute = frozenset(
+            planned.known.name for planned in plan.loops
+            if planned.measured and planned.known.kind is JointKind.REVOLUTE)
+        self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
+                                   if planned.known.name == name) for name in measured}
+
+    def restart(self) -> None:
+        """Forget the motion: the next valid message starts it again on the planned branches."""
+        self._last_stamp_ns: int | None = None
+        self._last: dict[str, float] = {}  # measured joint → its last value used, unwrapped
+        if self.solver is not None:
+            self.solver.reset()
+
+    def _loops_of(self, names: Sequence[str]) -> tuple[str, ...]:
+        """Return the loops whose known joint is one of the measured joints ``names``."""
+        return tuple(constraint for name in names for constraint in self._feeds[name])
+
+    def follow(self, stamp_ns: int, names: Sequence[str], positions: Sequence[float],
+               velocities: Sequence[float]) -> LoopSample | LoopDrop | None:
+        """
+        Return the passive loop joints at one message, or why it was dropped.
+
+        None for a message that carries none of the measured joints (with none given, none of
+        the loop joints), e.g. this node's own output heard back: ignored, not counted.
+        """
+        index = {name: i for i, name in enumerate(names)}
+        if self.solver is None:
+            carried = tuple(name for name in names if name in self.loop_joints)
+            if not carried:
+                return None
+            self._plan(carried)
+        measured = self.solver.plan.measured
+        if not any(name in index for name in measured):
+            return None
+        missing = [name for name in measured
+                   if name not in index or index[name] >= len(positions)]
+        if missing:
+            return LoopDrop(LoopRejection.NO_JOINT, self._loops_of(missing),
+                            f'no position of {missing}')
+        values = {name: positions[index[name]] for name in measured}
+        given = {name: velocities[index[name]] for name in measured
+                 if index[name] < len(velocities)}
+        bad = [name for name in measured if not math.isfinite(values[name])
+               or not math.isfinite(given.get(name, 0.0))]
+        if bad:
+            return LoopDrop(LoopRejection.NON_FINITE, self._loops_of(bad),
+                            f'{bad} not finite')
+        if self._last_stamp_ns is not None and stamp_ns <= self._last_stamp_ns:
+            return LoopDrop(LoopRejection.STAMP_NOT_NEWER, (), 'stamp not newer')
+        for name in self._revolute & self._last.keys():
+            # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are counted.
+            last = self._last[name]
+            values[name] += round((last - values[name]) / TWO_PI) * TWO_PI
+        jumps = [name for name in self._revolute & self._last.keys()
+                 if abs(values[name] - self._last[name]) > self.max_jump]
+        if jumps:
+            return LoopDrop(LoopRejection.JUMP, self._loops_of(jumps), f'{jumps} jumped')
+        rates, estimates = {}, {}
+        for name in measured:
+            last = None if name not in self._last else (self._last_stamp_ns, self._last[name])
+            rates[name], estimates[name] = joint_velocity(stamp_ns, values[name],
+                                                          given.get(name), last)
+        try:
+            solved, solved_rates = self.solver.solve(values, rates)
+        except LoopSampleError as error:
+            return LoopDrop(LoopRejection.UNREACHABLE,
+                            () if error.constraint is None else (error.constraint,), str(error))
+        self._last_stamp_ns, self._last = stamp_ns, values
+        joints = {**values, **solved}
+        return LoopSample(
+            stamp_ns, tuple(solved), tuple(solved.values()), tuple(solved_rates.values()),
+            joints, estimates,
+            {planned.loop.constraint: joints[planned.known.name]
+             for planned in self.solver.plan.loops})
+
+
+def dead_point_distances(plan: LoopPlan,
+                         known_values: Mapping[str, float]) -> dict[str, float | None]:
+    """Return each loop's distance (rad or m) from its known joint to its nearest dead point."""
+    return {
+        planned.loop.constraint: known_joint_range(
+            planned.loop.planar, planned.known.index).dead_point_distance(
+                planned.known.sign * known_values[planned.loop.constraint])
+        for planned in plan.loops if planned.loop.constraint in known_values}

@@ -1,0 +1,170 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+ros.loop_source's source, hosted by test_sources' fake host: ~/pause, ~/resume, ~/reset, timeout.
+
+What crosses DDS is test_robot_loops.py's; here the order of services and messages is the
+test's own, so that a paused message is known to have come while paused.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable
+
+from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription
+from linkage_kinematics.run.control import RunState
+from linkage_kinematics.run.diagnostics import Level, StatusInputs
+from linkage_kinematics.run.measured import Estimate
+from loop_robots import ROBOTS
+from rclpy.serialization import serialize_message
+from sensor_msgs.msg import JointState
+from std_msgs.msg import String
+from test_sources import configuration, FakeHost, FakeLogger, START_NS
+
+KNEE = ROBOTS['four_bar_knee'].urdf()
+# the parallelogram's coupler joint also mimics the crank
+MIMIC = ROBOTS['parallelogram'].urdf().replace(
+    '<axis xyz="0.0 0.0 -1.0"/>',
+    '<axis xyz="0.0 0.0 -1.0"/><mimic joint="crank_joint" multiplier="1.0"/>', 1)
+PERIOD_NS = 10_000_000
+
+
+class LoopsLogger(FakeLogger):
+    def warning(self, text: str) -> None:
+        self._record.append(('log warning', text))
+
+
+class LoopsHost(FakeHost):
+    """The fake host, with raw subscriptions and a logger that also warns."""
+
+    def __init__(self, **overrides: Any) -> None:
+        super().__init__(configuration(**{'source': 'measured', 'loops': 'robot_description',
+                                          **overrides}))
+        self._logger = LoopsLogger(self.record)
+
+    def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
+                            qos_profile: object, *, raw: bool = False) -> object:
+        return super().create_subscription(msg_type, topic, callback, qos_profile)
+
+
+class FakeOutputs:
+    """Records what the source publishes and logs."""
+
+    input_topic = '/measured_joint_states'
+    description_topic = '/robot_description'
+
+    def __init__(self) -> None:
+        self.joint_states: list[tuple] = []
+        self.logged: list[str] = []
+
+    def publish_joint_states(self, names, positions, velocities, stamp_ns) -> None:
+        self.joint_states.append((stamp_ns, dict(zip(names, positions))))
+
+    def record_input(self, data: bytes, stamp_ns: int) -> None:
+        self.logged.append('input')
+
+    def record_robot(self, urdf, transforms, stamp_ns) -> None:
+        self.logged.append('robot')
+
+    def record_tf(self, positions, stamp_ns) -> None:
+        self.logged.append('tf')
+
+
+def hosted(from_parameter: bool = True
+           ) -> tuple[LoopsHost, FakeOutputs, RobotLoopsSubscription]:
+    host = LoopsHost(**({'robot_description': KNEE} if from_parameter else {}))
+    outputs = FakeOutputs()
+    robot = ClosedRobot(KNEE, host.config) if from_parameter else None
+    source = RobotLoopsSubscription(host, outputs, robot)
+    source.start()
+    return host, outputs, source
+
+
+def send(host: LoopsHost, stamp: int, angle: float) -> None:
+    message = JointState(name=['knee_front'], position=[angle])
+    message.header.stamp.sec, message.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
+    host.subscriptions['measured_joint_states'](serialize_message(message))
+
+
+def node_status(host: LoopsHost, source: RobotLoopsSubscription) -> Any:
+    inputs = StatusInputs(config=host.config, run_state=host.control.state, state=None,
+                          activity=host.activity, achieved_rate=None, missed_deadlines=0,
+                          log_file=None, log_size=None, now_ns=host.clock_ns)
+    return source.statuses(inputs)[0]
+
+
+def test_pause_ignores_the_input_and_resume_follows_again_afresh() -> None:
+    host, outputs, source = hosted()
+    send(host, START_NS, 0.1)
+    assert source.pause().success
+    assert host.control.state is RunState.PAUSED
+    send(host, START_NS + PERIOD_NS, 0.2)  # ignored, not counted
+    assert [stamp for stamp, _ in outputs.joint_states] == [START_NS]
+    assert not source.pause().success
+    assert source.resume().success
+    send(host, START_NS + 2 * PERIOD_NS, 0.3)
+    assert [stamp for stamp, _ in outputs.joint_states] == [START_NS, START_NS + 2 * PERIOD_NS]
+    status = node_status(host, source)
+    assert (status.values['valid samples'], status.values['dropped samples']) == ('2', '0')
+    # afresh: the first sample after ~/resume has no previous one to difference
+    assert 'estimated (0: first sample without velocity)' in status.values['estimated']
+
+
+def test_reset_starts_afresh_and_stale_data_is_an_error() -> None:
+    host, outputs, source = hosted()
+    send(host, START_NS, 0.1)
+    send(host, START_NS + PERIOD_NS, 0.2)
+    assert 'backward difference' in node_status(host, source).values['estimated']
+    assert source.reset().success
+    send(host, START_NS + 2 * PERIOD_NS, 0.25)
+    assert 'first sample' in node_status(host, source).values['estimated']
+    assert source.stale is False
+    host.clock_ns += round(2e9 * host.config.measured_timeout)
+    (freshness,) = host.timers
+    freshness.callback()
+    assert source.stale
+    status = node_status(host, source)
+    assert status.level is Level.ERROR
+    assert status.message.startswith('no valid measured sample for')
+    send(host, START_NS + 3 * PERIOD_NS, 0.3)
+    assert not source.stale
+    assert node_status(host, source).level is Level.OK
+    assert Estimate.FIRST_SAMPLE.value in node_status(host, source).values['estimated']
+
+
+def test_descriptions_from_the_topic_are_read_afresh_and_bad_ones_reported() -> None:
+    host, outputs, source = hosted(from_parameter=False)
+    send(host, START_NS, 0.1)
+    assert outputs.joint_states == []
+    assert host.activity == 'waiting for the robot description on topic /robot_description'
+    status = node_status(host, source)
+    assert status.message == 'dropped 1 message before the robot description was closed'
+    assert status.values['dropped before the robot description was closed'] == '1'
+    assert node_status(host, source).message == host.activity  # the drop was reported once
+    host.subscriptions['robot_description'](String(data=KNEE))
+    send(host, START_NS + PERIOD_NS, 0.1)
+    assert len(outputs.joint_states) == 1
+    plain = '<robot name="r"><link name="a"/></robot>'
+    host.subscriptions['robot_description'](String(data=plain))
+    status = node_status(host, source)
+    assert status.level is Level.ERROR
+    assert status.message == ('cannot close the loops of the robot description on '
+                              "/robot_description: robot 'r' has no <constraint> loop to close")
+    assert ('log error', status.message) in host.record
+    send(host, START_NS + 2 * PERIOD_NS, 0.15)  # the knee is still followed
+    assert len(outputs.joint_states) == 2
+    host.subscriptions['robot_description'](String(data=KNEE))
+    assert node_status(host, source).level is Level.OK
+    assert outputs.logged.count('robot') == 2
+
+
+def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None:
+    host = LoopsHost(robot_description=MIMIC)
+    source = RobotLoopsSubscription(host, FakeOutputs(), ClosedRobot(MIMIC, host.config))
+    source.start()
+    message = JointState(name=['crank_joint'], position=[0.1])
+    host.subscriptions['measured_joint_states'](serialize_message(message))
+    assert ('log warning', "joint 'coupler_joint' (constraint 'follower_pin') is solved by its "
+            "loop but also mimics 'crank_joint': robot_state_publisher would pose it from two "
+            'sources') in host.record
