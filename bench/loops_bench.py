@@ -81,7 +81,7 @@ def run(quick: bool, ros_domain: int) -> str:
             node, seconds, ros_domain + 4, joints,
             {f'{robot}.yaml': yaml.safe_dump(parameters)},
             frozenset(find_loops(urdf).plan(list(measured)).passive))
-        lines += ['', f'**{robot}** ({len(measured)} measured joints, '
-                      f'{len(joints) - len(measured)} other joints in each message)', '',
-                  measured_bench.report(figures)]
+        # the encoder's messages also carry the relay's crank and an unrelated joint
+        lines += ['', f'**{robot}** ({len(measured)} measured of the {len(joints) + 2} joints '
+                      'in each message)', '', measured_bench.report(figures)]
     return '\n'.join(lines)
