@@ -2,14 +2,16 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-A lab's encoder for the measured benchmark: one JointState per millisecond.
+A lab's encoder for the measured benchmarks: one JointState per millisecond.
 
-Usage: python bench/encoder.py OUTPUT.json RATE_HZ SECONDS
+Usage: python bench/encoder.py OUTPUT.json RATE_HZ SECONDS [JOINTS.json]
 
 Publishes on /encoder/joint_states the crank of the Grashof crank-rocker turning at 2 rad/s
 (position wrapped at ±π, as an encoder's, and its velocity) next to an unrelated joint, each
 stamped with the system clock just before it is published, at RATE_HZ on absolute deadlines
-for SECONDS; then writes the stamps it published as JSON.
+for SECONDS; then writes the stamps it published as JSON. JOINTS.json, a map from joint name to
+[low, high] (rad or m), adds those joints to every message, each swinging sinusoidally over its
+range (with its velocity, each in its own phase): a robot's measured joints.
 """
 
 from __future__ import annotations
@@ -24,15 +26,25 @@ from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 
 OMEGA = 2.0  # rad/s
+SWING_HZ = 0.5  # of the added joints: slow, as a leg or a boom moves
 
 
 def main(argv: list[str]) -> int:
     output, rate, seconds = argv[0], float(argv[1]), float(argv[2])
+    ranges: dict[str, list[float]] = {}
+    if len(argv) > 3:
+        with open(argv[3], encoding='utf-8') as file:
+            ranges = json.load(file)
     rclpy.init()
     node = rclpy.create_node('bench_encoder')
     publisher = node.create_publisher(JointState, '/encoder/joint_states', QoSProfile(depth=10))
-    message = JointState(name=['crank_joint', 'gripper_finger'], position=[0.0, 0.0],
-                         velocity=[OMEGA, 0.0])
+    names = ['crank_joint', 'gripper_finger', *ranges]
+    message = JointState(name=names, position=[0.0] * len(names),
+                         velocity=[OMEGA] + [0.0] * (len(names) - 1))
+    # Each added joint's centre, amplitude and phase: the swing stays inside its range.
+    swings = [((low + high) / 2.0, (high - low) / 2.0, 2.0 * math.pi * index / len(ranges))
+              for index, (low, high) in enumerate(ranges.values())]
+    turn = 2.0 * math.pi * SWING_HZ
     period = 1.0 / rate
     count = round(rate * seconds)
     stamps = []
@@ -41,7 +53,11 @@ def main(argv: list[str]) -> int:
         delay = start + index * period - time.monotonic()
         if delay > 0.0:
             time.sleep(delay)
-        message.position[0] = math.remainder(OMEGA * index * period, 2.0 * math.pi)
+        elapsed = index * period
+        message.position[0] = math.remainder(OMEGA * elapsed, 2.0 * math.pi)
+        for joint, (centre, amplitude, phase) in enumerate(swings, start=2):
+            message.position[joint] = centre + amplitude * math.sin(turn * elapsed + phase)
+            message.velocity[joint] = amplitude * turn * math.cos(turn * elapsed + phase)
         stamp = time.time_ns()
         message.header.stamp.sec, message.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
         publisher.publish(message)

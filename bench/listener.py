@@ -9,7 +9,8 @@ Usage: python bench/listener.py OUTPUT.json SECONDS [TOPIC ...]
 Subscribes to /diagnostics and to each TOPIC (sensor_msgs/JointState); once the first message
 of every TOPIC (without TOPICs: of /diagnostics) has arrived (discovery is done), records for
 SECONDS every JointState's header stamp and receive time (system clock, the clock the node
-stamps with) and the key-value pairs of every /diagnostics status; then writes them as JSON.
+stamps with) and the key-value pairs of every /diagnostics status; then writes them, and the
+joint names of each TOPIC's first message, as JSON.
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ def main(argv: list[str]) -> int:
     rclpy.init()
     node = rclpy.create_node('bench_listener')
     received: dict[str, list[tuple[int, int]]] = {topic: [] for topic in topics}
+    # the joint names of each TOPIC's first message, to check what a node publishes
+    names: dict[str, list[str]] = {}
     diagnostics: list[dict[str, str]] = []
     matched: set[str] = set()
     recording = False
@@ -40,6 +43,7 @@ def main(argv: list[str]) -> int:
         def callback(message: JointState) -> None:
             arrival = time.time_ns()
             matched.add(topic)
+            names.setdefault(topic, list(message.name))
             if recording:
                 stamp = message.header.stamp
                 samples.append((stamp.sec * 1_000_000_000 + stamp.nanosec, arrival))
@@ -67,7 +71,7 @@ def main(argv: list[str]) -> int:
     while time.monotonic() < deadline:
         executor.spin_once(timeout_sec=0.05)
     with open(output, 'w', encoding='utf-8') as file:
-        json.dump({'received': received, 'diagnostics': diagnostics}, file)
+        json.dump({'received': received, 'diagnostics': diagnostics, 'names': names}, file)
     node.destroy_node()
     rclpy.try_shutdown()
     return 0

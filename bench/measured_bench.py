@@ -12,6 +12,9 @@ process, receives both outputs. CPU is utime + stime from /proc/PID/stat over th
 window, the node's with its bag writer's; latency is the listener's receipt time minus the
 stamp the encoder gave the sample just before publishing it (both carry the input's stamp);
 samples lost are the encoder's samples within the window that did not arrive.
+
+``follow_side_by_side`` is that run for any node command line (the "loops" section runs the
+node closing a URDF's loops with it), ``report`` its table and the goals.
 """
 
 from __future__ import annotations
@@ -30,8 +33,8 @@ from timing import markdown_table
 
 HERE = pathlib.Path(__file__).resolve().parent
 RATE_HZ = 1000.0
-OUTPUTS = {'linkage_node (measured, logging)': '/completer/joint_states',
-           'minimal rclpy relay': '/relay/joint_states'}
+RELAY = 'minimal rclpy relay'
+RELAY_TOPIC = '/relay/joint_states'
 # The window's edges: samples published this close to its start or end may fall outside it.
 EDGE_S = 0.5
 
@@ -41,36 +44,68 @@ def percentile(values: list[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, round(fraction * (len(ordered) - 1)))]
 
 
-def one_run(seconds: float, domain: int) -> dict[str, dict[str, float]]:
-    """Return per output: CPU share of one core, latency p50 and p99 (s), samples lost."""
+def node_command(namespace: str, folder: str, arguments: list[str]) -> list[str]:
+    """Return linkage_node's command line following the encoder, logging into ``folder``."""
+    return [sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args',
+            '-r', f'__ns:={namespace}', '-r', 'measured_joint_states:=/encoder/joint_states',
+            '-p', 'source:=measured', '-p', f'log.folder:={folder}/bags', *arguments]
+
+
+def follow_side_by_side(
+    node: tuple[str, str, list[str]], seconds: float, domain: int,
+    joints: dict[str, tuple[float, float]] | None = None,
+    files: dict[str, str] | None = None,
+    published: frozenset[str] | None = None,
+) -> dict[str, dict[str, float]]:
+    """
+    Return per follower: CPU share of one core, latency p50 and p99 (s), samples lost.
+
+    ``node`` is (its name in the table, its namespace, its ``--ros-args`` after the measured
+    source's and logging's); the relay follows the same encoder at the same time. ``files``
+    (name → text) are written into the run's folder first, and ``{folder}`` in an argument is
+    that folder. ``joints`` adds a robot's measured joints to the encoder's messages, each
+    swinging over its range. With ``published``, the node's messages must carry exactly those
+    joints: a node that took its parameters otherwise is not what was to be measured.
+    """
+    name, namespace, arguments = node
+    outputs = {name: f'{namespace}/joint_states', RELAY: RELAY_TOPIC}
     environment = node_bench.ros_environment(domain)
     with tempfile.TemporaryDirectory(prefix='linkage_bench_measured_') as folder:
         sent_file = pathlib.Path(folder) / 'sent.json'
-        node = subprocess.Popen(
-            [sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args',
-             '-r', '__ns:=/completer', '-r', 'measured_joint_states:=/encoder/joint_states',
-             '-p', 'source:=measured', '-p', 'preset:=grashof_crank_rocker',
-             '-p', f'log.folder:={folder}/bags'],
-            cwd=node_bench.ROOT, env=environment, stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL)
-        relay = subprocess.Popen([sys.executable, str(HERE / 'minimal_relay.py')],
-                                 cwd=node_bench.ROOT, env=environment,
-                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        processes = {'linkage_node (measured, logging)': node, 'minimal rclpy relay': relay}
+        joints_file = pathlib.Path(folder) / 'joints.json'
+        joints_file.write_text(json.dumps(joints or {}), encoding='utf-8')
+        for file_name, text in (files or {}).items():
+            (pathlib.Path(folder) / file_name).write_text(text, encoding='utf-8')
+        command = node_command(namespace, folder,
+                               [argument.format(folder=folder) for argument in arguments])
+        node_log = pathlib.Path(folder) / 'node.log'
+        with node_log.open('w', encoding='utf-8') as log:
+            node_process = subprocess.Popen(command, cwd=node_bench.ROOT, env=environment,
+                                            stdout=subprocess.DEVNULL, stderr=log)
+        processes = {
+            name: node_process,
+            RELAY: subprocess.Popen([sys.executable, str(HERE / 'minimal_relay.py')],
+                                    cwd=node_bench.ROOT, env=environment,
+                                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL),
+        }
         try:
             time.sleep(node_bench.STARTUP_S)
+            if processes[name].poll() is not None:
+                # a node that refused its parameters: say why rather than time out listening
+                raise RuntimeError(f'{name} exited early: '
+                                   + node_log.read_text(encoding='utf-8')[-2000:])
             encoder = subprocess.Popen(
                 [sys.executable, str(HERE / 'encoder.py'), str(sent_file), f'{RATE_HZ:g}',
-                 f'{seconds + 2.0 * node_bench.STARTUP_S:g}'],
+                 f'{seconds + 2.0 * node_bench.STARTUP_S:g}', str(joints_file)],
                 cwd=node_bench.ROOT, env=environment, stdout=subprocess.DEVNULL,
                 stderr=subprocess.DEVNULL)
-            listener, output = node_bench.listen(seconds, list(OUTPUTS.values()), domain)
+            listener, output = node_bench.listen(seconds, list(outputs.values()), domain)
             # The listener records once it has heard both outputs: CPU within its window.
             time.sleep(1.0)
             started = time.monotonic()
-            before = {name: cpu_seconds(process.pid) for name, process in processes.items()}
+            before = {key: cpu_seconds(process.pid) for key, process in processes.items()}
             time.sleep(seconds - 2.0)
-            after = {name: cpu_seconds(process.pid) for name, process in processes.items()}
+            after = {key: cpu_seconds(process.pid) for key, process in processes.items()}
             elapsed = time.monotonic() - started
             data = node_bench.collect(listener, output)
             encoder.wait(timeout=seconds + 60.0)
@@ -81,17 +116,26 @@ def one_run(seconds: float, domain: int) -> dict[str, dict[str, float]]:
                     process.send_signal(signal.SIGINT)
             for process in processes.values():
                 node_bench.stop(process)
+    shown = data.get('names', {}).get(outputs[name])
+    if published is not None and set(shown or ()) != published:
+        raise RuntimeError(f'{name} published {shown}, not the joints {sorted(published)}')
+    cpu = {key: (after[key] - before[key]) / elapsed for key in processes}
+    return _figures(data['received'], sent, outputs, cpu)
+
+
+def _figures(received: dict[str, list[tuple[int, int]]], sent: list[int],
+             outputs: dict[str, str], cpu: dict[str, float]) -> dict[str, dict[str, float]]:
+    """Return each follower's CPU, latencies and samples lost within the listener's window."""
     figures = {}
-    all_arrivals = [arrival for samples in data['received'].values()
-                    for _, arrival in samples]
+    all_arrivals = [arrival for samples in received.values() for _, arrival in samples]
     window = (min(all_arrivals) + EDGE_S * 1e9, max(all_arrivals) - EDGE_S * 1e9)
     expected = {stamp for stamp in sent if window[0] <= stamp <= window[1]}
-    for name, topic in OUTPUTS.items():
-        samples = data['received'][topic]
+    for name, topic in outputs.items():
+        samples = received[topic]
         latencies = [(arrival - stamp) * 1e-9 for stamp, arrival in samples
                      if stamp in expected]
         figures[name] = {
-            'cpu': (after[name] - before[name]) / elapsed,
+            'cpu': cpu[name],
             'p50': percentile(latencies, 0.5),
             'p99': percentile(latencies, 0.99),
             'missing': expected - {stamp for stamp, _ in samples},
@@ -106,10 +150,8 @@ def one_run(seconds: float, domain: int) -> dict[str, dict[str, float]]:
     return figures
 
 
-def run(quick: bool, ros_domain: int) -> str:
-    """Return the section as markdown (domain ``ros_domain`` + 4)."""
-    seconds = 10.0 if quick else 30.0
-    figures = one_run(seconds, ros_domain + 4)
+def report(figures: dict[str, dict[str, float]]) -> str:
+    """Return the followers' table and the goals: the node's figures against the relay's."""
     rows = [[name, f"{100.0 * value['cpu']:.1f} %", f"{1e3 * value['p50']:.3f} ms",
              f"{1e3 * value['p99']:.3f} ms",
              f"{value['lost']} of {value['expected']} ({value['lost by both']} by both)"]
@@ -122,5 +164,14 @@ def run(quick: bool, ros_domain: int) -> str:
         f"latency node − relay: {1e3 * (node['p99'] - relay['p99']):+.3f} ms (goal ≤ +0.5 ms); "
         f"samples lost by the node: {node['lost']} (goal 0)."
     )
+    return table + '\n' + goals
+
+
+def run(quick: bool, ros_domain: int) -> str:
+    """Return the section as markdown (domain ``ros_domain`` + 4)."""
+    seconds = 10.0 if quick else 30.0
+    node = ('linkage_node (measured, logging)', '/completer',
+            ['-p', 'preset:=grashof_crank_rocker'])
+    figures = follow_side_by_side(node, seconds, ros_domain + 4)
     return (f'encoder at {RATE_HZ:g} Hz for {seconds:g} s, both followers at once, '
-            'latency to a third process\n\n' + table + '\n' + goals)
+            'latency to a third process\n\n' + report(figures))

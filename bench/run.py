@@ -4,12 +4,14 @@
 """
 The benchmark report: ``./dev bench`` (= ``python bench/run.py``) from the repository root.
 
-Sections: kinematics (cost per configuration against error), drive (the drive law in time), tf (one
-state's /tf bytes, prepared against the generic forward kinematics), node (the ROS node's tick,
-rates, jitter, latency and log size), cost (the node's CPU side by side with a minimal hand-written
-rclpy publisher, its highest sustained rate with the default placement and with cpu_affinity:=0)
-and memory (the node's resident memory over a long 1 kHz run). Every section prints markdown tables
-for docs/benchmarks.md; the kinematics section also draws docs/benchmark_speed_error.png.
+Sections: kinematics (cost per configuration against error), drive (the drive law in time),
+tf (one state's /tf bytes, prepared against the generic forward kinematics), node (the ROS node's
+tick, rates, jitter, latency and log size), cost (the node's CPU side by side with a minimal
+hand-written rclpy publisher, its highest sustained rate with the default placement and with
+cpu_affinity:=0), measured and loops (the measured source, and a URDF's four loops closed, each
+against a minimal hand-written rclpy relay) and memory (the node's resident memory over a long
+1 kHz run). Every section prints markdown tables for docs/benchmarks.md; the kinematics section
+also draws docs/benchmark_speed_error.png.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'memory')
+SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'memory')
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -90,6 +92,11 @@ def main(argv: list[str] | None = None) -> int:
 
         print('\n## Measured source against a minimal hand-written relay\n')
         print(measured_bench.run(arguments.quick, arguments.ros_domain))
+    if 'loops' in sections:
+        import loops_bench
+
+        print("\n## A URDF's loops closed, against a minimal hand-written relay\n")
+        print(loops_bench.run(arguments.quick, arguments.ros_domain))
     if 'memory' in sections:
         import node_bench
 
