@@ -263,7 +263,6 @@ def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
     accelerations by more than ``singular_points.RATE_ACCURACY``) and UnreachableError where the
     loop does not close at ``value``. Never returns NaN.
     """
-    _check_known(loop, known)
     return driven_loop(loop, known).solve(value, rate, branch)
 
 
@@ -328,7 +327,6 @@ def continued_branch_of(loop: PlanarLoop, known: int, value_from: float, branch:
     The motion has ``branch`` at ``value_from``; it continues through change points on the smooth
     branch, so the branch flips at each change point passed (``kinematics.continued_branch``).
     """
-    _check_known(loop, known)
     return driven_loop(loop, known).continued_branch(value_from, branch, value_to)
 
 
