@@ -13,15 +13,29 @@ follows ``source:=measured`` with ``loops:=robot_description``, the URDF given a
 the same time and is the baseline. The encoder's messages carry the robot's measured joints
 (each swinging over the range in which its loops close), its hip joints where it has them, and
 the relay's crank.
+
+Before the nodes, ``path_run`` times the node's per-sample loops path in this process on the
+same two robots: ``RobotLoopsFollower.follow`` and the ``joint_states`` bytes through the prepared
+``JointStateEncoder``, against the path before it (test/loops_per_call.py's per-call follower,
+and a rclpy ``JointState`` through ``encode_cdr``), checking that both give the same bytes.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+import math
 import re
 
+from builtin_interfaces.msg import Time
+from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.model.loops import find_loops
+from linkage_kinematics.ros.messages import JointStateEncoder
+from linkage_kinematics.run.robot_loops import LoopSample, read_loops, RobotLoopsFollower
 from loop_robots import excavator, four_bar_knee, ROBOTS
+from loops_per_call import ReferenceFollower
 import measured_bench
+from sensor_msgs.msg import JointState
+from timing import format_seconds, interleaved_medians, markdown_table, paired_ratio
 import yaml
 
 # Each leg's hip on the body: the legs stand apart along x and in depth (z, the knee pins'
@@ -29,6 +43,11 @@ import yaml
 LEGS = {'front_left': (0.3, 0.1), 'front_right': (0.3, -0.1),
         'rear_left': (-0.3, 0.1), 'rear_right': (-0.3, -0.1)}
 KNEE = ROBOTS['four_bar_knee']
+# The ratios are medians of back-to-back pairs of this many samples each (timing.paired_ratio).
+PAIRS = 41
+PAIR_SAMPLES = 100
+STAMP_NS = 1_790_000_000_000_000_000
+PERIOD_NS = 1_000_000
 
 
 def quadruped() -> str:
@@ -85,3 +104,100 @@ def run(quick: bool, ros_domain: int) -> str:
         lines += ['', f'**{robot}** ({len(measured)} measured of the {len(joints) + 2} joints '
                       'in each message)', '', measured_bench.report(figures)]
     return '\n'.join(lines)
+
+
+Message = tuple[int, list[str], list[float], list[float]]
+
+
+def messages(joints: dict[str, tuple[float, float]], count: int) -> list[Message]:
+    """Return ``count`` messages at 1 kHz, each joint swinging over its range, with velocities."""
+    names = list(joints)
+    return [(STAMP_NS + index * PERIOD_NS, names,
+             [low + (high - low) * (0.5 + 0.5 * math.sin(0.01 * index + k))
+              for k, (low, high) in enumerate(joints.values())],
+             [0.5 * math.cos(0.01 * index + k) for k in range(len(names))])
+            for index in range(count)]
+
+
+def encode_before(sample: LoopSample) -> bytes:
+    """Return the output as ``NodeOutputs.publish_joint_states`` encoded it before: encode_cdr."""
+    message = JointState(name=list(sample.names), position=list(sample.positions),
+                         velocity=list(sample.velocities))
+    message.header.stamp = Time(sec=sample.stamp_ns // 1_000_000_000,
+                                nanosec=sample.stamp_ns % 1_000_000_000)
+    return encode_cdr(message)
+
+
+def path_workloads(measured: tuple[str, ...], urdf: str, inputs: list[Message]
+                   ) -> tuple[dict[str, Callable[[], int]], bool]:
+    """
+    Return the workloads (follow, encode and both; before and now) and whether bytes agree.
+
+    Each follow workload restarts its follower first, so that every run follows the same motion.
+    """
+    follower = RobotLoopsFollower(read_loops(urdf), measured, {}, math.pi / 2)
+    reference = ReferenceFollower(follower)
+    now = [follower.follow(*message) for message in inputs]
+    before = [reference.follow(*message) for message in inputs]
+    encoder = JointStateEncoder(now[0].names)
+    identical = all(encoder.encode(new.stamp_ns, new.positions, new.velocities)
+                    == encode_before(old) for new, old in zip(now, before))
+
+    def follow_now() -> int:
+        follower.restart()
+        for message in inputs:
+            follower.follow(*message)
+        return len(inputs)
+
+    def follow_before() -> int:
+        reference.restart()
+        for message in inputs:
+            reference.follow(*message)
+        return len(inputs)
+
+    def encode_now() -> int:
+        for sample in now:
+            encoder.encode(sample.stamp_ns, sample.positions, sample.velocities)
+        return len(now)
+
+    def encode_old() -> int:
+        for sample in before:
+            encode_before(sample)
+        return len(before)
+
+    def both_now() -> int:
+        follower.restart()
+        for message in inputs:
+            sample = follower.follow(*message)
+            encoder.encode(sample.stamp_ns, sample.positions, sample.velocities)
+        return len(inputs)
+
+    def both_before() -> int:
+        reference.restart()
+        for message in inputs:
+            encode_before(reference.follow(*message))
+        return len(inputs)
+
+    return {'follow now': follow_now, 'follow before': follow_before,
+            'encode now': encode_now, 'encode before': encode_old,
+            'both now': both_now, 'both before': both_before}, identical
+
+
+def path_run(quick: bool, repetitions: int) -> str:
+    """Return the in-process table: µs per sample before and now, and now ÷ before."""
+    count = 1_000 if quick else 5_000
+    rows = []
+    for robot, (urdf, joints, measured) in robots().items():
+        workloads, identical = path_workloads(measured, urdf, messages(joints, count))
+        medians = interleaved_medians(workloads, repetitions)
+        pair_inputs = messages(joints, PAIR_SAMPLES)
+        pairs, _ = path_workloads(measured, urdf, pair_inputs)
+        for stage, label in (('follow', 'RobotLoopsFollower.follow'),
+                             ('encode', 'joint_states bytes'), ('both', 'both')):
+            ratio = paired_ratio(pairs[f'{stage} now'], pairs[f'{stage} before'], PAIRS)
+            rows.append([robot, label, format_seconds(medians[f'{stage} before']),
+                         format_seconds(medians[f'{stage} now']), f'{ratio:.2f}×',
+                         'yes' if identical else '**no**'])
+    return markdown_table(
+        ['robot', 'per sample', 'per-call path (before)', 'prepared path (now)',
+         f'now ÷ before (median of {PAIRS} back-to-back pairs)', 'bytes identical'], rows)

@@ -95,6 +95,8 @@ def main(argv: list[str] | None = None) -> int:
     if 'loops' in sections:
         import loops_bench
 
+        print("\n## A URDF's loops closed: the per-sample path in this process\n")
+        print(loops_bench.path_run(arguments.quick, repetitions))
         print("\n## A URDF's loops closed, against a minimal hand-written relay\n")
         print(loops_bench.run(arguments.quick, arguments.ros_domain))
     if 'memory' in sections:

@@ -45,8 +45,8 @@ from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
 from linkage_kinematics.kinematics.solver import DeadPointError, solve
 
 __all__ = [
-    'branch_of', 'continued_branch_of', 'joint_points', 'JointKind', 'known_joint_range',
-    'KnownJointRange', 'LoopState', 'PlanarLoop', 'solve_loop',
+    'branch_of', 'continued_branch_of', 'driven_loop', 'DrivenLoop', 'joint_points', 'JointKind',
+    'known_joint_range', 'KnownJointRange', 'LoopState', 'PlanarLoop', 'solve_loop',
 ]
 
 # |slide| must be 1 to this relative tolerance (a unit vector written as floats).
@@ -188,6 +188,71 @@ def _prismatic(loop: PlanarLoop, known: int) -> PrismaticLoop:
     return PrismaticLoop(loop.links, loop.slide, loop.prismatic, known)
 
 
+class DrivenLoop:
+    """
+    A loop driven at one known joint, its constants resolved once (``driven_loop``).
+
+    ``solve`` and ``continued_branch`` are ``solve_loop``'s and ``continued_branch_of``'s
+    work for that joint: a caller that solves the same loop sample after sample (``LoopSolver``)
+    keeps one, instead of looking the loop's four-bar or prismatic closed form up by the
+    loop's hash at every call.
+    """
+
+    def __init__(self, loop: PlanarLoop, known: int) -> None:
+        _check_known(loop, known)
+        self.known = known
+        self._prismatic = None if loop.prismatic is None else _prismatic(loop, known)
+        if self._prismatic is None:
+            self._linkage = _four_bar(loop, known)
+            links = loop.links
+            # The FourBar's frame is body known − 1's turned by arg(links[known]) + π/2.
+            self._turn = _angle(links[known]) + 0.5 * math.pi
+            self._coupler_angle = _angle(links[(known + 1) % 4])
+            self._rocker_angle = _angle(links[(known + 2) % 4])
+
+    def solve(self, value: float, rate: float, branch: int) -> LoopState:
+        """Return the loop's state as ``solve_loop`` does, for this loop and known joint."""
+        known = self.known
+        if branch != 1 and branch != -1:
+            check_branch(branch)
+        if not math.isfinite(value) or not math.isfinite(rate):
+            raise UnreachableError(f'joint {known}: value and rate must be finite, got '
+                                   f'{value!r}, {rate!r}')
+        if self._prismatic is not None:
+            coordinates, rates = self._prismatic.solve(value, rate, branch)
+            return LoopState(coordinates, rates, branch)
+        try:
+            state = solve(self._linkage, value, CrankRates(rate, 0.0), branch)
+        except (DeadPointError, UnreachableError) as error:
+            raise type(error)(f'joint {known}: {error}') from None
+        turn = self._turn
+        coupler = state.gamma + turn - self._coupler_angle  # θ_{k+1} − θ_{k−1}
+        rocker = -state.beta + turn - self._rocker_angle  # θ_{k+2} − θ_{k−1}
+        coordinates = [0.0] * 4
+        rates = [0.0] * 4
+        coordinates[known] = value
+        coordinates[(known + 1) % 4] = wrap_angle(coupler - value)
+        coordinates[(known + 2) % 4] = wrap_angle(rocker - coupler)
+        coordinates[(known + 3) % 4] = wrap_angle(-rocker)
+        rates[known] = rate
+        rates[(known + 1) % 4] = state.omega_ab - rate
+        rates[(known + 2) % 4] = state.omega_bc - state.omega_ab
+        rates[(known + 3) % 4] = -state.omega_bc
+        return LoopState(tuple(coordinates), tuple(rates), branch)
+
+    def continued_branch(self, value_from: float, branch: int, value_to: float) -> int:
+        """Return the branch at ``value_to`` as ``continued_branch_of`` does for this loop."""
+        if self._prismatic is not None:
+            return self._prismatic.continued_branch(value_from, branch, value_to)
+        return int(continued_branch(self._linkage, value_from, branch, value_to))
+
+
+@lru_cache(maxsize=_CACHE_SIZE)
+def driven_loop(loop: PlanarLoop, known: int) -> DrivenLoop:
+    """Return ``loop`` driven at joint ``known`` (1, 2 or 3), its constants resolved."""
+    return DrivenLoop(loop, known)
+
+
 def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
                branch: int) -> LoopState:
     """
@@ -198,35 +263,7 @@ def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
     accelerations by more than ``singular_points.RATE_ACCURACY``) and UnreachableError where the
     loop does not close at ``value``. Never returns NaN.
     """
-    _check_known(loop, known)
-    check_branch(branch)
-    if not math.isfinite(value) or not math.isfinite(rate):
-        raise UnreachableError(f'joint {known}: value and rate must be finite, got {value!r}, '
-                               f'{rate!r}')
-    if loop.prismatic is not None:
-        coordinates, rates = _prismatic(loop, known).solve(value, rate, branch)
-        return LoopState(coordinates, rates, branch)
-    linkage = _four_bar(loop, known)
-    try:
-        state = solve(linkage, value, CrankRates(rate, 0.0), branch)
-    except (DeadPointError, UnreachableError) as error:
-        raise type(error)(f'joint {known}: {error}') from None
-    links = loop.links
-    # The FourBar's frame is body known − 1's turned by arg(links[known]) + π/2.
-    turn = _angle(links[known]) + 0.5 * math.pi
-    coupler = state.gamma + turn - _angle(links[(known + 1) % 4])  # θ_{k+1} − θ_{k−1}
-    rocker = -state.beta + turn - _angle(links[(known + 2) % 4])  # θ_{k+2} − θ_{k−1}
-    coordinates = [0.0] * 4
-    rates = [0.0] * 4
-    coordinates[known] = value
-    coordinates[(known + 1) % 4] = wrap_angle(coupler - value)
-    coordinates[(known + 2) % 4] = wrap_angle(rocker - coupler)
-    coordinates[(known + 3) % 4] = wrap_angle(-rocker)
-    rates[known] = rate
-    rates[(known + 1) % 4] = state.omega_ab - rate
-    rates[(known + 2) % 4] = state.omega_bc - state.omega_ab
-    rates[(known + 3) % 4] = -state.omega_bc
-    return LoopState(tuple(coordinates), tuple(rates), branch)
+    return driven_loop(loop, known).solve(value, rate, branch)
 
 
 def joint_points(loop: PlanarLoop, coordinates: tuple[float, ...]
@@ -290,10 +327,7 @@ def continued_branch_of(loop: PlanarLoop, known: int, value_from: float, branch:
     The motion has ``branch`` at ``value_from``; it continues through change points on the smooth
     branch, so the branch flips at each change point passed (``kinematics.continued_branch``).
     """
-    _check_known(loop, known)
-    if loop.prismatic is not None:
-        return _prismatic(loop, known).continued_branch(value_from, branch, value_to)
-    return int(continued_branch(_four_bar(loop, known), value_from, branch, value_to))
+    return driven_loop(loop, known).continued_branch(value_from, branch, value_to)
 
 
 def known_joint_range(loop: PlanarLoop, known: int) -> KnownJointRange:

@@ -24,11 +24,10 @@ import math
 from linkage_kinematics.kinematics.geometry import GeometryError, TWO_PI
 from linkage_kinematics.kinematics.planar_loop import (
     branch_of,
-    continued_branch_of,
     DeadPointError,
+    driven_loop,
     JointKind,
     known_joint_range,
-    solve_loop,
     UnreachableError,
 )
 from linkage_kinematics.kinematics.solver import unwrap_near
@@ -205,26 +204,33 @@ class LoopSolver:
     Closes a plan's loops sample by sample: measured joints in, passive loop joints out.
 
     Each loop starts on its planned branch at the zero pose and follows the known joint's motion
-    from sample to sample (``continued_branch_of``), so that it stays on its assembly through
-    change points; revolute and continuous joints are kept within π of their previous value
-    (at first, of the zero pose), and a revolute known joint is followed across whole turns. A
-    refused sample leaves that state as it was.
+    from sample to sample (``DrivenLoop.continued_branch``), so that it stays on its assembly
+    through change points; revolute and continuous joints are kept within π of their previous
+    value (at first, of the zero pose), and a revolute known joint is followed across whole turns.
+    A refused sample leaves that state as it was.
     """
 
     def __init__(self, plan: LoopPlan) -> None:
         self.plan = plan
-        # the loops whose revolute known joint meets an odd number of change points per turn
-        self._odd_turns = frozenset(
-            planned.loop.constraint for planned in plan.loops
-            if planned.known.kind is JointKind.REVOLUTE
-            and len(known_joint_range(planned.loop.planar, planned.known.index).change_points)
-            % 2)
+        # Each loop's step, resolved once here rather than at every sample: its constraint, its
+        # known joint's name and sign, whether its branch flips with each whole turn of that
+        # joint (a revolute known joint meeting an odd number of change points per turn), the
+        # loop driven at that joint, and each passive joint's name, sign, index and revolute-ness.
+        self._steps = tuple(
+            (planned.loop.constraint, planned.known.name, planned.known.sign,
+             planned.known.kind is JointKind.REVOLUTE and len(known_joint_range(
+                 planned.loop.planar, planned.known.index).change_points) % 2 == 1,
+             driven_loop(planned.loop.planar, planned.known.index),
+             tuple((joint.name, joint.sign, joint.index, joint.kind is JointKind.REVOLUTE)
+                   for joint in planned.passive))
+            for planned in plan.loops)
         self.reset()
 
     def reset(self) -> None:
         """Start again from the zero pose on the planned branches."""
-        self._known_values = {planned.loop.constraint: 0.0 for planned in self.plan.loops}
-        self._branches = {planned.loop.constraint: planned.branch for planned in self.plan.loops}
+        # each loop's known value and branch at the last sample, in solve order
+        self._known_values = [0.0] * len(self.plan.loops)
+        self._branches = [planned.branch for planned in self.plan.loops]
         self._previous = {name: 0.0 for name in self.plan.passive}
 
     def solve(self, positions: Mapping[str, float],
@@ -245,36 +251,32 @@ class LoopSolver:
             if not (math.isfinite(values[name]) and math.isfinite(rates[name])):
                 raise LoopSampleError(f'measured joint {name!r}: position {values[name]} and '
                                       f'velocity {rates[name]} are not both finite')
-        known_values, branches = {}, {}
+        known_values, branches = [], []
         solved_positions, solved_velocities = {}, {}
-        for planned in self.plan.loops:
-            constraint, known = planned.loop.constraint, planned.known
-            value = known.sign * values[known.name]
-            planar = planned.loop.planar
+        previous = self._previous
+        for step, last_value, last_branch in zip(self._steps, self._known_values, self._branches):
+            constraint, known, sign, flips_with_turns, driven, passive = step
+            value = sign * values[known]
             try:
-                branch = continued_branch_of(planar, known.index,
-                                             self._known_values[constraint],
-                                             self._branches[constraint], value)
+                branch = driven.continued_branch(last_value, last_branch, value)
                 # A revolute known joint is followed across whole turns (an encoder that wraps
                 # at ±π): the motion went the short way, the whole turns between it and the way
                 # just counted holding an odd number of change points each where it flips.
-                if (known.kind is JointKind.REVOLUTE and constraint in self._odd_turns
-                        and round((self._known_values[constraint] - value) / TWO_PI) % 2):
+                if flips_with_turns and round((last_value - value) / TWO_PI) % 2:
                     branch = -branch
-                state = solve_loop(planar, known.index, value, known.sign * rates[known.name],
-                                   branch)
+                state = driven.solve(value, sign * rates[known], branch)
             except (DeadPointError, UnreachableError) as error:
-                raise LoopSampleError(f'constraint {constraint!r} at {known.name} = '
-                                      f'{values[known.name]:.9g}: {error}',
-                                      constraint) from None
-            known_values[constraint], branches[constraint] = value, state.branch
-            for joint in planned.passive:
-                position = joint.sign * state.coordinates[joint.index]
-                if joint.kind is JointKind.REVOLUTE:
-                    position = unwrap_near(position, self._previous[joint.name])
-                values[joint.name] = solved_positions[joint.name] = position
-                rates[joint.name] = solved_velocities[joint.name] = (
-                    joint.sign * state.rates[joint.index])
+                raise LoopSampleError(f'constraint {constraint!r} at {known} = '
+                                      f'{values[known]:.9g}: {error}', constraint) from None
+            known_values.append(value)
+            branches.append(state.branch)
+            coordinates, state_rates = state.coordinates, state.rates
+            for name, joint_sign, index, revolute in passive:
+                position = joint_sign * coordinates[index]
+                if revolute:
+                    position = unwrap_near(position, previous[name])
+                values[name] = solved_positions[name] = position
+                rates[name] = solved_velocities[name] = joint_sign * state_rates[index]
         self._known_values, self._branches = known_values, branches
         self._previous = dict(solved_positions)
         return solved_positions, solved_velocities

@@ -118,6 +118,7 @@ class NodeOutputs:
         self._encoded: FourBar | None = None
         self._streamed: JointMap | None = None
         self._robot_transforms: messages.RobotStateTransforms | None = None
+        self._loop_joint_names: tuple[str, ...] | None = None  # publish_joint_states's encoder's
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = config.frame_prefix + config.frame_id
         self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
@@ -237,11 +238,13 @@ class NodeOutputs:
     def publish_joint_states(self, names: tuple[str, ...], positions: tuple[float, ...],
                              velocities: tuple[float, ...], stamp_ns: int) -> None:
         """Publish (and log) one ``joint_states`` message of ``names``, stamped ``stamp_ns``."""
-        message = JointState(name=list(names), position=list(positions),
-                             velocity=list(velocities))
-        message.header.stamp = Time(sec=stamp_ns // 1_000_000_000,
-                                    nanosec=stamp_ns % 1_000_000_000)
-        self.send(self._publishers.joint_states, encode_cdr(message), stamp_ns)
+        if names != self._loop_joint_names:
+            # The names are the plan's, the same message after message: one encoder per plan.
+            self._loop_joint_state_encoder = messages.JointStateEncoder(names)
+            self._loop_joint_names = names
+        self.send(self._publishers.joint_states,
+                  self._loop_joint_state_encoder.encode(stamp_ns, positions, velocities),
+                  stamp_ns)
 
     def record_input(self, data: bytes, stamp_ns: int) -> None:
         """Log one input message's bytes as received, at its stamp."""

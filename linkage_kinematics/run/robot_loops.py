@@ -119,11 +119,16 @@ class RobotLoopsFollower:
     def _plan(self, measured: tuple[str, ...]) -> None:
         plan = self.loops.plan(measured, self._branches)
         self.solver = LoopSolver(plan)
-        self._revolute = frozenset(
-            planned.known.name for planned in plan.loops
-            if planned.measured and planned.known.kind is JointKind.REVOLUTE)
+        # resolved once per plan rather than per message: the revolute measured joints (in
+        # measured order), each loop's constraint and known joint, the loops each feeds
+        revolute = {planned.known.name for planned in plan.loops
+                    if planned.measured and planned.known.kind is JointKind.REVOLUTE}
+        self._revolute = tuple(name for name in plan.measured if name in revolute)
+        self._known = tuple((planned.loop.constraint, planned.known.name)
+                            for planned in plan.loops)
         self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
                                    if planned.known.name == name) for name in measured}
+        self._names: Sequence[str] | None = None  # the names _indices were found in
 
     def restart(self) -> None:
         """Forget the motion: the next valid message starts it again on the planned branches."""
@@ -144,23 +149,28 @@ class RobotLoopsFollower:
         None for a message that carries none of the measured joints (with none given, none of
         the loop joints), e.g. this node's own output heard back: ignored, not counted.
         """
-        index = {name: i for i, name in enumerate(names)}
         if self.solver is None:
             carried = tuple(name for name in names if name in self.loop_joints)
             if not carried:
                 return None
             self._plan(carried)
         measured = self.solver.plan.measured
-        if not any(name in index for name in measured):
+        if names != self._names:
+            # A source sends the same names message after message: found once, not per message.
+            index = {name: i for i, name in enumerate(names)}
+            self._names = names[:]
+            self._indices = tuple(index.get(name) for name in measured)
+        indices = self._indices
+        if all(i is None for i in indices):
             return None
-        missing = [name for name in measured
-                   if name not in index or index[name] >= len(positions)]
+        count = len(positions)
+        missing = [name for name, i in zip(measured, indices) if i is None or i >= count]
         if missing:
             return LoopDrop(LoopRejection.NO_JOINT, self._loops_of(missing),
                             f'no position of {missing}')
-        values = {name: positions[index[name]] for name in measured}
-        given = {name: velocities[index[name]] for name in measured
-                 if index[name] < len(velocities)}
+        values = {name: positions[i] for name, i in zip(measured, indices)}
+        count = len(velocities)
+        given = {name: velocities[i] for name, i in zip(measured, indices) if i < count}
         bad = [name for name in measured if not math.isfinite(values[name])
                or not math.isfinite(given.get(name, 0.0))]
         if bad:
@@ -168,17 +178,21 @@ class RobotLoopsFollower:
                             f'{bad} not finite')
         if self._last_stamp_ns is not None and stamp_ns <= self._last_stamp_ns:
             return LoopDrop(LoopRejection.STAMP_NOT_NEWER, (), 'stamp not newer')
-        for name in self._revolute & self._last.keys():
-            # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are counted.
-            last = self._last[name]
-            values[name] += round((last - values[name]) / TWO_PI) * TWO_PI
-        jumps = [name for name in self._revolute & self._last.keys()
-                 if abs(values[name] - self._last[name]) > self.max_jump]
+        last_values = self._last
+        jumps = []
+        for name in self._revolute:
+            if name in last_values:
+                # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are
+                # counted.
+                last = last_values[name]
+                values[name] += round((last - values[name]) / TWO_PI) * TWO_PI
+                if abs(values[name] - last) > self.max_jump:
+                    jumps.append(name)
         if jumps:
             return LoopDrop(LoopRejection.JUMP, self._loops_of(jumps), f'{jumps} jumped')
         rates, estimates = {}, {}
         for name in measured:
-            last = None if name not in self._last else (self._last_stamp_ns, self._last[name])
+            last = None if name not in last_values else (self._last_stamp_ns, last_values[name])
             rates[name], estimates[name] = joint_velocity(stamp_ns, values[name],
                                                           given.get(name), last)
         try:
@@ -191,8 +205,7 @@ class RobotLoopsFollower:
         return LoopSample(
             stamp_ns, tuple(solved), tuple(solved.values()), tuple(solved_rates.values()),
             joints, estimates,
-            {planned.loop.constraint: joints[planned.known.name]
-             for planned in self.solver.plan.loops})
+            {constraint: joints[known] for constraint, known in self._known})
 
 
 def dead_point_distances(plan: LoopPlan,
