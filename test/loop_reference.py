@@ -43,6 +43,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 import functools
+import itertools
 import math
 from pathlib import Path
 import tempfile
@@ -62,6 +63,10 @@ CONVERGED = mpf('1e-40')
 # robots) so that convergence is checked with margin rather than at the rounding floor.
 NEWTON_TOLERANCE = mpf('1e-45')
 NEWTON_STEPS = 30
+# Converging from a neighbouring sample takes under 10 evaluations of the equations. When it
+# cannot converge (no closure, a wrong branch, a dead point) findroot's step halving would go
+# on to the last bit, about 170 evaluations per step; this budget ends it first.
+NEWTON_EVALUATIONS = 60
 # How far a loop's axes may be from parallel (rad) before the loop is not planar: the drawings'
 # rounding of π/2 tilts a frame by about 6e-17 rad.
 PLANAR_TOLERANCE = 1e-9
@@ -478,7 +483,12 @@ def solve(urdf_text: str, known: Mapping[str, float | mpf], guess: Mapping[str, 
             # Newton evaluates the residuals and the Jacobian at the same points.
             return _forward(robot, {**fixed, **dict(zip(unknowns, x))})
 
+        evaluations = itertools.count(1)
+
         def residuals(*x: mpf) -> list[mpf]:
+            if next(evaluations) > NEWTON_EVALUATIONS:
+                raise NotClosed(f'{names}: no convergence in {NEWTON_EVALUATIONS} evaluations '
+                                f'from {dict(guess)} with {dict(known)}')
             kinematics = kinematics_at(*x)
             return [value for name in names
                     for value in _residuals(kinematics, robot.constraints[name], planes[name])]

@@ -201,7 +201,7 @@ def test_any_one_tree_joint_of_a_loop_may_be_the_known_one(name: str) -> None:
 
 def test_reference_refuses_a_loop_that_cannot_close() -> None:
     # A slider 1 m along its line is out of reach of a 5 cm crank and a 13 cm coupler.
-    with pytest.raises(NotClosed, match='in-plane gap'):
+    with pytest.raises(NotClosed):
         solve(slider_crank(), {'slider_joint': 1.0}, {})
 
 
