@@ -28,7 +28,7 @@ import math
 import re
 import xml.etree.ElementTree as ElementTree
 
-from linkage_kinematics.model.robot_transforms import JointType
+from linkage_kinematics.model.robot_transforms import JointType, parse_vector, UrdfError
 import lxml.etree
 import numpy as np
 from urdf_parser_py import urdf as urdf_parser
@@ -144,15 +144,10 @@ def _parser_messages() -> Iterator[list[str]]:
 
 
 def _vector(text: str | None, default: tuple[float, float, float], where: str) -> np.ndarray:
-    if text is None:
-        return np.array(default, dtype=float)
     try:
-        values = [float(word) for word in text.split()]
-    except ValueError:
-        raise LoopError(f'{where}: {text!r} is not three numbers') from None
-    if len(values) != 3 or not all(math.isfinite(value) for value in values):
-        raise LoopError(f'{where}: {text!r} is not three finite numbers')
-    return np.array(values)
+        return np.array(parse_vector(text, default, where), dtype=float)
+    except UrdfError as error:
+        raise LoopError(str(error)) from None
 
 
 def _unit(vector: np.ndarray, where: str) -> np.ndarray:

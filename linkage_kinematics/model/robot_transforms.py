@@ -131,7 +131,12 @@ def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
     return (x / norm, y / norm, z / norm, w / norm)
 
 
-def _numbers(text: str | None, default: Vector, where: str) -> Vector:
+def parse_vector(text: str | None, default: Vector, where: str) -> Vector:
+    """
+    Return a URDF attribute of three numbers (xyz, rpy, an axis), ``default`` where it is absent.
+
+    Raises UrdfError naming ``where`` for anything but three finite numbers.
+    """
     if text is None:
         return default
     try:
@@ -162,13 +167,13 @@ def _parse_joint(element: ElementTree.Element, links: set[str]) -> UrdfJoint:
             raise UrdfError(f'{where}: {tag} link {link!r} is not a <link> of the robot')
         ends.append(link)
     origin = element.find('origin')
-    xyz = _numbers(origin.get('xyz') if origin is not None else None, (0.0, 0.0, 0.0),
-                   f'{where} origin xyz')
-    rpy = _numbers(origin.get('rpy') if origin is not None else None, (0.0, 0.0, 0.0),
-                   f'{where} origin rpy')
+    xyz = parse_vector(origin.get('xyz') if origin is not None else None, (0.0, 0.0, 0.0),
+                       f'{where} origin xyz')
+    rpy = parse_vector(origin.get('rpy') if origin is not None else None, (0.0, 0.0, 0.0),
+                       f'{where} origin rpy')
     axis_element = element.find('axis')
-    axis = _numbers(axis_element.get('xyz') if axis_element is not None else None,
-                    (1.0, 0.0, 0.0), f'{where} axis xyz')
+    axis = parse_vector(axis_element.get('xyz') if axis_element is not None else None,
+                        (1.0, 0.0, 0.0), f'{where} axis xyz')
     length = math.sqrt(sum(component * component for component in axis))
     if joint_type in MOVABLE_TYPES and length == 0.0:
         raise UrdfError(f'{where}: the axis is zero')
@@ -218,6 +223,12 @@ class RobotTransforms:
             if joint.mimic is not None and joint.mimic.joint not in self.joints:
                 raise UrdfError(f'joint {joint.name!r} mimics {joint.mimic.joint!r}, which is '
                                 'not a joint of the robot')
+
+    @property
+    def driven_joints(self) -> tuple[str, ...]:
+        """Return the movable joints a joint state sets, in URDF order (mimic joints follow)."""
+        return tuple(name for name, joint in self.joints.items()
+                     if joint.movable and joint.mimic is None)
 
     def fixed_transforms(self) -> list[Transform]:
         """Return the transforms of every fixed joint (robot_state_publisher's /tf_static)."""

@@ -20,7 +20,7 @@ import math
 from typing import Any, Callable, Protocol
 
 from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.robot_transforms import RobotTransforms, UrdfError
+from linkage_kinematics.model.robot_transforms import UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
     MEASURED_QOS,
@@ -73,8 +73,7 @@ class ClosedRobot:
                                            dict(config.loop_branches), config.max_jump)
         self.transforms = RobotStateTransforms(urdf, config.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
-        self.tree_joints = tuple(name for name, joint in RobotTransforms(urdf).joints.items()
-                                 if joint.movable and joint.mimic is None)
+        self.tree_joints = self.transforms.driven_joints
 
 
 def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:

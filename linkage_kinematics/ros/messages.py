@@ -295,6 +295,11 @@ class RobotStateTransforms:
         self._robot = RobotTransforms(urdf, frame_prefix)
         self._names: tuple[str, ...] | None = None
 
+    @property
+    def driven_joints(self) -> tuple[str, ...]:
+        """Return the movable joints a joint state sets (``RobotTransforms.driven_joints``)."""
+        return self._robot.driven_joints
+
     def static_message(self, stamp_ns: int) -> bytes:
         """Return /tf_static: the fixed joints, stamped ``stamp_ns``."""
         return encode_cdr(tf_message(self._robot.fixed_transforms(), stamp_ns))

@@ -245,21 +245,51 @@ def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
     return level, text, values
 
 
-class MeasuredHealth:
+class Freshness:
     """
-    The measured source's health: dropped samples by reason, and how fresh the data is.
+    How fresh a measured source's data is: its valid samples, and when the last one came.
 
-    Drops since the previous status make it WARN, naming each reason and its count; no valid
-    sample for ``measured.timeout`` (node clock) makes it ERROR, as diagnostic_updater's
-    frequency status says ERROR when no event came in its window.
+    No valid sample for ``measured.timeout`` (node clock) makes the source's status ERROR, as
+    diagnostic_updater's frequency status says ERROR when no event came in its window. Both
+    measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``).
     """
 
     def __init__(self, start_ns: int) -> None:
-        self.totals = dict.fromkeys(Rejection, 0)
-        self._window = dict.fromkeys(Rejection, 0)
         self.accepted = 0
         self.last_valid_ns: int | None = None
         self._start_ns = start_ns
+
+    def _accepted_at(self, now_ns: int) -> None:
+        self.accepted += 1
+        self.last_valid_ns = now_ns
+
+    def is_stale(self, now_ns: int, timeout: float) -> bool:
+        """Whether no valid sample came for ``timeout`` seconds (since the start, at first)."""
+        since = self.last_valid_ns if self.last_valid_ns is not None else self._start_ns
+        return (now_ns - since) * 1e-9 > timeout
+
+    def _stale_problem(self, now_ns: int, timeout: float, sample: str) -> str | None:
+        """Return the ERROR message naming ``sample`` when the data is stale, else None."""
+        if not self.is_stale(now_ns, timeout):
+            return None
+        if self.last_valid_ns is None:
+            return f'no valid {sample} received yet (timeout {timeout:g} s)'
+        age = (now_ns - self.last_valid_ns) * 1e-9
+        return f'no valid {sample} for {age:.3f} s (timeout {timeout:g} s)'
+
+
+class MeasuredHealth(Freshness):
+    """
+    The measured source's health: dropped samples by reason, and how fresh the data is.
+
+    Drops since the previous status make it WARN, naming each reason and its count; stale data
+    (``Freshness``) makes it ERROR.
+    """
+
+    def __init__(self, start_ns: int) -> None:
+        super().__init__(start_ns)
+        self.totals = dict.fromkeys(Rejection, 0)
+        self._window = dict.fromkeys(Rejection, 0)
         self.velocity: Estimate | None = None
 
     def drop(self, rejection: Rejection) -> None:
@@ -267,23 +297,12 @@ class MeasuredHealth:
         self._window[rejection] += 1
 
     def accept(self, now_ns: int, velocity: Estimate) -> None:
-        self.accepted += 1
-        self.last_valid_ns = now_ns
+        self._accepted_at(now_ns)
         self.velocity = velocity
-
-    def is_stale(self, now_ns: int, timeout: float) -> bool:
-        """Whether no valid sample came for ``timeout`` seconds (since the start, at first)."""
-        since = self.last_valid_ns if self.last_valid_ns is not None else self._start_ns
-        return (now_ns - since) * 1e-9 > timeout
 
     def problem(self, now_ns: int, timeout: float, driver_name: str) -> str | None:
         """Return the ERROR message when the data is stale, else None."""
-        if not self.is_stale(now_ns, timeout):
-            return None
-        if self.last_valid_ns is None:
-            return f'no valid sample of {driver_name} received yet (timeout {timeout:g} s)'
-        age = (now_ns - self.last_valid_ns) * 1e-9
-        return f'no valid sample of {driver_name} for {age:.3f} s (timeout {timeout:g} s)'
+        return self._stale_problem(now_ns, timeout, f'sample of {driver_name}')
 
     def take_warnings(self) -> tuple[str, ...]:
         """Return the drops since the last call, one text per reason, and start a new window."""

@@ -19,7 +19,13 @@ import math
 
 from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.model.loops import LoopPlan, PlannedLoop
-from linkage_kinematics.run.diagnostics import Level, LOG_DISABLED, NOT_MEASURED, StatusInputs
+from linkage_kinematics.run.diagnostics import (
+    Freshness,
+    Level,
+    LOG_DISABLED,
+    NOT_MEASURED,
+    StatusInputs,
+)
 from linkage_kinematics.run.measured import Estimate
 from linkage_kinematics.run.robot_loops import (
     dead_point_distances,
@@ -50,22 +56,20 @@ def _dropped(count: int, reason: LoopRejection) -> str:
     return f'dropped {count} message{"s" if count > 1 else ""} {reason.value}'
 
 
-class LoopsHealth:
+class LoopsHealth(Freshness):
     """
     Dropped messages by reason (overall and per loop), and how fresh the data is.
 
     Drops since the previous status make the node's status (and the loops they concern) WARN;
-    no valid message for ``measured.timeout`` (node clock) makes the node's status ERROR.
+    stale data (``Freshness``) makes the node's status ERROR.
     """
 
     def __init__(self, start_ns: int) -> None:
+        super().__init__(start_ns)
         self.totals = _counts()
         self._window = _counts()
         self.per_loop: dict[str, dict[LoopRejection, int]] = {}
         self._loop_window: dict[str, dict[LoopRejection, int]] = {}
-        self.accepted = 0
-        self.last_valid_ns: int | None = None
-        self._start_ns = start_ns
         self.last: LoopSample | None = None
 
     def drop(self, drop: LoopDrop) -> None:
@@ -78,23 +82,12 @@ class LoopsHealth:
 
     def accept(self, now_ns: int, sample: LoopSample) -> None:
         """Note a message followed at node-clock time ``now_ns``."""
-        self.accepted += 1
-        self.last_valid_ns = now_ns
+        self._accepted_at(now_ns)
         self.last = sample
-
-    def is_stale(self, now_ns: int, timeout: float) -> bool:
-        """Whether no valid message came for ``timeout`` seconds (since the start, at first)."""
-        since = self.last_valid_ns if self.last_valid_ns is not None else self._start_ns
-        return (now_ns - since) * 1e-9 > timeout
 
     def problem(self, now_ns: int, timeout: float) -> str | None:
         """Return the ERROR message when the data is stale, else None."""
-        if not self.is_stale(now_ns, timeout):
-            return None
-        if self.last_valid_ns is None:
-            return f'no valid measured sample received yet (timeout {timeout:g} s)'
-        age = (now_ns - self.last_valid_ns) * 1e-9
-        return f'no valid measured sample for {age:.3f} s (timeout {timeout:g} s)'
+        return self._stale_problem(now_ns, timeout, 'measured sample')
 
     def take_warnings(self) -> tuple[tuple[str, ...], dict[str, tuple[str, ...]]]:
         """Return the drops since the last call (the node's, each loop's) and start anew."""
