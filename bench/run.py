@@ -17,6 +17,8 @@ also draws docs/benchmark_speed_error.png.
 from __future__ import annotations
 
 import argparse
+from collections.abc import Collection
+from contextlib import ExitStack
 import os
 import pathlib
 import sys
@@ -26,9 +28,14 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 # The high-precision reference lives with the tests; the library is imported from the tree.
 sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 
+from ros_domains import domain_lease  # noqa: E402
 from timing import machine_description  # noqa: E402
 
 SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'memory')
+# The sections that run nodes, each kind of run on its own ROS_DOMAIN_ID: the first one and the
+# four after it (node_bench's DOMAIN_* offsets).
+ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'memory')
+DOMAIN_COUNT = 5
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -44,19 +51,41 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument('--memory-minutes', type=float, default=None,
                         help="length of the node's resident-memory run at 1 kHz "
                              '(default 10, 0.5 with --quick)')
-    parser.add_argument('--ros-domain', type=int, default=50,
-                        help='first of the five ROS_DOMAIN_IDs the node, cost and memory '
-                             'sections use (default 50, so 50–54)')
+    parser.add_argument('--ros-domain', type=int, default=None,
+                        help='first of the five ROS_DOMAIN_IDs the node, cost, measured, loops '
+                             'and memory sections use (default: five in a row that no test or '
+                             'other benchmark run holds)')
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
         parser.error('--repetitions must be at least 1')
-    if not 0 <= arguments.ros_domain <= 228:
+    if arguments.ros_domain is not None and not 0 <= arguments.ros_domain <= 228:
         parser.error('--ros-domain must be between 0 and 228 (five IDs up to 232)')
-    repetitions = arguments.repetitions or (5 if arguments.quick else 7)
     sections = arguments.only or SECTIONS
     started = time.perf_counter()
     print(f'machine: {machine_description()}')
     print(f"command: python bench/run.py {' '.join(sys.argv[1:])}".rstrip())
+    with ExitStack() as held:
+        ros_domain = None
+        if any(section in ROS_SECTIONS for section in sections):
+            # Taken through the tests' lease (test/ros_domains.py), so that a test run or another
+            # benchmark run beside this one never shares an id with it: a fixed default (it was
+            # 50) lay among the ids the tests are handed, and its nodes saw theirs.
+            try:
+                ros_domain = held.enter_context(domain_lease(DOMAIN_COUNT, arguments.ros_domain))
+            except RuntimeError as error:
+                parser.error(str(error))
+            print(f'ROS domains: {ros_domain}–{ros_domain + DOMAIN_COUNT - 1}')
+        run_sections(arguments, sections, ros_domain)
+    load = ', '.join(f'{value:.2f}' for value in os.getloadavg())
+    print(f'\nbenchmark took {time.perf_counter() - started:.0f} s; load average at the end: '
+          f'{load}')
+    return 0
+
+
+def run_sections(arguments: argparse.Namespace, sections: Collection[str],
+                 ros_domain: int | None) -> None:
+    """Print each of ``sections``; the node sections run on ``ros_domain`` and the four after."""
+    repetitions = arguments.repetitions or (5 if arguments.quick else 7)
     if 'kinematics' in sections:
         import kinematics_bench
 
@@ -81,24 +110,24 @@ def main(argv: list[str] | None = None) -> int:
         import node_bench
 
         print('\n## Node\n')
-        print(node_bench.run(arguments.quick, repetitions, arguments.ros_domain))
+        print(node_bench.run(arguments.quick, repetitions, ros_domain))
     if 'cost' in sections:
         import cost_bench
 
         print('\n## Node against a minimal hand-written publisher\n')
-        print(cost_bench.run(arguments.quick, arguments.ros_domain))
+        print(cost_bench.run(arguments.quick, ros_domain))
     if 'measured' in sections:
         import measured_bench
 
         print('\n## Measured source against a minimal hand-written relay\n')
-        print(measured_bench.run(arguments.quick, arguments.ros_domain))
+        print(measured_bench.run(arguments.quick, ros_domain))
     if 'loops' in sections:
         import loops_bench
 
         print("\n## A URDF's loops closed: the per-sample path in this process\n")
         print(loops_bench.path_run(arguments.quick, repetitions))
         print("\n## A URDF's loops closed, against a minimal hand-written relay\n")
-        print(loops_bench.run(arguments.quick, arguments.ros_domain))
+        print(loops_bench.run(arguments.quick, ros_domain))
     if 'memory' in sections:
         import node_bench
 
@@ -106,11 +135,7 @@ def main(argv: list[str] | None = None) -> int:
         if minutes is None:
             minutes = 0.5 if arguments.quick else 10.0
         print(f'\n## Node memory over {minutes:g} min at 1 kHz\n')
-        print(node_bench.memory_run(minutes, arguments.ros_domain))
-    load = ', '.join(f'{value:.2f}' for value in os.getloadavg())
-    print(f'\nbenchmark took {time.perf_counter() - started:.0f} s; load average at the end: '
-          f'{load}')
-    return 0
+        print(node_bench.memory_run(minutes, ros_domain))
 
 
 if __name__ == '__main__':

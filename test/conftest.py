@@ -10,8 +10,9 @@ every one after the test (node_process.NodeProcesses); ``module_nodes`` after th
 
 from collections.abc import Iterator
 
-from node_process import domain_lease, NodeProcesses
+from node_process import NodeProcesses
 import pytest
+from ros_domains import domain_lease
 
 
 def pytest_addoption(parser: pytest.Parser) -> None:

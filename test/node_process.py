@@ -4,23 +4,21 @@
 """
 Helpers for the node tests: run linkage_node in its own process, listen with real rclpy.
 
-Every test module that starts nodes runs in its own ROS_DOMAIN_ID (``domain_lease``, the
-``domain_id`` fixture), so that tests never see each other's nodes; every process a test starts
-through ``NodeProcesses`` (the ``nodes`` fixture) has ended when the test has.
+Every test module that starts nodes runs in its own ROS_DOMAIN_ID (the ``domain_id`` fixture,
+leased by ``ros_domains``), so that tests never see each other's nodes; every process a test
+starts through ``NodeProcesses`` (the ``nodes`` fixture) has ended when the test has.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-import fcntl
 import math
 import os
 from pathlib import Path
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from typing import Any
 
@@ -44,53 +42,9 @@ REPOSITORY = Path(__file__).resolve().parent.parent
 PROCESS_TIMEOUT = 60.0
 # The message types of ROS 2 Jazzy, as rosbags knows them independently of rclpy.
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
-# The ROS_DOMAIN_IDs the tests take: those whose DDS ports stay below Linux's ephemeral range,
-# but 0, the default, which other ROS programs on the machine use.
-DOMAIN_IDS = range(1, 102)
-# One lock file per id: a test run holds the id's lock (flock) while it uses it, so that two runs
-# on one machine at once (two worktrees, a rerun started before the last ended) never share one.
-DOMAIN_LOCKS = Path(tempfile.gettempdir()) / 'linkage_kinematics-ros-domains'
 # How long a process that outlived its test gets after each signal of the teardown (s): SIGINT is
 # how the node is meant to end (it finalizes its bag), SIGTERM and SIGKILL are the escalation.
 STOP_TIMEOUTS = ((signal.SIGINT, 30.0), (signal.SIGTERM, 10.0), (signal.SIGKILL, PROCESS_TIMEOUT))
-
-
-class _DomainIds:
-    """Hands out the ROS_DOMAIN_IDs no other holder (here or in another test run) has."""
-
-    def __init__(self) -> None:
-        # Ids go round: the next lease starts after the last one taken, so a module (or a rerun)
-        # never gets the id its predecessor just gave back.
-        self.last = DOMAIN_IDS[-1]
-
-    def take(self) -> tuple[int, int]:
-        """Lock the next free id; return it and the lock's file descriptor."""
-        DOMAIN_LOCKS.mkdir(exist_ok=True)
-        start = DOMAIN_IDS.index(self.last) + 1
-        for offset in range(len(DOMAIN_IDS)):
-            domain_id = DOMAIN_IDS[(start + offset) % len(DOMAIN_IDS)]
-            descriptor = os.open(DOMAIN_LOCKS / f'{domain_id}', os.O_RDWR | os.O_CREAT, 0o666)
-            try:
-                fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(descriptor)
-                continue
-            self.last = domain_id
-            return domain_id, descriptor
-        raise RuntimeError(f'every ROS_DOMAIN_ID in {DOMAIN_IDS} is held by another test run')
-
-
-_DOMAIN_IDS = _DomainIds()
-
-
-@contextmanager
-def domain_lease() -> Iterator[int]:
-    """Hold a ROS_DOMAIN_ID that no other test, and no other test run, holds meanwhile."""
-    domain_id, descriptor = _DOMAIN_IDS.take()
-    try:
-        yield domain_id
-    finally:
-        os.close(descriptor)  # which releases the lock
 
 
 def ros_environment(domain_id: int) -> dict[str, str]:

@@ -8,8 +8,9 @@ import signal
 import subprocess
 import sys
 
-from node_process import DOMAIN_IDS, domain_lease, end_process, NodeProcesses, PROCESS_TIMEOUT
+from node_process import end_process, NodeProcesses, PROCESS_TIMEOUT
 import pytest
+from ros_domains import DOMAIN_IDS, domain_lease
 
 # A process that ignores SIGINT and SIGTERM: only SIGKILL ends it. It says so once it does.
 STUBBORN = [sys.executable, '-c', (
@@ -38,6 +39,20 @@ def test_domain_leases_are_distinct_until_given_back() -> None:
     # Given back, an id is not the next one handed out: the leases go round.
     with domain_lease() as third:
         assert third not in (first, second)
+
+
+def test_a_lease_of_ids_in_a_row_holds_each_of_them() -> None:
+    """bench/run.py's five ids: no other lease gets one of them, neither by number nor next."""
+    with domain_lease(5) as first:
+        block = range(first, first + 5)
+        assert set(block) <= set(DOMAIN_IDS)
+        with pytest.raises(RuntimeError, match=(
+                f'^ROS_DOMAIN_IDs {first + 4} to {first + 5}: another test or benchmark run '
+                'holds one of them$')):
+            with domain_lease(2, first + 4):
+                pass
+        with domain_lease() as single:
+            assert single not in block
 
 
 def test_domain_id_fixtures_differ(domain_id: int, other_domain_id: int) -> None:
