@@ -13,9 +13,11 @@ what it holds.
 from __future__ import annotations
 
 from collections import Counter
+import ctypes
 import errno
 import os
 from pathlib import Path
+import select
 import time
 
 from bag_files import only_bag
@@ -40,6 +42,8 @@ from rclpy.qos import DurabilityPolicy, QoSProfile
 from rosbags.rosbag2 import Reader
 from std_msgs.msg import String
 
+# inotify(7): a file created in a watched folder, one renamed into it
+IN_CREATE, IN_MOVED_TO = 0x100, 0x80
 LATCHED = ('/robot_description', '/tf_static', '/diagnostics')
 # the node's topics and the TF robot_state_publisher would publish (logged only)
 LOGGED_TOPICS = ('/joint_states', '/linkage/state', '/robot_description', '/linkage/markers',
@@ -226,6 +230,47 @@ def test_a_node_splits_its_bag_by_duration_and_every_file_opens_alone(
     assert nanoseconds[-1] - nanoseconds[0] == round(0.5 * 3.141592653589793 / 2.0 * 1e9)
 
 
+def wait_for_listed_files(folder: Path, count: int, timeout: float = PROCESS_TIMEOUT) -> bool:
+    """
+    Wait until the metadata.yaml of a bag in ``folder`` lists ``count`` files; whether it did.
+
+    Woken by inotify when the bag folder is made in ``folder`` and whenever the bag writer
+    replaces metadata.yaml (a rename into the bag folder, ``BagMetadata.write``: at each file it
+    begins). Each folder is watched before it is read, so that no change goes unseen.
+    """
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.inotify_add_watch.argtypes = (ctypes.c_int, ctypes.c_char_p, ctypes.c_uint32)
+    events = libc.inotify_init1(os.O_CLOEXEC)
+    assert events >= 0, os.strerror(ctypes.get_errno())
+    watched: set[Path] = set()
+
+    def watch(path: Path, mask: int) -> None:
+        assert libc.inotify_add_watch(events, os.fsencode(path), mask) >= 0, (
+            path, os.strerror(ctypes.get_errno()))
+        watched.add(path)
+
+    def listed() -> bool:
+        for bag in (path for path in folder.iterdir() if path.is_dir()):
+            if bag not in watched:
+                watch(bag, IN_MOVED_TO)
+            if ((bag / 'metadata.yaml').exists()
+                    and len(BagMetadata.read(bag).relative_file_paths) >= count):
+                return True
+        return False
+
+    deadline = time.monotonic() + timeout
+    try:
+        watch(folder, IN_CREATE)
+        while not listed():
+            remaining = deadline - time.monotonic()
+            if remaining <= 0.0 or not select.select([events], [], [], remaining)[0]:
+                return listed()
+            os.read(events, 65536)  # what changed is read from the folders themselves
+        return True
+    finally:
+        os.close(events)
+
+
 def test_a_node_splits_its_bag_by_size(nodes: NodeProcesses, tmp_path: Path) -> None:
     """
     A looping node in files of 4 KiB: split at each flushed chunk.
@@ -234,15 +279,11 @@ def test_a_node_splits_its_bag_by_size(nodes: NodeProcesses, tmp_path: Path) -> 
     above 1 KiB, so there every message would start a file before the status was logged once.
     """
     folder = tmp_path / 'bags'
+    folder.mkdir()
     process = nodes.start(
         {'log.folder': str(folder), 'log.max_bag_size': 4 * MIN_SPLIT_SIZE, 'rate_hz': 200.0,
          'end_behavior': 'loop'}, tmp_path / 'node.log')
-    deadline = time.monotonic() + PROCESS_TIMEOUT
-    while time.monotonic() < deadline:
-        bags = list(folder.glob('*/metadata.yaml')) if folder.exists() else []
-        if bags and len(BagMetadata.read(bags[0].parent).relative_file_paths) >= 3:
-            break
-        time.sleep(0.1)
+    assert wait_for_listed_files(folder, 3), (tmp_path / 'node.log').read_text()
     assert nodes.interrupt(process) == 0, (tmp_path / 'node.log').read_text()
     files = assert_metadata_lists_every_file(only_bag(folder))
     assert len(files) >= 3
