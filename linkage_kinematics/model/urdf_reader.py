@@ -198,8 +198,9 @@ def _plain_cause(cause: Exception, text: str | None) -> str:
                           ('Invalid joint type: ', 'unknown type {!r}')):
         if message.startswith(prefix):
             return plain.format(message[len(prefix):])
-    if message == 'Invalid vector length' and text is not None:
-        return f'{text!r} is not the right count of numbers'
+    if message == 'Invalid vector length':
+        shown = '' if text is None else f'{text!r} is '
+        return shown + 'not the right count of numbers'
     if message.startswith(_NOT_A_FLOAT):
         word = message[len(_NOT_A_FLOAT):]
         inside = f' in {text!r}' if text is not None and repr(text) != word else ''
