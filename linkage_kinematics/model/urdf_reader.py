@@ -209,7 +209,11 @@ def _plain_cause(cause: Exception, text: str | None) -> str:
 
 
 def _numbers(values: Iterable[float], where: str) -> tuple[float, ...]:
-    """Return ``values`` as floats; UrdfError naming ``where`` for one that is not finite."""
+    """
+    Return ``values`` as floats; UrdfError naming ``where`` for one that is not finite.
+
+    urdf_parser_py's float() takes 'nan', 'inf' and '1e400'; urdfdom's strToDouble refuses them.
+    """
     numbers = tuple(float(value) for value in values)
     for number in numbers:
         if not math.isfinite(number):
