@@ -19,7 +19,8 @@ from typing import Any
 
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition, type_description_hash
-from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform, UrdfError
+from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
+from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
@@ -180,22 +181,23 @@ def test_only_joints_named_in_the_joint_state_move_and_a_named_mimic_keeps_its_v
 @pytest.mark.parametrize('text, problem', [
     ('<robot', 'not XML'),
     ('<model/>', 'root element is <model>'),
-    ('<robot><link name="a"/><link name="b"/></robot>', "2 root links ['a', 'b']"),
-    ('<robot><link name="a"/><joint name="j" type="hinge"><parent link="a"/>'
+    ('<robot name="r"><link name="a"/><link name="b"/></robot>', "2 root links ['a', 'b']"),
+    ('<robot name="r"><link name="a"/><joint name="j" type="hinge"><parent link="a"/>'
      '<child link="a"/></joint></robot>', "joint 'j': unknown type 'hinge'"),
-    ('<robot><link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
-     '<child link="b"/></joint></robot>', "child link 'b' is not a <link>"),
-    ('<robot><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+    ('<robot name="r"><link name="a"/><joint name="j" type="fixed"><parent link="a"/>'
+     '<child link="b"/></joint></robot>', "joint 'j': child link 'b' is not a <link>"),
+    ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
      '<parent link="a"/><child link="b"/><axis xyz="0 0 0"/></joint></robot>',
-     'the axis is zero'),
-    ('<robot><link name="a"/><link name="b"/><joint name="j" type="fixed">'
+     "joint 'j': the axis is zero"),
+    ('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="fixed">'
      '<parent link="a"/><child link="b"/><origin xyz="1 2"/></joint></robot>',
-     "origin xyz: '1 2' is not three finite numbers"),
+     "joint 'j' origin xyz: '1 2' is not the right count of numbers"),
 ])
 def test_a_bad_urdf_is_refused_naming_the_problem(text: str, problem: str) -> None:
     with pytest.raises(UrdfError) as raised:
         RobotTransforms(text)
     assert problem in str(raised.value)
+    assert '\n' not in str(raised.value)
 
 
 # --- the shipped tf2_msgs/msg/TFMessage ----------------------------------------------------------

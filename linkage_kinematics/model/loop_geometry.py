@@ -34,15 +34,8 @@ import math
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, PlanarLoop
-from linkage_kinematics.model.loop_urdf import (
-    Constraint,
-    JointType,
-    LoopError,
-    MOVING_TYPES,
-    Robot,
-    ROTATING_TYPES,
-    tree_path,
-)
+from linkage_kinematics.model.loop_urdf import Constraint, LoopError, Robot, tree_path
+from linkage_kinematics.model.urdf_reader import JointType, MOVABLE_TYPES, ROTATING_TYPES
 import numpy as np
 
 # How far (rad, as the sine of the angle) a revolute axis may lean from the loop normal, or a
@@ -112,7 +105,7 @@ def _moving_path(robot: Robot, constraint: Constraint,
         raise LoopError(f'{where}: the loop holds floating or planar joints {free}, which have '
                         'no single coordinate to solve')
     moving = [(joint.joint_type, joint.name, forward) for joint, forward in path
-              if joint.joint_type in MOVING_TYPES]
+              if joint.joint_type in MOVABLE_TYPES]
     if len(moving) != 3:
         raise LoopError(f'{where}: the loop has {len(moving)} moving joints '
                         f'{[name for _, name, _ in moving]}, not 3: only a four-bar (or a '

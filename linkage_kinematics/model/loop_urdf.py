@@ -4,43 +4,40 @@
 """
 A lab's URDF read for its kinematic loops: the tree at the zero pose and its ``<constraint>``s.
 
-The links and joints come from ROS's own Python URDF parser (``urdf_parser_py``, the urdfdom_py
-package), so the joints mean what they mean to ROS. A ``<constraint>`` is the cut joint of a
-closed loop as proposed for URDF (urdfdom PR #264, urdfdom_headers PR #108), a direct child of
-``<robot>``::
+The links and joints are those ``urdf_reader`` reads with ROS's own Python URDF parser
+(``urdf_parser_py``, the urdfdom_py package), so the joints mean what they mean to ROS. A
+``<constraint>`` is the cut joint of a closed loop as proposed for URDF (urdfdom PR #264,
+urdfdom_headers PR #108), a direct child of ``<robot>``::
 
     <constraint name="N" type="revolute">
       <parent link="L1"/><parent_origin xyz="…" rpy="…"/><parent_axis xyz="…"/>
       <child link="L2"/><child_origin xyz="…" rpy="…"/><child_axis xyz="…"/>
     </constraint>
 
-The parser does not know the element, so the constraints are read from the same text with
-``xml.etree.ElementTree``. Every link's world pose at the zero pose (every joint at 0) is kept,
-in float64 as a URDF reader computes it. Pure: numpy and urdf_parser_py, no ROS graph.
+The parser does not know the element (nor does urdfdom), so the constraints are read here from
+the XML tree the parser read. Every link's world pose at the zero pose (every joint at 0) is
+kept, in float64 as a URDF reader computes it. Pure: numpy, urdf_parser_py and lxml, no ROS
+graph.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-import contextlib
 from dataclasses import dataclass
 import math
-import re
-import xml.etree.ElementTree as ElementTree
 
-from linkage_kinematics.model.robot_transforms import JointType, parse_vector, UrdfError
+from linkage_kinematics.model.urdf_reader import (
+    JointType,
+    read_urdf,
+    UrdfError,
+    UrdfTree,
+    Vector,
+)
 import lxml.etree
 import numpy as np
-from urdf_parser_py import urdf as urdf_parser
-from urdf_parser_py.xml_reflection import core as xml_reflection_core
 
 
 class LoopError(ValueError):
     """A URDF, or one of its loops, that cannot be closed; the message names it and says why."""
-
-
-ROTATING_TYPES = frozenset({JointType.REVOLUTE, JointType.CONTINUOUS})
-MOVING_TYPES = ROTATING_TYPES | {JointType.PRISMATIC}
 
 
 @dataclass(frozen=True)
@@ -117,37 +114,22 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     ])
 
 
-# urdf_parser_py reports what it does not know through the module-level function
-# xml_reflection.core.on_error, which by default writes each message to stderr; Reflection's
-# set_from_xml looks the name up in that module at call time. A <constraint> is not known to it,
-# so every lab's good URDF with loops would print 'Unknown tag "constraint" in /robot[...]'. The
-# parse below swaps the function for one that drops exactly that message (a <constraint> directly
-# under <robot>, whose path is /robot[@name='…']) and keeps every other one, a <constraint>
-# misplaced inside a <joint> included, which the caller gets back; then it restores the function.
-_CONSTRAINT_COMPLAINT = re.compile(r'Unknown tag "constraint" in /robot(\[@name=\'[^/]*\'\])?')
+def _vector(text: str | None, default: Vector, where: str) -> np.ndarray:
+    """
+    Return a constraint's attribute of three numbers (xyz, rpy, an axis); ``default`` if absent.
 
-
-@contextlib.contextmanager
-def _parser_messages() -> Iterator[list[str]]:
-    messages: list[str] = []
-
-    def keep(message: str) -> None:
-        if not _CONSTRAINT_COMPLAINT.fullmatch(message):
-            messages.append(message)
-
-    previous = xml_reflection_core.on_error
-    xml_reflection_core.on_error = keep
+    urdf_parser_py does not read a <constraint>, so its numbers are read here, as finite as
+    urdf_reader asks a joint's to be. Raises LoopError naming ``where`` for anything else.
+    """
+    if text is None:
+        return np.array(default, dtype=float)
     try:
-        yield messages
-    finally:
-        xml_reflection_core.on_error = previous
-
-
-def _vector(text: str | None, default: tuple[float, float, float], where: str) -> np.ndarray:
-    try:
-        return np.array(parse_vector(text, default, where), dtype=float)
-    except UrdfError as error:
-        raise LoopError(str(error)) from None
+        values = [float(word) for word in text.split()]
+    except ValueError:
+        raise LoopError(f'{where}: {text!r} is not three numbers') from None
+    if len(values) != 3 or not all(math.isfinite(value) for value in values):
+        raise LoopError(f'{where}: {text!r} is not three finite numbers')
+    return np.array(values, dtype=float)
 
 
 def _unit(vector: np.ndarray, where: str) -> np.ndarray:
@@ -157,65 +139,30 @@ def _unit(vector: np.ndarray, where: str) -> np.ndarray:
     return vector / length
 
 
-def _parse_tree(data: bytes) -> tuple[urdf_parser.Robot, tuple[str, ...]]:
-    with _parser_messages() as messages:
-        try:
-            robot = urdf_parser.URDF.from_xml_string(data)
-        except lxml.etree.XMLSyntaxError as error:
-            raise LoopError(f'the URDF is not XML: {error}') from None
-        except Exception as error:  # urdf_parser_py raises ParseError, AssertionError, ...
-            raise LoopError(f'urdf_parser_py cannot read the URDF: {error}') from None
-    return robot, tuple(messages)
-
-
-def _tree_joints(robot: urdf_parser.Robot) -> tuple[str, dict[str, TreeJoint], dict[str, Pose]]:
-    """Return the root link, every joint at the zero pose, and every link's world pose."""
-    links = set(robot.link_map)
-    by_parent: dict[str, list[urdf_parser.Joint]] = {}
-    children: set[str] = set()
-    for joint in robot.joints:
-        for role, link in (('parent', joint.parent), ('child', joint.child)):
-            if link not in links:
-                raise LoopError(f'joint {joint.name!r}: {role} link {link!r} is not a <link>')
-        if joint.child in children:
-            raise LoopError(f'link {joint.child!r} is the child of more than one joint')
-        children.add(joint.child)
-        by_parent.setdefault(joint.parent, []).append(joint)
-    roots = sorted(links - children)
-    if len(roots) != 1:
-        raise LoopError(f'the URDF has {len(roots)} root links {roots}, not one')
-    poses = {roots[0]: Pose(np.eye(3), np.zeros(3))}
+def _tree_joints(tree: UrdfTree) -> tuple[dict[str, TreeJoint], dict[str, Pose]]:
+    """Return every joint at the zero pose, and every link's world pose."""
+    by_parent: dict[str, list[str]] = {}
+    for joint in tree.joints.values():
+        by_parent.setdefault(joint.parent, []).append(joint.name)
+    poses = {tree.root_link: Pose(np.eye(3), np.zeros(3))}
     joints: dict[str, TreeJoint] = {}
-    stack = [roots[0]]
+    stack = [tree.root_link]
     while stack:
         link = stack.pop()
-        for joint in by_parent.get(link, []):
-            where = f'joint {joint.name!r}'
-            origin = joint.origin
-            frame = poses[link].then(
-                np.array(origin.xyz if origin is not None else (0.0, 0.0, 0.0), dtype=float),
-                np.array(origin.rpy if origin is not None else (0.0, 0.0, 0.0), dtype=float))
-            try:
-                joint_type = JointType(joint.type)
-            except ValueError:
-                raise LoopError(f'{where}: unknown type {joint.type!r}') from None
-            axis = np.array(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), float)
-            if joint_type in MOVING_TYPES:
-                axis = _unit(axis, where)
-            joints[joint.name] = TreeJoint(
-                joint.name, joint_type, joint.parent, joint.child, frame, frame.rotation @ axis,
+        for name in by_parent.get(link, []):
+            joint = tree.joints[name]
+            frame = poses[link].then(np.array(joint.origin_translation, dtype=float),
+                                     np.array(joint.origin_rpy, dtype=float))
+            joints[name] = TreeJoint(
+                name, joint.joint_type, joint.parent, joint.child, frame,
+                frame.rotation @ np.array(joint.axis, dtype=float),
                 joint.mimic.joint if joint.mimic is not None else None)
             poses[joint.child] = frame
             stack.append(joint.child)
-    # links reached from the root; any other link with a parent sits on a cycle of joints
-    unreached = sorted(links - set(poses))
-    if unreached:
-        raise LoopError(f'links {unreached} are not reached from the root link {roots[0]!r}: '
-                        'the joints form a cycle')
-    return roots[0], joints, poses
+    return joints, poses
 
 
-def _constraint_side(element: ElementTree.Element, side: str, links: dict[str, Pose],
+def _constraint_side(element: lxml.etree._Element, side: str, links: dict[str, Pose],
                      where: str) -> ConstraintFrame:
     link_element = element.find(side)
     link = link_element.get('link') if link_element is not None else None
@@ -238,7 +185,7 @@ def _constraint_side(element: ElementTree.Element, side: str, links: dict[str, P
     return ConstraintFrame(link, frame, axis)
 
 
-def _constraints(root: ElementTree.Element,
+def _constraints(root: lxml.etree._Element,
                  links: dict[str, Pose]) -> tuple[tuple[Constraint, ...], tuple[str, ...]]:
     """Return the constraints that can be read, and one line for each that cannot."""
     constraints, problems = [], []
@@ -265,17 +212,18 @@ def read_robot(urdf: str) -> Robot:
     Read a URDF's tree at the zero pose and its ``<constraint>`` elements.
 
     Raises LoopError, naming the element, for a text that is not a URDF robot or joints that do
-    not form a tree; a constraint that names an unknown link or holds a malformed number is one
-    line of ``constraint_problems``.
+    not form a tree (urdf_reader's refusals); a constraint that names an unknown link or holds
+    a malformed number is one line of ``constraint_problems``.
     """
-    # bytes: lxml refuses a str that carries an XML encoding declaration, as xacro writes one
-    data = urdf.encode('utf-8')
-    parsed, messages = _parse_tree(data)
-    root, joints, links = _tree_joints(parsed)
-    constraints, problems = _constraints(ElementTree.fromstring(data), links)
-    return Robot(str(parsed.name), root, joints,
+    try:
+        tree = read_urdf(urdf)
+    except UrdfError as error:
+        raise LoopError(str(error)) from None
+    joints, links = _tree_joints(tree)
+    constraints, problems = _constraints(tree.element, links)
+    return Robot(tree.name, tree.root_link, joints,
                  {joint.child: joint for joint in joints.values()}, links, constraints, problems,
-                 messages)
+                 tree.parser_messages)
 
 
 def tree_path(robot: Robot, start: str, end: str) -> list[tuple[TreeJoint, bool]]:

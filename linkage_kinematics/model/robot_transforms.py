@@ -4,8 +4,9 @@
 """
 The transforms robot_state_publisher publishes for a URDF and a joint state.
 
-A pure module (the standard library only): ``RobotTransforms`` reads a URDF's joints and computes,
-as robot_state_publisher (Jazzy) does through kdl_parser and KDL,
+A pure module: ``RobotTransforms`` takes a URDF's joints as ``urdf_reader`` reads them (with
+urdf_parser_py, as robot_state_publisher reads them with urdfdom) and computes, as
+robot_state_publisher (Jazzy) does through kdl_parser and KDL,
 
 * for each fixed joint, the transform parent link → child link, published once on /tf_static
   (kdl_parser turns ``floating`` and ``planar`` joints into fixed ones, so they are fixed here
@@ -28,32 +29,10 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-import enum
 import math
 from typing import Any
-import xml.etree.ElementTree as ElementTree
 
-Vector = tuple[float, float, float]
-Quaternion = tuple[float, float, float, float]  # x, y, z, w
-
-
-class UrdfError(ValueError):
-    """The URDF text cannot be read as a robot's joints; the message says what is wrong."""
-
-
-class JointType(enum.Enum):
-    """URDF joint types."""
-
-    FIXED = 'fixed'
-    REVOLUTE = 'revolute'
-    CONTINUOUS = 'continuous'
-    PRISMATIC = 'prismatic'
-    FLOATING = 'floating'
-    PLANAR = 'planar'
-
-
-# kdl_parser gives floating and planar joints no degree of freedom: they stay at their origin.
-MOVABLE_TYPES = frozenset({JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC})
+from linkage_kinematics.model.urdf_reader import Quaternion, read_urdf, UrdfJoint, Vector
 
 
 @dataclass(frozen=True)
@@ -64,37 +43,6 @@ class Transform:
     child_frame: str
     translation: Vector
     rotation: Quaternion
-
-
-@dataclass(frozen=True)
-class Mimic:
-    """A mimic joint's position = multiplier · (the position of ``joint``) + offset."""
-
-    joint: str
-    multiplier: float
-    offset: float
-
-
-@dataclass(frozen=True)
-class UrdfJoint:
-    """A URDF joint: its links, origin, unit axis and mimic."""
-
-    name: str
-    joint_type: JointType
-    parent: str
-    child: str
-    origin_translation: Vector
-    origin_rotation: Quaternion
-    axis: Vector
-    mimic: Mimic | None
-
-    @property
-    def movable(self) -> bool:
-        return self.joint_type in MOVABLE_TYPES
-
-    @property
-    def revolute(self) -> bool:
-        return self.joint_type in (JointType.REVOLUTE, JointType.CONTINUOUS)
 
 
 def quaternion_product(first: Quaternion, second: Quaternion) -> Quaternion:
@@ -118,115 +66,24 @@ def rotate(rotation: Quaternion, vector: Vector) -> Vector:
     return (x, y, z)
 
 
-def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
-    """Return the quaternion of URDF's rpy (about fixed x, y, z, in that order), as urdfdom."""
-    sr, cr = math.sin(0.5 * roll), math.cos(0.5 * roll)
-    sp, cp = math.sin(0.5 * pitch), math.cos(0.5 * pitch)
-    sy, cy = math.sin(0.5 * yaw), math.cos(0.5 * yaw)
-    x = sr * cp * cy - cr * sp * sy
-    y = cr * sp * cy + sr * cp * sy
-    z = cr * cp * sy - sr * sp * cy
-    w = cr * cp * cy + sr * sp * sy
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    return (x / norm, y / norm, z / norm, w / norm)
-
-
-def parse_vector(text: str | None, default: Vector, where: str) -> Vector:
-    """
-    Return a URDF attribute of three numbers (xyz, rpy, an axis), ``default`` where it is absent.
-
-    Raises UrdfError naming ``where`` for anything but three finite numbers.
-    """
-    if text is None:
-        return default
-    try:
-        values = tuple(float(word) for word in text.split())
-    except ValueError:
-        raise UrdfError(f'{where}: {text!r} is not three numbers') from None
-    if len(values) != 3 or not all(math.isfinite(value) for value in values):
-        raise UrdfError(f'{where}: {text!r} is not three finite numbers')
-    return values  # type: ignore[return-value]
-
-
-def _parse_joint(element: ElementTree.Element, links: set[str]) -> UrdfJoint:
-    name = element.get('name')
-    if not name:
-        raise UrdfError('a <joint> has no name')
-    where = f'joint {name!r}'
-    try:
-        joint_type = JointType(element.get('type'))
-    except ValueError:
-        raise UrdfError(f"{where}: unknown type {element.get('type')!r}") from None
-    ends = []
-    for tag in ('parent', 'child'):
-        end = element.find(tag)
-        link = end.get('link') if end is not None else None
-        if not link:
-            raise UrdfError(f'{where}: no <{tag} link="…"/>')
-        if link not in links:
-            raise UrdfError(f'{where}: {tag} link {link!r} is not a <link> of the robot')
-        ends.append(link)
-    origin = element.find('origin')
-    xyz = parse_vector(origin.get('xyz') if origin is not None else None, (0.0, 0.0, 0.0),
-                       f'{where} origin xyz')
-    rpy = parse_vector(origin.get('rpy') if origin is not None else None, (0.0, 0.0, 0.0),
-                       f'{where} origin rpy')
-    axis_element = element.find('axis')
-    axis = parse_vector(axis_element.get('xyz') if axis_element is not None else None,
-                        (1.0, 0.0, 0.0), f'{where} axis xyz')
-    length = math.sqrt(sum(component * component for component in axis))
-    if joint_type in MOVABLE_TYPES and length == 0.0:
-        raise UrdfError(f'{where}: the axis is zero')
-    if length > 0.0:
-        axis = (axis[0] / length, axis[1] / length, axis[2] / length)
-    mimic = None
-    mimic_element = element.find('mimic')
-    if mimic_element is not None:
-        try:
-            mimic = Mimic(mimic_element.get('joint', ''),
-                          float(mimic_element.get('multiplier', '1')),
-                          float(mimic_element.get('offset', '0')))
-        except ValueError:
-            raise UrdfError(f'{where}: mimic multiplier or offset is not a number') from None
-    return UrdfJoint(name, joint_type, ends[0], ends[1], xyz, quaternion_from_rpy(*rpy), axis,
-                     mimic)
-
-
 class RobotTransforms:
     """
     The joints of one URDF, and the transforms robot_state_publisher publishes for them.
 
-    Raises UrdfError for a text that is not a URDF robot, or whose joints do not form a tree.
+    Raises urdf_reader.UrdfError for a text that is not a URDF robot, or whose joints do not
+    form a tree.
     """
 
     def __init__(self, urdf: str, frame_prefix: str = '') -> None:
-        try:
-            robot = ElementTree.fromstring(urdf)
-        except ElementTree.ParseError as error:
-            raise UrdfError(f'the URDF is not XML: {error}') from None
-        if robot.tag != 'robot':
-            raise UrdfError(f'the URDF root element is <{robot.tag}>, not <robot>')
-        links = {link.get('name', '') for link in robot.findall('link')}
-        joints = sorted((_parse_joint(element, links) for element in robot.findall('joint')),
-                        key=lambda joint: joint.name)
-        children = [joint.child for joint in joints]
-        doubled = sorted({child for child in children if children.count(child) > 1})
-        if doubled:
-            raise UrdfError(f'links {doubled} have more than one parent joint')
-        roots = sorted(links - set(children))
-        if len(roots) != 1:
-            raise UrdfError(f'the URDF has {len(roots)} root links {roots}, not one')
-        self.root_link: str = roots[0]
+        tree = read_urdf(urdf)
+        self.root_link: str = tree.root_link
         self.frame_prefix = frame_prefix
-        self.joints: dict[str, UrdfJoint] = {joint.name: joint for joint in joints}
-        for joint in joints:
-            if joint.mimic is not None and joint.mimic.joint not in self.joints:
-                raise UrdfError(f'joint {joint.name!r} mimics {joint.mimic.joint!r}, which is '
-                                'not a joint of the robot')
+        # robot_state_publisher keeps its joints in maps keyed by name
+        self.joints: dict[str, UrdfJoint] = dict(sorted(tree.joints.items()))
 
     @property
     def driven_joints(self) -> tuple[str, ...]:
-        """Return the movable joints a joint state sets, in URDF order (mimic joints follow)."""
+        """Return the movable joints a joint state sets, in name order (mimic joints follow)."""
         return tuple(name for name, joint in self.joints.items()
                      if joint.movable and joint.mimic is None)
 

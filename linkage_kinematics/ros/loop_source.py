@@ -20,7 +20,7 @@ import math
 from typing import Any, Callable, Protocol
 
 from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.robot_transforms import UrdfError
+from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
     MEASURED_QOS,

@@ -286,7 +286,7 @@ class RobotStateTransforms:
     The /tf_static and /tf messages robot_state_publisher publishes for one URDF, as bytes.
 
     With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
-    robot_transforms.UrdfError for a URDF it cannot read. The /tf of a joint state is written
+    urdf_reader.UrdfError for a URDF it cannot read. The /tf of a joint state is written
     from the joints' prepared transforms (``RobotTransforms.moving``) and a prepared message,
     both made again only when the joint state's names change.
     """
