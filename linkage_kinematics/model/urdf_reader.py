@@ -190,6 +190,32 @@ def _parse_problem(robot: lxml.etree._Element, error: xml_reflection_core.ParseE
     return f'{where}: {_plain_cause(error.e, text)}'
 
 
+def _unplaced_problem(robot: lxml.etree._Element, error: Exception) -> str:
+    """
+    Return, as ``_parse_problem`` does, an error urdf_parser_py raised without its path.
+
+    It wraps only an attribute's errors in a ParseError; an element read from one attribute
+    (``<axis xyz>``, ``<mass value>``: its SimpleElementType) raises plainly. The element is
+    the innermost ``path`` of the parser's frames, the attribute that type's.
+    """
+    path, attribute = None, None
+    trace = error.__traceback__
+    while trace is not None:
+        local = trace.tb_frame.f_locals
+        if isinstance(local.get('path'), xml_reflection_core.Path):
+            path = local['path']
+        if isinstance(local.get('self'), xml_reflection_core.SimpleElementType):
+            attribute = local['self'].attribute
+        trace = trace.tb_next
+    if path is None:  # e.g. an unsupported URDF version
+        return 'urdf_parser_py cannot read the URDF: ' + ' '.join(str(error).split('\n'))
+    if attribute is not None:
+        path = xml_reflection_core.Path(path.tag, path.parent, f'{path.suffix}[@{attribute}]')
+        if isinstance(error, AttributeError):  # None.split(): the attribute is missing
+            error = ValueError(f'Required attribute not set in XML: {attribute}')
+    return _parse_problem(robot, xml_reflection_core.ParseError(error, path))
+
+
 def _plain_cause(cause: Exception, text: str | None) -> str:
     """Return urdf_parser_py's reason in plain words, ``text`` the attribute's, if any."""
     message = ' '.join(str(cause).split('\n'))
@@ -304,14 +330,17 @@ def read_urdf(urdf: str) -> UrdfTree:
         raise UrdfError(f'the URDF is not XML: {error}') from None
     if robot.tag != 'robot':  # urdf_parser_py reads any root element as a robot
         raise UrdfError(f'the URDF root element is <{robot.tag}>, not <robot>')
+    # urdf_parser_py reads a <parent/> or <child/> without its link attribute as link 'None'
+    for end in robot.iterfind('joint/*'):
+        if end.tag in ('parent', 'child') and end.get('link') is None:
+            raise UrdfError(f"joint {end.getparent().get('name')!r} {end.tag}: no link attribute")
     with _parser_messages() as messages:
         try:
             parsed = urdf_parser.Robot.from_xml(robot, xml_reflection_core.Path('robot'))
         except xml_reflection_core.ParseError as error:
             raise UrdfError(_parse_problem(robot, error)) from None
-        except Exception as error:  # e.g. an unsupported version; an <axis> without xyz
-            raise UrdfError('urdf_parser_py cannot read the URDF: '
-                            + ' '.join(str(error).split('\n'))) from None
+        except Exception as error:  # raised outside its path bookkeeping
+            raise UrdfError(_unplaced_problem(robot, error)) from None
     # urdf_parser_py reads each element on its own; what urdfdom's parseURDF then checks of the
     # whole (names unique, joints' links known, mimics' joints known, one root, a tree) and
     # what kdl_parser needs of a joint is checked here.
