@@ -234,6 +234,8 @@ class RobotLoopsSubscription:
     def reset(self) -> ServiceAnswer:
         """Start the motion afresh at the next valid message."""
         self.restart()
+        self._show_activity()
+        self._host.publish_diagnostics()  # as ~/pause and ~/resume: the status says what now
         paused = self._host.control.paused
         return ServiceAnswer(True, 'the motion starts afresh at the next valid sample' + (
             '; paused: ~/resume follows it' if paused else ''))
