@@ -39,11 +39,11 @@ from mcap.writer import Writer
 # publish time (mcap's Message.write, field by field).
 MESSAGE_HEADER = struct.Struct('<BQHIQQ')
 MESSAGE_OPCODE = Opcode.MESSAGE
+_RECORD_PREFIX = 9  # every record's opcode and record length
 # The record length of a message besides its data: channel id to publish time.
-MESSAGE_FIELDS_SIZE = MESSAGE_HEADER.size - 9
+MESSAGE_FIELDS_SIZE = MESSAGE_HEADER.size - _RECORD_PREFIX
 # What an index entry and a split need of a record: its length, channel, log and publish time.
 _RECORD_FIELDS = struct.Struct('<xQH4xQQ')
-_RECORD_PREFIX = 9  # opcode and record length
 _INDEX_HEADER = struct.Struct('<BQHI')  # opcode, record length, channel id, entries' length
 Records = bytes | bytearray  # Message records, one after the other
 
