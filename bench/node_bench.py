@@ -242,12 +242,135 @@ def _tick_parts(logging_node: Any, quiet_node: Any, bare_publisher: Any,
     }
 
 
-def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, dict[str, float]]:
+# --- logging one message: CPU of the node's side and of its bag writer's ------------------
+
+def _logged_messages(logging_node: Any) -> list[tuple[str, str, bytes]]:
+    """Return what a tick of the 1 kHz timer node logs: joint_states, /tf, linkage/state."""
+    from linkage_kinematics.kinematics.solver import solve
+    from linkage_kinematics.model.joints import DEFAULT_JOINT_NAMES, Driver, tree_values
+    from linkage_kinematics.ros import messages
+
+    config, outputs = logging_node.config, logging_node.outputs
+    state = solve(config.linkage, 0.3, config.drive, config.branch)
+    positions, velocities = tree_values(state, Driver.CRANK)
+    names = list(DEFAULT_JOINT_NAMES.values())
+    stamp_ns = logging_node.get_clock().now().nanoseconds
+    transforms = outputs._robot_transforms.message(dict(zip(names, positions)), stamp_ns)
+    return [
+        ('/joint_states', 'sensor_msgs/msg/JointState',
+         messages.JointStateEncoder(names).encode(stamp_ns, positions, velocities)),
+        ('/tf', 'tf2_msgs/msg/TFMessage', transforms),
+        ('/linkage/state', 'trajectory_msgs/msg/JointTrajectory',
+         messages.LinkageStateEncoder(config.linkage, config.frame_id).encode(
+             state, stamp_ns, 0.0)),
+    ]
+
+
+def _cpu_per_message(workloads: dict[str, Callable[[], int]],
+                     repetitions: int) -> dict[str, float]:
+    """Median CPU seconds (this process's) per message of each workload, timed in turn."""
+    samples: dict[str, list[float]] = {name: [] for name in workloads}
+    for _ in range(repetitions):
+        for name, workload in workloads.items():
+            start = time.process_time()
+            count = workload()
+            samples[name].append((time.process_time() - start) / count)
+    return {name: statistics.median(values) for name, values in samples.items()}
+
+
+def logging_cost(logging_node: Any, ticks: int, repetitions: int) -> str:
+    """
+    CPU per logged message: ``Recorder.record`` in the node, and its bag writer's work.
+
+    The writer's side in this process: ``_Child._write_messages`` of the batches the node
+    hands over (``BATCH_SIZE`` bytes of MCAP Message records), with the chunk flush and the size
+    report the child makes once a second at 1 kHz; beside it the same messages through mcap's
+    own ``Writer.add_message``, the per-message path the child ran before ``mcap_chunk``.
+    """
+    import io
+    from linkage_kinematics.bag.definitions import message_definition
+    from linkage_kinematics.bag.mcap_chunk import message_record
+    from linkage_kinematics.bag.writer_process import _Child, BATCH_SIZE
+    from mcap.writer import Writer
+
+    logged = _logged_messages(logging_node)
+    recorder = logging_node.outputs.recorder
+    per_second = 1000  # ticks: the child flushes its chunk and reports the size once a second
+
+    def record() -> int:
+        for tick in range(ticks):
+            for topic, _, data in logged:
+                recorder.record(topic, data, tick)
+        return ticks * len(logged)
+
+    with tempfile.TemporaryDirectory(prefix='linkage_bench_log_') as folder:
+        replies = io.BytesIO()
+        child = _Child(io.BytesIO(), replies)
+        child._start({'folder': folder, 'metadata': {}, 'split': {'max_bag_size': 0,
+                                                                  'max_bag_duration_ns': 0}})
+        for topic, type_name, _ in logged:
+            child._add_topic({'topic': topic, 'type_name': type_name,
+                              'message_definition': message_definition(type_name),
+                              'offered_qos_profiles': [], 'repeat_latest': False})
+        channels = [json.loads(line)['channel'] for line in replies.getvalue().splitlines()
+                    if 'channel' in json.loads(line)]
+        records = [message_record(channel, tick, tick, data)
+                   for tick in range(ticks) for channel, (_, _, data) in zip(channels, logged)]
+        batches, batch = [], b''
+        for start in range(0, len(records), per_second * len(logged)):
+            for message in records[start:start + per_second * len(logged)]:
+                batch += message
+                if len(batch) >= BATCH_SIZE:
+                    batches.append(batch)
+                    batch = b''
+            batches += [batch, None] if batch else [None]  # None: a second has passed
+            batch = b''
+        reference_file = open(os.path.join(folder, 'add_message.mcap'), 'wb')
+        reference = Writer(reference_file)
+        reference.start()
+        schema = reference.register_schema('s', 'ros2msg', b'')
+        for topic, _, _ in logged:
+            reference.register_channel(topic, 'cdr', schema)
+
+        def write_batches() -> int:
+            for frame in batches:
+                if frame is None:
+                    child._writer.flush()
+                    child._writer.finished_size()
+                else:
+                    child._write_messages(frame)
+            return len(records)
+
+        def add_message() -> int:
+            for tick in range(ticks):
+                for channel, (_, _, data) in zip(channels, logged):
+                    reference.add_message(channel, tick, data, tick)
+                if tick % per_second == per_second - 1:
+                    reference.flush()
+            return len(records)
+
+        times = _cpu_per_message({
+            "node: Recorder.record (the pipe's os.write once per batch)": record,
+            "bag writer: _Child._write_messages of the node's batches": write_batches,
+            "  the same messages through mcap's Writer.add_message": add_message,
+        }, repetitions)
+        child._close()
+        reference.finish()
+        reference_file.close()
+    rows = [[name, format_seconds(seconds)] for name, seconds in times.items()]
+    sizes = ', '.join(f'{topic} {len(data)} B' for topic, _, data in logged)
+    return (f"Logging one message, CPU per message ({sizes}; the node's three per tick, "
+            f'{ticks} ticks; `time.process_time`, median of {repetitions}):\n\n'
+            + markdown_table(['part', 'CPU per message'], rows))
+
+
+def tick_split(quick: bool, repetitions: int,
+               domain_base: int) -> tuple[str, dict[str, float], str]:
     """
     Median time of each part of the node's tick and of a bare rclpy publish, side by side.
 
     A listener in another process subscribes to /joint_states and to the bare publisher's
-    topic, so both publishes really send over loopback.
+    topic, so both publishes really send over loopback. Then ``logging_cost``.
     """
     os.environ.update(ros_environment(domain_base + DOMAIN_SPLIT))
     from linkage_kinematics.ros.node import LinkageNode
@@ -276,6 +399,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
             parts = _tick_parts(logging_node, quiet_node, bare_publisher, count)
             time.sleep(STARTUP_S)  # let the listener match both publishers
             times = interleaved_medians(parts, repetitions)
+            logging = logging_cost(logging_node, count * 10, repetitions)
         finally:
             for node in nodes:
                 if isinstance(node, LinkageNode):
@@ -289,7 +413,7 @@ def tick_split(quick: bool, repetitions: int, domain_base: int) -> tuple[str, di
     rows = [[name, format_seconds(seconds), f'{seconds / bare_time:.2f}×']
             for name, seconds in times.items()]
     table = markdown_table(['part of a tick', 'time (median)', '× bare publish'], rows)
-    return table, times
+    return table, times, logging
 
 
 # --- rates, jitter, latency and log size from node processes --------------------------------
@@ -390,7 +514,7 @@ def rate_text(rate: float | None) -> str:
 
 def run(quick: bool, repetitions: int, domain_base: int) -> str:
     """Return the node section as markdown."""
-    split, times = tick_split(quick, repetitions, domain_base)
+    split, times, logging_text = tick_split(quick, repetitions, domain_base)
     with_logging = times['whole tick, logging on (DriveLawTimer.tick)']
     ratio = with_logging / times['bare rclpy publish of the same JointState']
     logging_share = with_logging / times['whole tick, logging off (DriveLawTimer.tick)']
@@ -398,7 +522,8 @@ def run(quick: bool, repetitions: int, domain_base: int) -> str:
              '/joint_states and the bare topic):', '', split, '',
              f'- whole tick with logging / bare publish = {ratio:.2f}× (goal ≤ 2×: '
              f"{'met' if ratio <= 2.0 else 'missed'})",
-             f'- whole tick with logging / without = {logging_share:.2f}×', '']
+             f'- whole tick with logging / without = {logging_share:.2f}×', '',
+             logging_text, '']
     seconds = 4.0 if quick else 8.0
     rates = (100.0, 500.0, 1000.0) if quick else (100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0)
     rows = []

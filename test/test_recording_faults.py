@@ -68,7 +68,7 @@ def udp_only(monkeypatch: pytest.MonkeyPatch) -> None:
 
 # The bag writer's flush interval (1 s) plus one tick and scheduling slack.
 MAX_LOSS_AT_KILL_NS = 1_500_000_000
-# The node's last batch (16 messages, at most 50 ms old) plus scheduling slack.
+# The node's last batch (at most 16 KiB and 50 ms old) plus scheduling slack.
 MAX_LOSS_AT_NODE_KILL_NS = 500_000_000
 # A second's chunk of a 1 kHz run (about 260 KB with /tf) fits, the next one does not.
 FILE_SIZE_LIMIT_BYTES = 512 * 1024
@@ -178,7 +178,7 @@ def test_sigkill_of_the_node_leaves_a_finished_bag_with_all_it_handed_over(
     """
     Return the bag writer outlives a killed node.
 
-    It writes what the node handed over (all but the last batch of at most 16 messages or 50 ms),
+    It writes what the node handed over (all but the last batch of at most 16 KiB or 50 ms),
     the summary and the final metadata.yaml.
     """
     folder = tmp_path / 'bags'

@@ -19,6 +19,9 @@ it starts with the latest message of each topic added with ``repeat_latest`` (wh
 later named ``--repeat-transient-local``), logged at the time of the file's first message, so
 that every file opens alone.
 
+Messages go into the open chunk as Message records packed once (``mcap_chunk``; mcap's
+writer writes all else), from ``write`` or, as the bag writer's node packs them, ``write_records``.
+
 Crash safety: the Python mcap writer keeps the open chunk in memory until it is full (and this
 writer queues up to ``WRITE_BATCH`` messages before adding them to it), so the writer also ends
 the chunk and flushes the OS file once ``flush_interval`` has passed; a killed process loses at
@@ -39,6 +42,7 @@ from typing import Any, BinaryIO
 
 from linkage_kinematics.bag.definitions import SCHEMA_ENCODING, type_description_hash
 from linkage_kinematics.bag.errors import BagError, BagExistsError
+from linkage_kinematics.bag.mcap_chunk import message_record, MessageChunk, record_fields, Records
 from linkage_kinematics.bag.metadata import (
     BagMetadata,
     FileInfo,
@@ -71,8 +75,8 @@ METADATA_RECORD_NAME = PACKAGE_NAME
 ROSBAG2_METADATA_RECORD_NAME = 'rosbag2'
 PROFILE = 'ros2'
 DEFAULT_CHUNK_SIZE = 1024 * 1024
-# Messages queued before they go into the MCAP chunk together (see BagWriter._add_queued): at
-# 5 kHz, 16 messages are 8 ticks, and adding them takes well under one tick's period.
+# Messages ``write`` queues before they go into the MCAP chunk together (a run of records
+# costs less per message than one).
 WRITE_BATCH = 16
 _COMPRESSION = {
     'zstd': CompressionType.ZSTD, 'lz4': CompressionType.LZ4, 'none': CompressionType.NONE
@@ -118,6 +122,8 @@ class _Span:
         self.count = 0
 
     def add(self, log_times: list[int]) -> None:
+        if not log_times:
+            return
         low, high = min(log_times), max(log_times)
         self.start_ns = low if self.start_ns is None else min(self.start_ns, low)
         self.end_ns = max(self.end_ns, high)
@@ -166,6 +172,7 @@ class _McapFile:
         self.stream: BinaryIO = open(path, 'xb')
         try:
             self.writer = Writer(self.stream, chunk_size=chunk_size, compression=compression)
+            self.chunk = MessageChunk.attach(self.writer, chunk_size)
             self.writer.start(
                 profile=PROFILE,
                 library=f'{PACKAGE_NAME}/{package_version()} {LIBRARY_IDENTIFIER}',
@@ -347,17 +354,10 @@ class BagWriter:
     ``max_bag_duration_ns`` split the bag into files (``NO_SPLIT``: never).
     """
 
-    def __init__(
-        self,
-        bag_path: Path | str,
-        *,
-        metadata: Mapping[str, str],
-        compression: str = 'zstd',
-        chunk_size: int = DEFAULT_CHUNK_SIZE,
-        flush_interval: float = 1.0,
-        max_bag_size: int = NO_SPLIT,
-        max_bag_duration_ns: int = NO_SPLIT,
-    ) -> None:
+    def __init__(self, bag_path: Path | str, *, metadata: Mapping[str, str],
+                 compression: str = 'zstd', chunk_size: int = DEFAULT_CHUNK_SIZE,
+                 flush_interval: float = 1.0, max_bag_size: int = NO_SPLIT,
+                 max_bag_duration_ns: int = NO_SPLIT) -> None:
         _check_options(metadata, compression, chunk_size, flush_interval, max_bag_size,
                        max_bag_duration_ns)
         self.bag_path = Path(bag_path)
@@ -371,7 +371,7 @@ class BagWriter:
         self._listing = _BagListing(self.bag_path, self.custom_data)
         self._definitions: dict[str, str] = {}
         self._repeated = RepeatedTopics()
-        self._queued: list[tuple[int, int, bytes, int]] = []
+        self._queued: list[bytes] = []  # Message records
         self._last_flush = time.monotonic()
         self._failure: BagError | None = None
         self._closed = False
@@ -432,9 +432,18 @@ class BagWriter:
         self._check_writable()
         if channel_id not in self._listing.topics:
             raise ValueError(f'unknown channel id {channel_id} in bag {self.bag_path}')
-        self._queued.append((channel_id, log_time_ns, data, publish_time_ns))
+        self._queued.append(message_record(channel_id, log_time_ns, publish_time_ns, data))
         if len(self._queued) >= WRITE_BATCH:
             self._add_queued()
+        if time.monotonic() - self._last_flush >= self._flush_interval:
+            self.flush()
+
+    def write_records(self, records: Records) -> None:
+        """``write`` of each Message record (``mcap_chunk.message_record``) in turn."""
+        self._check_writable()
+        if self._queued:
+            self._add_queued()
+        self._add_records(records)
         if time.monotonic() - self._last_flush >= self._flush_interval:
             self.flush()
 
@@ -499,31 +508,28 @@ class BagWriter:
         return _McapFile(path, self.custom_data, topics, *self._file_options)
 
     def _add_queued(self) -> None:
-        """
-        Hand the queued messages to the MCAP writer's open chunk, in one go.
+        queued, self._queued = b''.join(self._queued), []
+        self._add_records(queued)
 
-        The writer's Python then runs warm, at about a third of its cost per message when called
-        once per message between ticks. A split bag checks before each message whether it
-        starts the next file.
-        """
-        queued, self._queued = self._queued, []
+    def _add_records(self, records: Records) -> None:
+        """Add Message records to the open chunk; a split bag checks each for the next file."""
         counts = self._listing.pending_counts
         try:
             if not self._splits:
-                add_message = self._file.writer.add_message
-                for channel_id, log_time_ns, data, publish_time_ns in queued:
-                    add_message(channel_id, log_time_ns, data, publish_time_ns)
-                    counts[channel_id] = counts.get(channel_id, 0) + 1
-                self._file.pending.add([entry[1] for entry in queued])
+                self._file.pending.add(
+                    self._file.chunk.add_records(records, 0, len(records), counts))
                 return
-            for channel_id, log_time_ns, data, publish_time_ns in queued:
+            offset = 0
+            while offset < len(records):
+                end, channel_id, log_time_ns, publish_time_ns, data_start = record_fields(
+                    records, offset)
                 if self._file.ends_before(log_time_ns, self._max_size, self._max_duration_ns):
                     self._split(log_time_ns)
-                self._file.writer.add_message(channel_id, log_time_ns, data, publish_time_ns)
-                counts[channel_id] = counts.get(channel_id, 0) + 1
-                self._file.pending.add([log_time_ns])
+                self._file.pending.add(self._file.chunk.add_records(records, offset, end, counts))
                 self._file.new_messages += 1
-                self._repeated.remember(channel_id, data, publish_time_ns)
+                self._repeated.remember(channel_id, bytes(records[data_start:end]),
+                                        publish_time_ns)
+                offset = end
         except BagError:
             raise  # the next file could not be opened (_split); the bag has stopped
         except OSError as error:
@@ -551,8 +557,7 @@ class BagWriter:
         self.mcap_path = next_path
         counts = self._listing.pending_counts
         for channel_id, data, publish_time_ns in self._repeated.latest():
-            self._file.writer.add_message(channel_id, log_time_ns, data, publish_time_ns)
-            counts[channel_id] = counts.get(channel_id, 0) + 1
+            self._file.chunk.add(channel_id, log_time_ns, data, publish_time_ns, counts)
             self._file.pending.add([log_time_ns])
         self._listing.write_metadata_yaml(self._file)
 

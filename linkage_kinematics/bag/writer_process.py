@@ -18,11 +18,12 @@ metadata.yaml, then exits. It runs in a session of its own, so a Ctrl-C meant fo
 
 Frames on the child's stdin: one kind byte, a uint32 length, the payload. ``S`` (JSON:
 folder, metadata, split) opens a new bag folder ``rosbag2_<local time>[_<n>]`` in folder; ``T``
-(JSON) adds a topic; ``M`` holds messages, each a ``<HqqI`` header (channel id, log time,
-publish time, length) and its bytes; ``F`` (empty) asks the child to write out everything it
-holds. The child answers on stdout with JSON lines: ``bag`` or ``channel`` for S and T,
-``size`` (the size the finished bag would have, ``BagWriter.finished_size``) now and then and
-with ``flushed`` for F, ``error`` when the bag cannot go on, and ``closed`` when it is done.
+(JSON) adds a topic; ``M`` holds messages, each as its MCAP Message record (``mcap_chunk``), so
+that the child copies them into the open chunk as they are; ``F`` (empty) asks the child to
+write out everything it holds. The child answers on stdout with JSON lines: ``bag`` or
+``channel`` for S and T, ``size`` (the size the finished bag would have,
+``BagWriter.finished_size``) now and then and with ``flushed`` for F, ``error`` when the bag
+cannot go on, and ``closed`` when it is done.
 
 Plain Python (no rclpy), as ``writer``.
 """
@@ -40,15 +41,17 @@ import time
 from typing import Any, BinaryIO
 
 from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
-from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
+from linkage_kinematics.bag.mcap_chunk import MESSAGE_FIELDS_SIZE, MESSAGE_HEADER, MESSAGE_OPCODE
+from linkage_kinematics.bag.writer import BagWriter
 from linkage_kinematics.run.limits import NO_SPLIT
 from linkage_kinematics.run.placement import set_process_affinity
 
 _FRAME = struct.Struct('<cI')
-_MESSAGE = struct.Struct('<HqqI')
 START, TOPIC, MESSAGES, FLUSH = b'S', b'T', b'M', b'F'
-# The pipe holds a batch for at most this long (s), so that a node killed outright loses at
-# most its last batch of this age, even at low rates.
+# The node hands over its queued messages once they are this many bytes (well under the
+# pipe's 64 KiB, so that a write rarely waits for the child), or older than BATCH_AGE (s):
+# a node killed outright loses at most its last batch, of this age, even at low rates.
+BATCH_SIZE = 16384
 BATCH_AGE = 0.05
 SIZE_REPORT_INTERVAL = 0.25  # s between the child's reports of the file size
 CLOSE_TIMEOUT = 60.0  # s for the child to write the summary once the pipe is closed
@@ -80,7 +83,6 @@ class BagWriterProcess:
         self._input = self._process.stdin.fileno()
         self._replies = b''
         self._queued = bytearray()
-        self._queued_count = 0
         self._batch_started = time.monotonic()
         self._failure: str | None = None
         self._closed = False
@@ -118,10 +120,10 @@ class BagWriterProcess:
         """Queues one serialized message; a full or old batch goes to the child."""
         if self._failure is not None or self._closed:
             raise BagError(self._failure or f'bag {self.bag_path} is closed')
-        self._queued += _MESSAGE.pack(channel_id, log_time_ns, publish_time_ns, len(data))
+        self._queued += MESSAGE_HEADER.pack(MESSAGE_OPCODE, MESSAGE_FIELDS_SIZE + len(data),
+                                            channel_id, 0, log_time_ns, publish_time_ns)
         self._queued += data
-        self._queued_count += 1
-        if (self._queued_count >= WRITE_BATCH
+        if (len(self._queued) >= BATCH_SIZE
                 or time.monotonic() - self._batch_started >= BATCH_AGE):
             self._send_queued()
 
@@ -199,7 +201,6 @@ class BagWriterProcess:
         if self._failure is not None:
             raise BagError(self._failure)
         batch, self._queued = self._queued, bytearray()
-        self._queued_count = 0
         self._batch_started = time.monotonic()
         self._send(MESSAGES, batch)
 
@@ -335,16 +336,9 @@ class _Child:
     def _write_messages(self, batch: bytes) -> None:
         if self._failed:
             return  # the node was told; it stops sending once it reads that
-        offset = 0
-        unpack = _MESSAGE.unpack_from
-        write = self._writer.write
         try:
-            while offset < len(batch):
-                channel_id, log_time_ns, publish_time_ns, length = unpack(batch, offset)
-                offset += _MESSAGE.size
-                write(channel_id, batch[offset:offset + length], log_time_ns, publish_time_ns)
-                offset += length
-        except BagError as error:
+            self._writer.write_records(batch)
+        except (BagError, ValueError) as error:
             self._failed = True
             self._reply(error=str(error))
             return
