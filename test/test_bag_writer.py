@@ -25,9 +25,9 @@ from linkage_kinematics.bag import reader as bag_reader
 from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
 from linkage_kinematics.bag.definitions import DEFINITION_SEPARATOR, message_definition
 from linkage_kinematics.bag.errors import BagExistsError
-from linkage_kinematics.bag.metadata import offered_qos_profiles_for, package_version
+from linkage_kinematics.bag.metadata import offered_qos_profiles_for, package_version, yaml_text
 from linkage_kinematics.bag.recorder import Recorder
-from linkage_kinematics.bag.writer import BagWriter, WRITE_BATCH
+from linkage_kinematics.bag.writer import BagWriter, DEFAULT_CHUNK_SIZE, WRITE_BATCH
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.kinematics.solver import solve
@@ -444,9 +444,13 @@ def test_bag_writer_keeps_every_queued_message_in_order(tmp_path: Path, count: i
     assert information['duration']['nanoseconds'] == 4_000
 
 
-@pytest.mark.parametrize('flushes', [0, 1, 7])
-def test_finished_size_is_the_size_of_the_bag_closed_then(tmp_path: Path, flushes: int) -> None:
-    writer = BagWriter(tmp_path / 'sized', metadata={'run': 'x'}, flush_interval=3600.0)
+@pytest.mark.parametrize('flushes, chunk_size', [(0, DEFAULT_CHUNK_SIZE), (1, DEFAULT_CHUNK_SIZE),
+                                                 (7, DEFAULT_CHUNK_SIZE), (1, 2048)])
+def test_finished_size_is_the_size_of_the_bag_closed_then(tmp_path: Path, flushes: int,
+                                                          chunk_size: int) -> None:
+    """Also where chunks end by size between flushes (chunk_size 2048: about 40 chunks)."""
+    writer = BagWriter(tmp_path / 'sized', metadata={'run': 'x'}, flush_interval=3600.0,
+                       chunk_size=chunk_size)
     channels = [
         writer.add_topic(topic, type_name, message_definition(type_name),
                          offered_qos_profiles_for(QoSProfile(depth=10)))
@@ -481,3 +485,16 @@ def test_recorder_refuses_a_log_folder_under_a_regular_file(tmp_path: Path) -> N
     blocker.write_text('')
     with pytest.raises(OSError, match=re.escape(str(blocker / 'bags'))):
         Recorder(blocker / 'bags', metadata={})
+
+
+def test_the_metadata_text_is_what_pythons_yaml_dumper_writes(tmp_path: Path) -> None:
+    """The metadata's text (``metadata.yaml_text``, libyaml's dumper) is PyYAML's safe_dump's."""
+    writer = BagWriter(tmp_path / 'texts', metadata={'run': 'ünïcode', 'long': 'x ' * 200})
+    channel = writer.add_topic('/a', 'std_msgs/msg/String',
+                               message_definition('std_msgs/msg/String'),
+                               offered_qos_profiles_for(QoSProfile(depth=10)))
+    writer.write(channel, encode_cdr(String(data='a')), 1, 1)
+    writer.close()
+    information = yaml.safe_load((writer.bag_path / 'metadata.yaml').read_text())
+    assert yaml_text(information) == yaml.safe_dump(information, sort_keys=False)
+    assert yaml_text(information) == (writer.bag_path / 'metadata.yaml').read_text()

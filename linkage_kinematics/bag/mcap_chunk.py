@@ -98,6 +98,7 @@ class MessageChunk:
         self.num_messages = 0
         self.message_start_time = 0
         self.message_end_time = 0
+        self.chunks_ended = 0  # each a chunk of the file, and a chunk index in its summary
 
     @classmethod
     def attach(cls, writer: Writer, chunk_size: int) -> MessageChunk:
@@ -140,6 +141,7 @@ class MessageChunk:
 
     def end(self) -> bytes:
         """Return the chunk's records and empty it."""
+        self.chunks_ended += 1
         data = bytes(self._data)
         self._data.clear()
         return data

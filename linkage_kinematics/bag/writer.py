@@ -164,10 +164,8 @@ class _McapFile:
         self.pending = _Span()
         self.new_messages = 0  # besides the repeated ones it starts with
         self._compression = _CHUNK_COMPRESSION[compression]
-        # Bytes of the schema and channel records, which the summary repeats, and the chunks
-        # written so far (each gets a chunk index in the summary).
+        # Bytes of the schema and channel records, which the summary repeats.
         self._registered_size = 0
-        self._chunk_count = 0
         self._schema_ids: dict[str, int] = {}
         self.stream: BinaryIO = open(path, 'xb')
         try:
@@ -223,8 +221,6 @@ class _McapFile:
 
     def flush(self) -> None:
         self.writer.flush()
-        if self.stream.tell() > self.durable_size:
-            self._chunk_count += 1
         self.durable_size = self.stream.tell()
 
     def finished_size(self, serialized_metadata: str, channel_ids: Collection[int]) -> int:
@@ -250,7 +246,7 @@ class _McapFile:
             *[ChunkIndex(chunk_length=0, chunk_start_offset=0, compression=self._compression,
                          compressed_size=0, message_end_time=0, message_index_length=0,
                          message_index_offsets=channel_counts, message_start_time=0,
-                         uncompressed_size=0)] * self._chunk_count,
+                         uncompressed_size=0)] * self.chunk.chunks_ended,
             *[MetadataIndex(offset=0, length=0, name=name)
               for name in (METADATA_RECORD_NAME, ROSBAG2_METADATA_RECORD_NAME)],
             # schemas, channels, statistics, chunk, attachment and metadata indexes
