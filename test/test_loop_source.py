@@ -10,7 +10,7 @@ test's own, so that a paused message is known to have come while paused.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
 
 from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription
 from linkage_kinematics.run.control import RunState
@@ -36,16 +36,12 @@ class LoopsLogger(FakeLogger):
 
 
 class LoopsHost(FakeHost):
-    """The fake host, with raw subscriptions and a logger that also warns."""
+    """The fake host, with a logger that also warns."""
 
     def __init__(self, **overrides: Any) -> None:
         super().__init__(configuration(**{'source': 'measured', 'loops': 'robot_description',
                                           **overrides}))
         self._logger = LoopsLogger(self.record)
-
-    def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
-                            qos_profile: object, *, raw: bool = False) -> object:
-        return super().create_subscription(msg_type, topic, callback, qos_profile)
 
 
 class FakeOutputs:
@@ -157,6 +153,21 @@ def test_descriptions_from_the_topic_are_read_afresh_and_bad_ones_reported() -> 
     host.subscriptions['robot_description'](String(data=KNEE))
     assert node_status(host, source).level is Level.OK
     assert outputs.logged.count('robot') == 2
+
+
+def test_malformed_bytes_are_dropped_counted_and_not_logged() -> None:
+    host, outputs, source = hosted()
+    message = JointState(name=['knee_front'], position=[0.1])
+    data = serialize_message(message)
+    for malformed in (data[:20], b'\x00\x02' + data[2:], b''):
+        host.subscriptions['measured_joint_states'](malformed)
+    assert (outputs.joint_states, outputs.logged) == ([], ['robot'])
+    status = node_status(host, source)
+    assert status.level is Level.WARN
+    assert status.message == 'dropped 3 messages whose bytes are not a well-formed JointState'
+    assert status.values['dropped whose bytes are not a well-formed JointState'] == '3'
+    send(host, START_NS, 0.1)  # the next good message is followed
+    assert [stamp for stamp, _ in outputs.joint_states] == [START_NS]
 
 
 def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None:

@@ -46,6 +46,7 @@ class LoopRejection(StrEnum):
     STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
     UNREACHABLE = 'at joint values a loop cannot reach (or at a dead point)'
     JUMP = 'jumping further than measured.max_jump'
+    MALFORMED = 'whose bytes are not a well-formed JointState'
 
 
 @dataclass(frozen=True)
