@@ -30,7 +30,6 @@ from linkage_kinematics.kinematics.planar_loop import (
     known_joint_range,
     UnreachableError,
 )
-from linkage_kinematics.kinematics.solver import unwrap_near
 from linkage_kinematics.model.loop_geometry import derive_loop, Loop, LoopJoint
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 
@@ -244,17 +243,20 @@ class LoopSolver:
         """
         values = {}
         rates = {}
+        isfinite = math.isfinite
         for name in self.plan.measured:
             if name not in positions or name not in velocities:
                 raise LoopSampleError(f'no position and velocity for measured joint {name!r}')
-            values[name], rates[name] = float(positions[name]), float(velocities[name])
-            if not (math.isfinite(values[name]) and math.isfinite(rates[name])):
-                raise LoopSampleError(f'measured joint {name!r}: position {values[name]} and '
-                                      f'velocity {rates[name]} are not both finite')
+            value = values[name] = float(positions[name])
+            rate = rates[name] = float(velocities[name])
+            if not (isfinite(value) and isfinite(rate)):
+                raise LoopSampleError(f'measured joint {name!r}: position {value} and '
+                                      f'velocity {rate} are not both finite')
         known_values, branches = [], []
         solved_positions, solved_velocities = {}, {}
         previous = self._previous
-        for step, last_value, last_branch in zip(self._steps, self._known_values, self._branches):
+        for step, last_value, last_branch in zip(self._steps, self._known_values,
+                                                 self._branches):
             constraint, known, sign, flips_with_turns, driven, passive = step
             value = sign * values[known]
             try:
@@ -273,8 +275,8 @@ class LoopSolver:
             coordinates, state_rates = state.coordinates, state.rates
             for name, joint_sign, index, revolute in passive:
                 position = joint_sign * coordinates[index]
-                if revolute:
-                    position = unwrap_near(position, previous[name])
+                if revolute:  # solver.unwrap_near, written out: a call costs more than it
+                    position += TWO_PI * round((previous[name] - position) / TWO_PI)
                 values[name] = solved_positions[name] = position
                 rates[name] = solved_velocities[name] = joint_sign * state_rates[index]
         self._known_values, self._branches = known_values, branches
