@@ -31,7 +31,6 @@ from functools import lru_cache
 import math
 import operator
 
-from linkage_kinematics.kinematics.closed_form import CrankRates
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
 from linkage_kinematics.kinematics.geometry import (
     _DIGITS,
@@ -43,7 +42,7 @@ from linkage_kinematics.kinematics.geometry import (
 )
 from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
-from linkage_kinematics.kinematics.solver import DeadPointError, solve
+from linkage_kinematics.kinematics.solver import DeadPointError, solve_at_rates
 
 __all__ = [
     'branch_of', 'continued_branch_of', 'driven_loop', 'DrivenLoop', 'joint_points', 'JointKind',
@@ -226,7 +225,7 @@ class DrivenLoop:
             coordinates, rates = self._prismatic.solve(value, rate, branch)
             return LoopState(coordinates, rates, branch)
         try:
-            state = solve(self._linkage, value, CrankRates(rate, 0.0), branch)
+            state = solve_at_rates(self._linkage, value, rate, 0.0, branch)
         except (DeadPointError, UnreachableError) as error:
             raise type(error)(f'joint {known}: {error}') from None
         turn = self._turn

@@ -172,11 +172,15 @@ class RobotLoopsFollower:
             return LoopDrop(LoopRejection.NO_JOINT, self._loops_of(missing),
                             f'no position of {missing}')
         count = len(velocities)
-        given = [velocities[i] if i < count else None for i in indices]
-        values = {name: positions[i] for name, i in zip(measured, indices)}
+        values, given, finite = {}, [], True
         isfinite = math.isfinite
-        if not all(isfinite(value) for value in values.values()) or not all(
-                rate is None or isfinite(rate) for rate in given):
+        for name, i in zip(measured, indices):
+            value = values[name] = positions[i]
+            rate = velocities[i] if i < count else None
+            given.append(rate)
+            if not isfinite(value) or (rate is not None and not isfinite(rate)):
+                finite = False
+        if not finite:
             bad = [name for name, rate in zip(measured, given)
                    if not isfinite(values[name]) or not isfinite(0.0 if rate is None else rate)]
             return LoopDrop(LoopRejection.NON_FINITE, self._loops_of(bad),
