@@ -126,12 +126,14 @@ def _vectors(values: object) -> tuple[tuple[float, float], ...] | None:
     return tuple((float(vector[0]), float(vector[1])) for vector in vectors)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class LoopState:
     """
     The loop's coordinates (φ in rad, δ in m) of joints 0..3 and their time derivatives.
 
-    ``branch`` is the assembly the state lies on (+1 or −1, see ``branch_of``).
+    ``branch`` is the assembly the state lies on (+1 or −1, see ``branch_of``). A value, not
+    frozen because a frozen dataclass sets each field through ``object.__setattr__``: a loop
+    sample made three times slower to build than this (``LinkageState`` says the same).
     """
 
     coordinates: tuple[float, float, float, float]

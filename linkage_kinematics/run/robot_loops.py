@@ -58,14 +58,15 @@ class LoopDrop:
     detail: str
 
 
-@dataclass(frozen=True)
+@dataclass
 class LoopSample:
     """
     The passive loop joints at one message, in solve order, and what came with them.
 
     ``joints`` holds every measured and solved loop joint's position (for /tf);
     ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
-    loop's known joint value (URDF units), by constraint.
+    loop's known joint value (URDF units), by constraint. A value, not frozen: a frozen
+    dataclass's seven ``object.__setattr__`` cost four times its plain ``__init__`` per sample.
     """
 
     stamp_ns: int
