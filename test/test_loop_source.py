@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription
+from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription, TreePositions
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.measured import Estimate
@@ -179,3 +179,32 @@ def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None
     assert ('log warning', "joint 'coupler_joint' (constraint 'follower_pin') is solved by its "
             "loop but also mimics 'crank_joint': robot_state_publisher would pose it from two "
             'sources') in host.record
+
+
+def test_tree_positions_are_the_mapping_robot_state_publisher_would_get() -> None:
+    """
+    Loop joints as solved, others as last heard (finite), 0 before; names found once per list.
+
+    Each sample's positions equal the mapping the source built per sample before: every tree
+    joint from the sample's joints, else the input's last finite value, else 0.
+    """
+    tree_joints = ('hip', 'knee_front', 'knee_back', 'ankle', 'wrist')
+    heard = {'wrist': 0.5}  # heard under an earlier description
+    tree = TreePositions(tree_joints, frozenset({'knee_front', 'knee_back'}), heard)
+    names = ['knee_front', 'hip', 'other']
+    messages = [
+        (names, [0.1, 0.2, 9.0], {'knee_front': 0.1, 'knee_back': 0.3}),
+        (names, [0.15, float('nan'), 9.5], {'knee_front': 0.15, 'knee_back': 0.35}),
+        (['ankle', 'knee_front', 'hip'], [-0.4, 0.2], {'knee_front': 0.2, 'knee_back': 0.4}),
+        (names, [0.25], {'knee_front': 0.25, 'knee_back': 0.45}),
+    ]
+    expected_heard: dict[str, float] = {'wrist': 0.5}
+    for names_given, positions, joints in messages:
+        tree.note_input(names_given, positions)
+        for name, position in zip(names_given, positions):
+            if name not in ('knee_front', 'knee_back') and position == position:
+                expected_heard[name] = position
+        assert tree.at_sample(joints) == [
+            joints.get(name, expected_heard.get(name, 0.0)) for name in tree_joints]
+    assert heard == expected_heard == {'wrist': 0.5, 'hip': 0.2, 'other': 9.5, 'ankle': -0.4}
+    assert tree.positions == [0.2, 0.25, 0.45, -0.4, 0.5]
