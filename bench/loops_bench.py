@@ -15,9 +15,13 @@ the same time and is the baseline. The encoder's messages carry the robot's meas
 the relay's crank.
 
 Before the nodes, ``path_run`` times the node's per-sample loops path in this process on the
-same two robots: ``RobotLoopsFollower.follow`` and the ``joint_states`` bytes through the prepared
-``JointStateEncoder``, against the path before it (test/loops_per_call.py's per-call follower,
-and a rclpy ``JointState`` through ``encode_cdr``), checking that both give the same bytes.
+same two robots: the input's bytes read by ``JointStateDecoder`` (against rclpy's
+``deserialize_message``), ``RobotLoopsFollower.follow`` and the ``joint_states`` bytes through
+the prepared ``JointStateEncoder``, against the path before it (test/loops_per_call.py's per-call
+follower, and a rclpy ``JointState`` through ``encode_cdr``), and the /tf of the whole robot
+(``TreePositions`` and ``RobotStateTransforms.tree_message``, against a mapping of every tree
+joint per sample through ``RobotStateTransforms.message``), checking that both give the same
+fields and bytes.
 """
 
 from __future__ import annotations
@@ -27,13 +31,15 @@ import math
 import re
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr
+from linkage_kinematics.bag.cdr import encode_cdr, JointStateDecoder
 from linkage_kinematics.model.loops import find_loops
-from linkage_kinematics.ros.messages import JointStateEncoder
+from linkage_kinematics.ros.loop_source import TreePositions
+from linkage_kinematics.ros.messages import JointStateEncoder, RobotStateTransforms
 from linkage_kinematics.run.robot_loops import LoopSample, read_loops, RobotLoopsFollower
 from loop_robots import excavator, four_bar_knee, ROBOTS
 from loops_per_call import ReferenceFollower
 import measured_bench
+from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from timing import format_seconds, interleaved_medians, markdown_table, paired_ratio
 import yaml
@@ -128,20 +134,76 @@ def encode_before(sample: LoopSample) -> bytes:
     return encode_cdr(message)
 
 
+def input_bytes(message: Message) -> bytes:
+    """Return one input message as the measured source receives it: its CDR bytes."""
+    stamp_ns, names, positions, velocities = message
+    joint_state = JointState(name=names, position=positions, velocity=velocities)
+    joint_state.header.stamp = Time(sec=stamp_ns // 1_000_000_000,
+                                    nanosec=stamp_ns % 1_000_000_000)
+    return encode_cdr(joint_state)
+
+
+def decode_before(data: bytes) -> Message:
+    """Return an input's fields as ``RobotLoopsSubscription`` read them before: rclpy."""
+    message = deserialize_message(data, JointState)
+    stamp = message.header.stamp
+    return (stamp.sec * 1_000_000_000 + stamp.nanosec, message.name, message.position,
+            message.velocity)
+
+
+def tf_before(transforms: RobotStateTransforms, heard: dict[str, float], message: Message,
+              sample: LoopSample, loop_joints: frozenset[str]) -> bytes:
+    """Return the robot's /tf as ``RobotLoopsSubscription`` made it before: a mapping a sample."""
+    _, names, positions, _ = message
+    for name, position in zip(names, positions):
+        if name not in loop_joints and math.isfinite(position):
+            heard[name] = position
+    return transforms.message({name: sample.joints.get(name, heard.get(name, 0.0))
+                               for name in transforms.driven_joints}, sample.stamp_ns)
+
+
 def path_workloads(measured: tuple[str, ...], urdf: str, inputs: list[Message]
                    ) -> tuple[dict[str, Callable[[], int]], bool]:
     """
-    Return the workloads (follow, encode and both; before and now) and whether bytes agree.
+    Return the workloads (decode, follow, encode, /tf and all; before and now), whether agreed.
 
     Each follow workload restarts its follower first, so that every run follows the same motion.
     """
     follower = RobotLoopsFollower(read_loops(urdf), measured, {}, math.pi / 2)
     reference = ReferenceFollower(follower)
+    received = [input_bytes(message) for message in inputs]
+    decoder = JointStateDecoder()
     now = [follower.follow(*message) for message in inputs]
     before = [reference.follow(*message) for message in inputs]
     encoder = JointStateEncoder(now[0].names)
-    identical = all(encoder.encode(new.stamp_ns, new.positions, new.velocities)
-                    == encode_before(old) for new, old in zip(now, before))
+    transforms = RobotStateTransforms(urdf, '')
+    tree = TreePositions(transforms.driven_joints, follower.loop_joints, {})
+    heard: dict[str, float] = {}
+
+    def tf_now(message: Message, sample: LoopSample) -> bytes:
+        tree.note_input(message[1], message[2])
+        return transforms.tree_message(tree.at_sample(sample.joints), sample.stamp_ns)
+
+    def fields_before(data: bytes) -> tuple:
+        stamp_ns, names, positions, velocities = decode_before(data)
+        return stamp_ns, tuple(names), tuple(positions), tuple(velocities)
+
+    loop_joints = follower.loop_joints
+    identical = all(
+        encoder.encode(new.stamp_ns, new.positions, new.velocities) == encode_before(old)
+        and decoder.decode(data) == fields_before(data)
+        and tf_now(message, new) == tf_before(transforms, heard, message, new, loop_joints)
+        for new, old, data, message in zip(now, before, received, inputs))
+
+    def decode_now() -> int:
+        for data in received:
+            decoder.decode(data)
+        return len(received)
+
+    def decode_old() -> int:
+        for data in received:
+            decode_before(data)
+        return len(received)
 
     def follow_now() -> int:
         follower.restart()
@@ -165,22 +227,45 @@ def path_workloads(measured: tuple[str, ...], urdf: str, inputs: list[Message]
             encode_before(sample)
         return len(before)
 
-    def both_now() -> int:
+    def tf_new() -> int:
+        for message, sample in zip(inputs, now):
+            tf_now(message, sample)
+        return len(now)
+
+    def tf_old() -> int:
+        for message, sample in zip(inputs, before):
+            tf_before(transforms, heard, message, sample, loop_joints)
+        return len(before)
+
+    def all_now() -> int:
         follower.restart()
-        for message in inputs:
+        for data in received:
+            message = decoder.decode(data)
             sample = follower.follow(*message)
             encoder.encode(sample.stamp_ns, sample.positions, sample.velocities)
-        return len(inputs)
+            tf_now(message, sample)
+        return len(received)
 
-    def both_before() -> int:
+    def all_before() -> int:
         reference.restart()
-        for message in inputs:
-            encode_before(reference.follow(*message))
-        return len(inputs)
+        for data in received:
+            message = decode_before(data)
+            sample = reference.follow(*message)
+            encode_before(sample)
+            tf_before(transforms, heard, message, sample, loop_joints)
+        return len(received)
 
-    return {'follow now': follow_now, 'follow before': follow_before,
+    return {'decode now': decode_now, 'decode before': decode_old,
+            'follow now': follow_now, 'follow before': follow_before,
             'encode now': encode_now, 'encode before': encode_old,
-            'both now': both_now, 'both before': both_before}, identical
+            'tf now': tf_new, 'tf before': tf_old,
+            'all now': all_now, 'all before': all_before}, identical
+
+
+# the rows of path_run: each stage's workloads and what the row says
+STAGES = (('decode', 'input bytes → stamp, names, positions, velocities'),
+          ('follow', 'RobotLoopsFollower.follow'), ('encode', 'joint_states bytes'),
+          ('tf', '/tf bytes of the whole robot'), ('all', 'all four'))
 
 
 def path_run(quick: bool, repetitions: int) -> str:
@@ -192,12 +277,13 @@ def path_run(quick: bool, repetitions: int) -> str:
         medians = interleaved_medians(workloads, repetitions)
         pair_inputs = messages(joints, PAIR_SAMPLES)
         pairs, _ = path_workloads(measured, urdf, pair_inputs)
-        for stage, label in (('follow', 'RobotLoopsFollower.follow'),
-                             ('encode', 'joint_states bytes'), ('both', 'both')):
+        for stage, label in STAGES:
             ratio = paired_ratio(pairs[f'{stage} now'], pairs[f'{stage} before'], PAIRS)
             rows.append([robot, label, format_seconds(medians[f'{stage} before']),
                          format_seconds(medians[f'{stage} now']), f'{ratio:.2f}×',
                          'yes' if identical else '**no**'])
     return markdown_table(
-        ['robot', 'per sample', 'per-call path (before)', 'prepared path (now)',
-         f'now ÷ before (median of {PAIRS} back-to-back pairs)', 'bytes identical'], rows)
+        ['robot', 'per sample', 'before (rclpy, per-call follower, a mapping per /tf)',
+         'now (JointStateDecoder, prepared follower, TreePositions)',
+         f'now ÷ before (median of {PAIRS} back-to-back pairs)',
+         'fields and bytes identical'], rows)

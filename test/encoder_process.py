@@ -7,9 +7,10 @@ An encoder in its own process: publishes the JointState samples of a JSON file, 
 ``python test/encoder_process.py SAMPLES.json``. The file holds ``topic`` (where to publish),
 ``state_topic`` (the completer's ``linkage/state``) and ``samples``, each with ``stamp_ns``,
 ``name``, ``position``, ``velocity`` and ``answered`` (whether the completer will publish a state
-for it). After each answered sample the encoder waits for the state stamped like it before
-publishing the next, so that no sample waits in a queue a busy machine could overflow; the
-samples the completer drops in between are delivered in order before it (one reliable writer).
+for it), and optionally ``truncate``: only that many of the message's CDR bytes are sent.
+After each answered sample the encoder waits for the state stamped like it before publishing
+the next, so that no sample waits in a queue a busy machine could overflow; the samples the
+completer drops in between are delivered in order before it (one reliable writer).
 Exit status 0 when every answered sample was answered, 1 otherwise.
 """
 
@@ -22,6 +23,7 @@ import time
 import rclpy
 from rclpy.node import Node
 from rclpy.qos import QoSProfile
+from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState
 from trajectory_msgs.msg import JointTrajectory
 
@@ -58,7 +60,8 @@ def main(path: str) -> int:
                                  velocity=sample['velocity'])
             message.header.stamp.sec, message.header.stamp.nanosec = divmod(
                 sample['stamp_ns'], 1_000_000_000)
-            publisher.publish(message)
+            publisher.publish(message if 'truncate' not in sample
+                              else serialize_message(message)[:sample['truncate']])
             if sample['answered'] and not spin_until(lambda: sample['stamp_ns'] in answered):
                 print(f"encoder: no state stamped {sample['stamp_ns']}", file=sys.stderr)
                 return 1

@@ -10,9 +10,9 @@ test's own, so that a paused message is known to have come while paused.
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
 
-from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription
+from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription, TreePositions
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.measured import Estimate
@@ -36,16 +36,12 @@ class LoopsLogger(FakeLogger):
 
 
 class LoopsHost(FakeHost):
-    """The fake host, with raw subscriptions and a logger that also warns."""
+    """The fake host, with a logger that also warns."""
 
     def __init__(self, **overrides: Any) -> None:
         super().__init__(configuration(**{'source': 'measured', 'loops': 'robot_description',
                                           **overrides}))
         self._logger = LoopsLogger(self.record)
-
-    def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
-                            qos_profile: object, *, raw: bool = False) -> object:
-        return super().create_subscription(msg_type, topic, callback, qos_profile)
 
 
 class FakeOutputs:
@@ -159,6 +155,21 @@ def test_descriptions_from_the_topic_are_read_afresh_and_bad_ones_reported() -> 
     assert outputs.logged.count('robot') == 2
 
 
+def test_malformed_bytes_are_dropped_counted_and_not_logged() -> None:
+    host, outputs, source = hosted()
+    message = JointState(name=['knee_front'], position=[0.1])
+    data = serialize_message(message)
+    for malformed in (data[:20], b'\x00\x02' + data[2:], b''):
+        host.subscriptions['measured_joint_states'](malformed)
+    assert (outputs.joint_states, outputs.logged) == ([], ['robot'])
+    status = node_status(host, source)
+    assert status.level is Level.WARN
+    assert status.message == 'dropped 3 messages whose bytes are not a well-formed JointState'
+    assert status.values['dropped whose bytes are not a well-formed JointState'] == '3'
+    send(host, START_NS, 0.1)  # the next good message is followed
+    assert [stamp for stamp, _ in outputs.joint_states] == [START_NS]
+
+
 def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None:
     host = LoopsHost(robot_description=MIMIC)
     source = RobotLoopsSubscription(host, FakeOutputs(), ClosedRobot(MIMIC, host.config))
@@ -168,3 +179,32 @@ def test_a_passive_joint_that_also_mimics_is_warned_about_once_planned() -> None
     assert ('log warning', "joint 'coupler_joint' (constraint 'follower_pin') is solved by its "
             "loop but also mimics 'crank_joint': robot_state_publisher would pose it from two "
             'sources') in host.record
+
+
+def test_tree_positions_are_the_mapping_robot_state_publisher_would_get() -> None:
+    """
+    Loop joints as solved, others as last heard (finite), 0 before; names found once per list.
+
+    Each sample's positions equal the mapping the source built per sample before: every tree
+    joint from the sample's joints, else the input's last finite value, else 0.
+    """
+    tree_joints = ('hip', 'knee_front', 'knee_back', 'ankle', 'wrist')
+    heard = {'wrist': 0.5}  # heard under an earlier description
+    tree = TreePositions(tree_joints, frozenset({'knee_front', 'knee_back'}), heard)
+    names = ['knee_front', 'hip', 'other']
+    messages = [
+        (names, [0.1, 0.2, 9.0], {'knee_front': 0.1, 'knee_back': 0.3}),
+        (names, [0.15, float('nan'), 9.5], {'knee_front': 0.15, 'knee_back': 0.35}),
+        (['ankle', 'knee_front', 'hip'], [-0.4, 0.2], {'knee_front': 0.2, 'knee_back': 0.4}),
+        (names, [0.25], {'knee_front': 0.25, 'knee_back': 0.45}),
+    ]
+    expected_heard: dict[str, float] = {'wrist': 0.5}
+    for names_given, positions, joints in messages:
+        tree.note_input(names_given, positions)
+        for name, position in zip(names_given, positions):
+            if name not in ('knee_front', 'knee_back') and position == position:
+                expected_heard[name] = position
+        assert tree.at_sample(joints) == [
+            joints.get(name, expected_heard.get(name, 0.0)) for name in tree_joints]
+    assert heard == expected_heard == {'wrist': 0.5, 'hip': 0.2, 'other': 9.5, 'ankle': -0.4}
+    assert tree.positions == [0.2, 0.25, 0.45, -0.4, 0.5]

@@ -408,6 +408,7 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, n
         sample(3 * ms, crank, [0.012], [1.0], answered=False),  # as old as the last used
         sample(8 * ms, crank, [-0.1], [1.0], answered=False),  # past the dead point at −1.94°
         sample(9 * ms, crank, [1.5], [1.0], answered=False),  # a jump of 1.49 rad
+        {**sample(9 * ms, crank, [0.02], [1.0], answered=False), 'truncate': 30},  # cut short
         sample(10 * ms, crank, [0.02], [1.0]),
         sample(11 * ms, ['coupler_joint', 'rocker_joint'], [0.0, 0.0], [], answered=False),
         sample(12 * ms, crank, [0.03], [1.0]),
@@ -438,10 +439,10 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, n
         assert rejection.value in warnings
     values = {item.key: item.value for item in statuses()[-1].values}
     expected = {Rejection.NON_FINITE: 2, Rejection.NO_DRIVER: 1, Rejection.STAMP_NOT_NEWER: 2,
-                Rejection.UNREACHABLE: 1, Rejection.JUMP: 1}
+                Rejection.UNREACHABLE: 1, Rejection.JUMP: 1, Rejection.MALFORMED: 1}
     for rejection, count in expected.items():
         assert values[f'dropped {rejection.value}'] == str(count)
-    assert values['dropped samples'] == '7'
+    assert values['dropped samples'] == '8'
     assert values['valid samples'] == '4'
     for messages in run.received.values():
         for message in messages:

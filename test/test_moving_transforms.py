@@ -196,3 +196,15 @@ def test_new_names_prepare_new_transforms() -> None:
                       {'slide': 0.3, 'drive': 1.0, 'unknown': 5.0}, {'slide': 0.1}):
         assert tf.message(positions, STAMP_NS) == encode_cdr(
             messages.tf_message(reference_transforms(robot, positions), STAMP_NS))
+
+
+@pytest.mark.parametrize('urdf', [EVERY_JOINT_URDF, MIMIC_URDF])
+def test_the_whole_trees_tf_is_the_generic_one(urdf: str) -> None:
+    """``tree_message`` of every driven joint's position in order: the reference's bytes."""
+    tf = messages.RobotStateTransforms(urdf, 'robot_1/')
+    robot = RobotTransforms(urdf, 'robot_1/')
+    names = list(tf.driven_joints)
+    assert len(names) >= 2
+    for positions in random_positions(robot, names, random.Random(5)):
+        assert tf.tree_message([positions[name] for name in names], STAMP_NS) == encode_cdr(
+            messages.tf_message(reference_transforms(robot, positions), STAMP_NS)), positions

@@ -11,9 +11,11 @@ differences of the solved coordinates, and the existing four-bar solve they are 
 from __future__ import annotations
 
 import math
+import struct
 
 from hypothesis import assume, given, HealthCheck, settings
 from hypothesis import strategies as st
+from linkage_kinematics.kinematics import singular_points
 from linkage_kinematics.kinematics.closed_form import CrankRates
 from linkage_kinematics.kinematics.geometry import FourBar, GeometryError, UnreachableError
 from linkage_kinematics.kinematics.planar_loop import (
@@ -446,3 +448,28 @@ def test_loops_compare_by_value_whatever_sequences_they_are_given_as() -> None:
     assert loop.prismatic == 2
     with pytest.raises(GeometryError, match='kinds'):
         PlanarLoop(('revolute', 'ball', 'revolute', 'revolute'), same.links)
+
+
+@settings(max_examples=2000, deadline=None)
+@given(st.floats(allow_nan=True, allow_infinity=True), st.floats(allow_nan=False),
+       st.floats(allow_nan=False, min_value=-1e-8, max_value=1e-8))
+def test_offset_from_is_offset_of_no_turns_bit_for_bit(alpha: float, high: float,
+                                                       low: float) -> None:
+    """The slider loops' ``offset_from`` gives ``offset(…, 0.0)``'s bits, -0.0 and NaN too."""
+    expected = singular_points.offset(alpha, (high, low), 0.0)
+    got = singular_points.offset_from(alpha, (high, low))
+    assert struct.pack('<d', got) == struct.pack('<d', expected) or (
+        math.isnan(got) and math.isnan(expected))
+
+
+@pytest.mark.parametrize('alpha', [0.0, -0.0, 1.0, -1.0, 5e-324, -5e-324, 1e308, -1e308,
+                                   math.inf, -math.inf, 0.1 + 0.2, 1.0 + 2**-52])
+@pytest.mark.parametrize('point', [(0.0, 0.0), (-0.0, 0.0), (0.0, -0.0), (1.0, 0.0),
+                                   (0.3, 5.551115123125783e-17), (-1.0, -1e-17), (1e308, 0.0)])
+def test_offset_from_at_signed_zeros_and_limits(alpha: float, point: tuple[float, float]
+                                                ) -> None:
+    """The cases a random draw rarely meets: signed zeros, subnormals, overflow, infinities."""
+    expected = singular_points.offset(alpha, point, 0.0)
+    got = singular_points.offset_from(alpha, point)
+    assert struct.pack('<d', got) == struct.pack('<d', expected) or (
+        math.isnan(got) and math.isnan(expected))

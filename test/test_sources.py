@@ -30,6 +30,7 @@ from linkage_kinematics.run.control import RunControl
 from linkage_kinematics.run.motion import dead_point_problem
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import pytest
+from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState
 
 START_NS = 5_000_000_000  # the node clock's time when the motion starts
@@ -108,7 +109,7 @@ class FakeHost(RunStatus):
         return True
 
     def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
-                            qos_profile: object) -> object:
+                            qos_profile: object, *, raw: bool = False) -> object:
         self.subscriptions[topic] = callback
         return topic
 
@@ -240,11 +241,12 @@ def test_paused_the_source_publishes_no_state_and_a_reset_shows_alpha_start_once
     assert host.take() == []
 
 
-def joint_state(seconds: float, crank: float) -> JointState:
+def joint_state(seconds: float, crank: float) -> bytes:
+    """Return the CDR bytes of a crank sample, as the measured source's raw subscription gets."""
     message = JointState(name=['crank_joint'], position=[crank])
     message.header.stamp.sec = int(seconds)
     message.header.stamp.nanosec = round((seconds % 1) * 1e9)
-    return message
+    return serialize_message(message)
 
 
 def test_the_measured_source_takes_a_new_configuration_through_its_follower():
@@ -269,3 +271,18 @@ def test_the_measured_source_takes_a_new_configuration_through_its_follower():
     assert dropped['dropped jumping further than measured.max_jump'] == '1'
     follow(joint_state(1.2, 0.35))
     assert host.take() == [('state', pytest.approx(0.35), 1_200_000_000, pytest.approx(0.2))]
+
+
+def test_the_measured_source_drops_and_counts_malformed_bytes() -> None:
+    """Bytes that are no JointState (truncated, another encapsulation) are counted, not fatal."""
+    host = FakeHost(configuration(source='measured'))
+    source = MeasuredSubscription(host)
+    follow = host.subscriptions['measured_joint_states']
+    follow(joint_state(1.0, 0.3)[:24])  # within the name
+    follow(b'\x00\x07' + joint_state(1.0, 0.3)[2:])
+    assert host.take() == []
+    values = source.health.values(host.now_ns(), host.config)
+    assert values['dropped whose bytes are not a well-formed JointState'] == '2'
+    assert values['dropped samples'] == '2'
+    follow(joint_state(1.1, 0.3))  # the next good sample is followed
+    assert host.take()[-1] == ('state', pytest.approx(0.3), 1_100_000_000, 0.0)

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-CDR encoding: rclpy messages in, the bytes the node publishes and logs out.
+CDR encoding: rclpy messages in, the bytes the node publishes and logs out; and back for one.
 
 The node encodes each message once (``encode_cdr``, or for its per-tick messages and its
 scene a ``FixedShapeEncoder`` that writes the same bytes), publishes those bytes and logs the
@@ -19,6 +19,9 @@ rclpy's ``serialize_message`` is not used because it builds a type support objec
 a 1 kHz tick it cost more than the rest of the node's Python), can return a few bytes more
 than the message's encoding (after an empty ``effort`` in a JointState; rosbags rejects such
 messages), and leaves padding bytes as it finds them.
+
+``JointStateDecoder`` reads the measured sources' input the other way, straight from the bytes
+of their raw subscriptions, in a sixth of ``deserialize_message``'s time (both endiannesses).
 """
 from __future__ import annotations
 
@@ -316,3 +319,119 @@ class FixedShapeEncoder:
     def encode(self, values: tuple) -> bytes:
         """Return the message with ``values`` (``value_count`` of them) in the varying fields."""
         return ENCAPSULATION_HEADER + self._struct.pack(*self._order(self._constants + values))
+
+
+# A JointState received as bytes: the encapsulation's representation identifier (its first two
+# bytes) → the struct byte order of the body. Only plain XCDR1 (rmw_fastrtps' and rosbag2's
+# encoding, and what rosbags writes big endian): XCDR2 aligns differently, and a parameter list
+# is not how a JointState is written.
+_BYTE_ORDERS = {b'\x00\x00': '>', b'\x00\x01': '<'}
+_COUNTS = {order: struct.Struct(order + 'I').unpack_from for order in '<>'}  # lengths, counts
+JointStateFields = tuple[int, tuple[str, ...], tuple[float, ...], tuple[float, ...]]
+
+
+class JointStateDecoder:
+    """
+    The fields a follower needs of a ``sensor_msgs/JointState`` received as CDR bytes.
+
+    ``decode`` returns (header stamp in ns, names, positions, velocities) as rclpy's
+    ``deserialize_message`` gives them, or raises ValueError naming what is wrong with the
+    bytes: an encapsulation other than XCDR1, a length past the end, a string without its NUL or
+    not UTF-8. The efforts are checked, not read; bytes after them are allowed (rclpy's
+    serializer can leave some). A source sends the same names message after message: the
+    decoder keeps the last names' bytes and returns the same tuple while they repeat.
+    """
+
+    def __init__(self) -> None:
+        # the last names: their byte order, where they start and their bytes
+        self._names_key: tuple[str, int, bytes] | None = None
+        self._names: tuple[str, ...] = ()
+
+    def decode(self, data: bytes) -> JointStateFields:
+        """Return the stamp (ns), names, positions and velocities; ValueError if malformed."""
+        order = _BYTE_ORDERS.get(data[:2])
+        if order is None:
+            raise ValueError(f'unknown CDR encapsulation {data[:2].hex() or "(none)"}: not '
+                             'XCDR1 (00 00 big endian, 00 01 little endian)')
+        body = data[len(ENCAPSULATION_HEADER):]  # CDR aligns relative to the body's start
+        end = len(body)
+        if end < 12:
+            raise ValueError(f'JointState of {end} bytes ends within its header')
+        sec, nanosec, length = struct.unpack_from(order + 'iII', body)
+        offset = _string_end(body, 12, length, 'header.frame_id')
+        start = offset + (-offset & 3)
+        key = self._names_key
+        if (key is not None and key[0] == order and key[1] == start
+                and body[start:start + len(key[2])] == key[2]):
+            names, offset = self._names, start + len(key[2])
+        else:
+            names, offset = _strings(body, order, start)
+            self._names_key = (order, start, body[start:offset])
+            self._names = names
+        positions, velocities = _positions_and_velocities(body, order, offset)
+        return sec * 1_000_000_000 + nanosec, names, positions, velocities
+
+
+def _string_end(body: bytes, offset: int, length: int, field: str) -> int:
+    """Check the string of ``length`` bytes (its NUL counted) at ``offset``; return its end."""
+    if length == 0:
+        raise ValueError(f'JointState {field} has length 0 (a CDR string counts its NUL)')
+    if offset + length > len(body):
+        raise ValueError(f'JointState {field} of {length} bytes at byte {offset} goes past '
+                         f'the end ({len(body)} bytes)')
+    if body[offset + length - 1]:
+        raise ValueError(f'JointState {field} does not end in a NUL')
+    return offset + length
+
+
+def _strings(body: bytes, order: str, offset: int) -> tuple[tuple[str, ...], int]:
+    """Return the names sequence at ``offset`` and where it ends."""
+    unpack_length = _COUNTS[order]
+    offset += -offset & 3
+    if offset + 4 > len(body):
+        raise ValueError('JointState ends before the length of its name')
+    count = unpack_length(body, offset)[0]
+    offset += 4
+    if count * 5 > len(body) - offset:  # each name takes at least a length and its NUL
+        raise ValueError(f'JointState claims {count} names in {len(body) - offset} bytes')
+    names = []
+    for index in range(count):
+        offset += -offset & 3
+        if offset + 4 > len(body):
+            raise ValueError(f'JointState ends before the length of name[{index}]')
+        start = offset + 4
+        offset = _string_end(body, start, unpack_length(body, offset)[0], f'name[{index}]')
+        try:
+            names.append(str(body[start:offset - 1], 'utf-8'))
+        except UnicodeDecodeError as error:
+            raise ValueError(f'JointState name[{index}] is not UTF-8: {error}') from None
+    return tuple(names), offset
+
+
+# the float64 sequences after the names, and whether each is read (the efforts are not needed)
+_FLOAT_SEQUENCES = (('position', True), ('velocity', True), ('effort', False))
+
+
+def _positions_and_velocities(body: bytes, order: str, offset: int
+                              ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Return the float64 sequences at ``offset`` but the efforts, which are only checked."""
+    unpack_count = _COUNTS[order]
+    end = len(body)
+    values = []
+    for field, read in _FLOAT_SEQUENCES:
+        offset += -offset & 3
+        if offset + 4 > end:
+            raise ValueError(f'JointState ends before the length of its {field}')
+        count = unpack_count(body, offset)[0]
+        offset += 4
+        if count:
+            offset += -offset & 7  # the elements align to 8
+            if offset + 8 * count > end:
+                raise ValueError(f'JointState {field} of {count} values goes past the end '
+                                 f'({end} bytes)')
+            if read:
+                values.append(struct.unpack_from(f'{order}{count}d', body, offset))
+            offset += 8 * count
+        elif read:
+            values.append(())
+    return values[0], values[1]

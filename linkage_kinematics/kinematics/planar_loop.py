@@ -29,8 +29,8 @@ from decimal import Decimal, localcontext
 from enum import StrEnum
 from functools import lru_cache
 import math
+import operator
 
-from linkage_kinematics.kinematics.closed_form import CrankRates
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
 from linkage_kinematics.kinematics.geometry import (
     _DIGITS,
@@ -42,7 +42,7 @@ from linkage_kinematics.kinematics.geometry import (
 )
 from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
-from linkage_kinematics.kinematics.solver import DeadPointError, solve
+from linkage_kinematics.kinematics.solver import DeadPointError, solve_at_rates
 
 __all__ = [
     'branch_of', 'continued_branch_of', 'driven_loop', 'DrivenLoop', 'joint_points', 'JointKind',
@@ -126,12 +126,14 @@ def _vectors(values: object) -> tuple[tuple[float, float], ...] | None:
     return tuple((float(vector[0]), float(vector[1])) for vector in vectors)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class LoopState:
     """
     The loop's coordinates (φ in rad, δ in m) of joints 0..3 and their time derivatives.
 
-    ``branch`` is the assembly the state lies on (+1 or −1, see ``branch_of``).
+    ``branch`` is the assembly the state lies on (+1 or −1, see ``branch_of``). A value, not
+    frozen because a frozen dataclass sets each field through ``object.__setattr__``: a loop
+    sample made three times slower to build than this (``LinkageState`` says the same).
     """
 
     coordinates: tuple[float, float, float, float]
@@ -209,6 +211,9 @@ class DrivenLoop:
             self._turn = _angle(links[known]) + 0.5 * math.pi
             self._coupler_angle = _angle(links[(known + 1) % 4])
             self._rocker_angle = _angle(links[(known + 2) % 4])
+            # joints 0..3 from (known, known + 1, known + 2, known + 3), each mod 4
+            self._in_joint_order = operator.itemgetter(*((index - known) % 4
+                                                         for index in range(4)))
 
     def solve(self, value: float, rate: float, branch: int) -> LoopState:
         """Return the loop's state as ``solve_loop`` does, for this loop and known joint."""
@@ -222,23 +227,18 @@ class DrivenLoop:
             coordinates, rates = self._prismatic.solve(value, rate, branch)
             return LoopState(coordinates, rates, branch)
         try:
-            state = solve(self._linkage, value, CrankRates(rate, 0.0), branch)
+            state = solve_at_rates(self._linkage, value, rate, 0.0, branch)
         except (DeadPointError, UnreachableError) as error:
             raise type(error)(f'joint {known}: {error}') from None
         turn = self._turn
         coupler = state.gamma + turn - self._coupler_angle  # θ_{k+1} − θ_{k−1}
         rocker = -state.beta + turn - self._rocker_angle  # θ_{k+2} − θ_{k−1}
-        coordinates = [0.0] * 4
-        rates = [0.0] * 4
-        coordinates[known] = value
-        coordinates[(known + 1) % 4] = wrap_angle(coupler - value)
-        coordinates[(known + 2) % 4] = wrap_angle(rocker - coupler)
-        coordinates[(known + 3) % 4] = wrap_angle(-rocker)
-        rates[known] = rate
-        rates[(known + 1) % 4] = state.omega_ab - rate
-        rates[(known + 2) % 4] = state.omega_bc - state.omega_ab
-        rates[(known + 3) % 4] = -state.omega_bc
-        return LoopState(tuple(coordinates), tuple(rates), branch)
+        omega_ab, omega_bc = state.omega_ab, state.omega_bc
+        in_joint_order = self._in_joint_order
+        return LoopState(
+            in_joint_order((value, wrap_angle(coupler - value), wrap_angle(rocker - coupler),
+                            wrap_angle(-rocker))),
+            in_joint_order((rate, omega_ab - rate, omega_bc - omega_ab, -omega_bc)), branch)
 
     def continued_branch(self, value_from: float, branch: int, value_to: float) -> int:
         """Return the branch at ``value_to`` as ``continued_branch_of`` does for this loop."""

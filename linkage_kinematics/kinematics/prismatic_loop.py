@@ -45,6 +45,7 @@ from dataclasses import dataclass
 from decimal import Decimal, localcontext
 from enum import Enum
 import math
+import operator
 
 from linkage_kinematics.kinematics.continuation import _turns_past, check_branch
 from linkage_kinematics.kinematics.geometry import (
@@ -60,7 +61,7 @@ from linkage_kinematics.kinematics.geometry import (
 from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.singular_points import (
     half_sine,
-    offset,
+    offset_from,
     PIVOT_PASSAGE,
     too_close,
 )
@@ -105,7 +106,7 @@ class Factor:
         """sin(½(x − point)) for an angle, x − point for a displacement: exact near the point."""
         if self.periodic:
             return half_sine(value, point, math.sin)
-        return offset(value, point, 0.0)
+        return offset_from(value, point)
 
     def evaluate(self, value: float) -> tuple[float, float]:
         """Return the factor at ``value`` and its nearest root's unit (inf if it has none)."""
@@ -209,6 +210,9 @@ class PrismaticLoop:
         # +1: the known joint is p + 1 (its body p + 1 turns by +φ relative to body p − 1);
         # −1: it is p − 1 (body p − 2 turns by −φ).
         self.sense = 1 if (known - prismatic) % 4 == 1 else -1
+        # joints 0..3 from (p, p + 1, p + 2, p + 3, the known joint): the known one its own
+        self._in_joint_order = operator.itemgetter(*(
+            4 if index == known else (index - prismatic) % 4 for index in range(4)))
         self.link_a = links[(prismatic - 2) % 4]
         self.link_c = links[(prismatic + 1) % 4]
         self.angle_a = _angle(self.link_a)
@@ -268,26 +272,16 @@ class PrismaticLoop:
         else:
             delta, angle_a, angle_c, delta_rate, rate_a, rate_c = self._solve_next(
                 value, rate, branch, values)
-        p = self.prismatic
-        coordinates = [0.0] * 4
-        rates = [0.0] * 4
-        coordinates[p] = delta
-        coordinates[(p + 1) % 4] = wrap_angle(angle_c)
-        coordinates[(p + 2) % 4] = wrap_angle(angle_a - angle_c)
-        coordinates[(p + 3) % 4] = wrap_angle(-angle_a)
-        coordinates[self.known] = value
-        rates[p] = delta_rate
-        rates[(p + 1) % 4] = rate_c
-        rates[(p + 2) % 4] = rate_a - rate_c
-        rates[(p + 3) % 4] = -rate_a
-        rates[self.known] = rate
-        return tuple(coordinates), tuple(rates)
+        in_joint_order = self._in_joint_order
+        return (in_joint_order((delta, wrap_angle(angle_c), wrap_angle(angle_a - angle_c),
+                                wrap_angle(-angle_a), value)),
+                in_joint_order((delta_rate, rate_c, rate_a - rate_c, -rate_a, rate)))
 
     def _solve_slide(self, delta: float, speed: float, branch: int,
                      values: tuple[float, ...]) -> tuple[float, ...]:
         """Return δ, ψ_a, ψ_c and their rates, δ known: the triangle J_b J_c J_a (Heron)."""
         stretched, folded = values
-        along = offset(delta, self.centre, 0.0)  # t = δ + m·ŝ, exact near the change point
+        along = offset_from(delta, self.centre)  # t = δ + m·ŝ, exact near the change point
         across = self.offset
         slide_x, slide_y = self.slide
         w_x = along * slide_x + across * slide_y
@@ -425,8 +419,8 @@ class PrismaticLoop:
                 flips += abs(_turns_past(value_to, factor.first)
                              - _turns_past(value_from, factor.first))
             else:
-                flips += ((offset(value_to, factor.first, 0.0) >= 0.0)
-                          != (offset(value_from, factor.first, 0.0) >= 0.0))
+                flips += ((offset_from(value_to, factor.first) >= 0.0)
+                          != (offset_from(value_from, factor.first) >= 0.0))
         return branch if flips % 2 == 0 else -branch
 
 

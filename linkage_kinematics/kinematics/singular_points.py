@@ -106,6 +106,24 @@ def offset(alpha: FloatOrArray, point: tuple[float, float], turns: FloatOrArray)
     return second + (first_error + second_error - low - turn_low - turns * _TWO_PI_LOW)
 
 
+def offset_from(alpha: float, point: tuple[float, float]) -> float:
+    """
+    Return ``offset(alpha, point, 0.0)``, bit for bit: a displacement's distance from a point.
+
+    The same operations, ``_two_sum`` written out, without Dekker's product of no turns (it is
+    (+0.0, +0.0) for 0.0 turns): a slider loop takes several per sample.
+    """
+    high, low = point
+    negated = -high
+    first = alpha + negated
+    part = first - alpha
+    first_error = (alpha - (first - part)) + (negated - part)
+    second = first + -0.0
+    part = second - first
+    second_error = (first - (second - part)) + (-0.0 - part)
+    return second + (first_error + second_error - low - 0.0 - 0.0)
+
+
 def _corrected_half_sine(alpha: FloatOrArray, point: tuple[float, float], difference: FloatOrArray,
                          value: FloatOrArray, sin: Callable) -> FloatOrArray:
     """

@@ -55,7 +55,7 @@ import numpy as np
 __all__ = [
     'continued_branch', 'CrankRates', 'DeadPointError', 'LinkagePose', 'LinkageState',
     'loop_closure_residual', 'PIVOT_PASSAGE', 'RATE_ACCURACY', 'reachable_mask', 'solve',
-    'solve_many', 'solve_pose', 'unwrap_near',
+    'solve_at_rates', 'solve_many', 'solve_pose', 'unwrap_near',
 ]
 
 # Arrays longer than this are solved in pieces of this many angles, so that the closed form's
@@ -136,16 +136,24 @@ def solve(
     RATE_ACCURACY (``solve_pose`` still gives the positions there). The state returned never
     holds NaN or inf.
     """
-    if branch != 1 and branch != -1:
-        check_branch(branch)
     # The crank's rates here, not through DriveLaw's methods as solve_many takes them: a call
     # costs this hot path more than their arithmetic.
     if type(drive) is CrankRates:
-        omega = drive.omega
-        omega_dot = drive.omega_dot
-    else:
-        omega = drive.omega0 + drive.k * alpha
-        omega_dot = drive.k * omega
+        return solve_at_rates(linkage, alpha, drive.omega, drive.omega_dot, branch)
+    omega = drive.omega0 + drive.k * alpha
+    return solve_at_rates(linkage, alpha, omega, drive.k * omega, branch)
+
+
+def solve_at_rates(linkage: FourBar, alpha: float, omega: float, omega_dot: float,
+                   branch: int = 1) -> LinkageState:
+    """
+    Return ``solve``'s state with the crank's rates ω, ω̇ given as they are (rad/s, rad/s²).
+
+    For a caller that has them as numbers rather than as ``CrankRates`` (a loop driven at a
+    measured joint, sample after sample); the same refusals as ``solve``.
+    """
+    if branch != 1 and branch != -1:
+        check_branch(branch)
     try:
         state, check = evaluate(linkage, branch, alpha, omega, omega_dot, SCALAR_MATH)
     except ZeroDivisionError:

@@ -30,7 +30,6 @@ from linkage_kinematics.kinematics.planar_loop import (
     known_joint_range,
     UnreachableError,
 )
-from linkage_kinematics.kinematics.solver import unwrap_near
 from linkage_kinematics.model.loop_geometry import derive_loop, Loop, LoopJoint
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 
@@ -212,17 +211,24 @@ class LoopSolver:
 
     def __init__(self, plan: LoopPlan) -> None:
         self.plan = plan
-        # Each loop's step, resolved once here rather than at every sample: its constraint, its
-        # known joint's name and sign, whether its branch flips with each whole turn of that
-        # joint (a revolute known joint meeting an odd number of change points per turn), the
-        # loop driven at that joint, and each passive joint's name, sign, index and revolute-ness.
+        # A sample's joint values and rates are lists: the measured joints', then each passive
+        # joint's as it is solved (plan.passive's order). Each loop's step, resolved once here
+        # rather than at every sample: its constraint, its known joint's name, place in those
+        # lists and sign, whether its branch flips with each whole turn of that joint (a
+        # revolute known joint meeting an odd number of change points per turn), the loop
+        # driven at that joint, and each passive joint's place among the passive joints, sign,
+        # index and revolute-ness.
+        self._passive = plan.passive
+        places = {name: place for place, name in enumerate(plan.measured + self._passive)}
+        passive_places = {name: place for place, name in enumerate(self._passive)}
         self._steps = tuple(
-            (planned.loop.constraint, planned.known.name, planned.known.sign,
+            (planned.loop.constraint, planned.known.name, places[planned.known.name],
+             planned.known.sign,
              planned.known.kind is JointKind.REVOLUTE and len(known_joint_range(
                  planned.loop.planar, planned.known.index).change_points) % 2 == 1,
              driven_loop(planned.loop.planar, planned.known.index),
-             tuple((joint.name, joint.sign, joint.index, joint.kind is JointKind.REVOLUTE)
-                   for joint in planned.passive))
+             tuple((passive_places[joint.name], joint.sign, joint.index,
+                    joint.kind is JointKind.REVOLUTE) for joint in planned.passive))
             for planned in plan.loops)
         self.reset()
 
@@ -231,7 +237,7 @@ class LoopSolver:
         # each loop's known value and branch at the last sample, in solve order
         self._known_values = [0.0] * len(self.plan.loops)
         self._branches = [planned.branch for planned in self.plan.loops]
-        self._previous = {name: 0.0 for name in self.plan.passive}
+        self._previous = [0.0] * len(self._passive)  # in plan.passive's order
 
     def solve(self, positions: Mapping[str, float],
               velocities: Mapping[str, float]) -> tuple[dict[str, float], dict[str, float]]:
@@ -242,21 +248,26 @@ class LoopSolver:
         other names are ignored). Raises LoopSampleError, naming the constraint and the
         joint, at a dead point, out of reach, or for a measured joint missing or not finite.
         """
-        values = {}
-        rates = {}
+        values = []
+        rates = []
+        isfinite = math.isfinite
         for name in self.plan.measured:
             if name not in positions or name not in velocities:
                 raise LoopSampleError(f'no position and velocity for measured joint {name!r}')
-            values[name], rates[name] = float(positions[name]), float(velocities[name])
-            if not (math.isfinite(values[name]) and math.isfinite(rates[name])):
-                raise LoopSampleError(f'measured joint {name!r}: position {values[name]} and '
-                                      f'velocity {rates[name]} are not both finite')
+            value = float(positions[name])
+            rate = float(velocities[name])
+            if not (isfinite(value) and isfinite(rate)):
+                raise LoopSampleError(f'measured joint {name!r}: position {value} and '
+                                      f'velocity {rate} are not both finite')
+            values.append(value)
+            rates.append(rate)
         known_values, branches = [], []
-        solved_positions, solved_velocities = {}, {}
+        solved = len(values)  # where the passive joints start
         previous = self._previous
-        for step, last_value, last_branch in zip(self._steps, self._known_values, self._branches):
-            constraint, known, sign, flips_with_turns, driven, passive = step
-            value = sign * values[known]
+        for step, last_value, last_branch in zip(self._steps, self._known_values,
+                                                 self._branches):
+            constraint, known, place, sign, flips_with_turns, driven, passive = step
+            value = sign * values[place]
             try:
                 branch = driven.continued_branch(last_value, last_branch, value)
                 # A revolute known joint is followed across whole turns (an encoder that wraps
@@ -264,19 +275,20 @@ class LoopSolver:
                 # just counted holding an odd number of change points each where it flips.
                 if flips_with_turns and round((last_value - value) / TWO_PI) % 2:
                     branch = -branch
-                state = driven.solve(value, sign * rates[known], branch)
+                state = driven.solve(value, sign * rates[place], branch)
             except (DeadPointError, UnreachableError) as error:
                 raise LoopSampleError(f'constraint {constraint!r} at {known} = '
-                                      f'{values[known]:.9g}: {error}', constraint) from None
+                                      f'{values[place]:.9g}: {error}', constraint) from None
             known_values.append(value)
             branches.append(state.branch)
             coordinates, state_rates = state.coordinates, state.rates
-            for name, joint_sign, index, revolute in passive:
+            for passive_place, joint_sign, index, revolute in passive:
                 position = joint_sign * coordinates[index]
-                if revolute:
-                    position = unwrap_near(position, previous[name])
-                values[name] = solved_positions[name] = position
-                rates[name] = solved_velocities[name] = joint_sign * state_rates[index]
+                if revolute:  # solver.unwrap_near, written out: a call costs more than it
+                    position += TWO_PI * round((previous[passive_place] - position) / TWO_PI)
+                values.append(position)
+                rates.append(joint_sign * state_rates[index])
         self._known_values, self._branches = known_values, branches
-        self._previous = dict(solved_positions)
-        return solved_positions, solved_velocities
+        self._previous = values[solved:]
+        return (dict(zip(self._passive, self._previous)),
+                dict(zip(self._passive, rates[solved:])))

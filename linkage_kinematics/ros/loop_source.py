@@ -15,10 +15,12 @@ the description and the /tf robot_state_publisher would publish for the whole ro
 
 from __future__ import annotations
 
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import replace
 import math
-from typing import Any, Callable, Protocol
+from typing import Any, Protocol
 
+from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.model.loop_urdf import LoopError
 from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
@@ -46,20 +48,15 @@ from linkage_kinematics.run.robot_loops import (
     read_loops,
     RobotLoopsFollower,
 )
-from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 
 
 class LoopsHost(SourceHost, Protocol):
-    """What this source asks of the node beyond ``SourceHost``: its logger, raw subscriptions."""
+    """What this source asks of the node beyond ``SourceHost``: its logger."""
 
     def get_logger(self) -> Any:
         """Return the node's logger."""
-
-    def create_subscription(self, msg_type: type, topic: str, callback: Callable[[Any], None],
-                            qos_profile: Any, *, raw: bool = False) -> object:
-        """Subscribe ``callback`` to ``topic``; ``raw``: it receives the message's bytes."""
 
 
 class ClosedRobot:
@@ -74,6 +71,56 @@ class ClosedRobot:
         self.transforms = RobotStateTransforms(urdf, config.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
+
+
+class TreePositions:
+    """
+    The positions of a robot's tree joints (``driven_joints``, in order) for its /tf.
+
+    The loops' joints as the last sample closed them, every other joint as the input last gave
+    it (0 before that). Kept from message to message: what is fixed for a names list and for a
+    plan is found once, and a sample sets only the joints that moved.
+    """
+
+    def __init__(self, tree_joints: Sequence[str], loop_joints: Collection[str],
+                 heard: dict[str, float]) -> None:
+        """``heard``: the input's last finite value of each joint outside the loops, kept."""
+        self._slots = {name: slot for slot, name in enumerate(tree_joints)}
+        self._loop_joints = loop_joints
+        self._heard = heard
+        self.positions = [heard.get(name, 0.0) for name in tree_joints]
+        self._from_loops: tuple[tuple[int, str], ...] | None = None  # slot, joint
+        self._names: Sequence[str] | None = None
+        self._others: tuple[tuple[int, str, int | None], ...] = ()  # index, name, slot
+
+    def note_input(self, names: Sequence[str], positions: Sequence[float]) -> None:
+        """Keep the input's finite value of each joint outside the loops."""
+        if names is not self._names:  # a source sends the same names message after message
+            slots, loop_joints = self._slots, self._loop_joints
+            self._others = tuple((index, name, slots.get(name))
+                                 for index, name in enumerate(names) if name not in loop_joints)
+            self._names = names
+        count = len(positions)
+        heard, tree_positions, isfinite = self._heard, self.positions, math.isfinite
+        for index, name, slot in self._others:
+            if index < count and isfinite(position := positions[index]):
+                heard[name] = position
+                if slot is not None:
+                    tree_positions[slot] = position
+
+    def at_sample(self, joints: Mapping[str, float]) -> list[float]:
+        """
+        Return the positions with a sample's measured and solved ``joints`` set.
+
+        Their names are the same at every sample of a plan.
+        """
+        if self._from_loops is None:
+            self._from_loops = tuple((slot, name) for name, slot in self._slots.items()
+                                     if name in joints)
+        tree_positions = self.positions
+        for slot, name in self._from_loops:
+            tree_positions[slot] = joints[name]
+        return tree_positions
 
 
 def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
@@ -106,6 +153,7 @@ class RobotLoopsSubscription:
         self._schedule = StatusSchedule()
         self._problem: str | None = None
         self._input_positions: dict[str, float] = {}  # joints outside the loops, as last heard
+        self._tree: TreePositions | None = None  # the robot's /tf positions
         self.stale = False
         self._following = False  # a message of this motion followed since the last start
         self._description_from = f'topic {outputs.description_topic}'
@@ -115,6 +163,9 @@ class RobotLoopsSubscription:
         else:
             host.create_subscription(String, ROBOT_DESCRIPTION_TOPIC, self._on_description,
                                      ROBOT_DESCRIPTION_QOS)
+        # raw: logged as received, and read by JointStateDecoder in a sixth of
+        # deserialize_message's time
+        self._decoder = JointStateDecoder()
         host.create_subscription(JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS,
                                  raw=True)
         self._freshness_timer = host.create_timer(0.25 * host.config.measured_timeout,
@@ -143,6 +194,8 @@ class RobotLoopsSubscription:
         """Follow ``robot`` from now on, and log it with its /tf_static."""
         self._robot = robot
         self._problem = None
+        self._tree = TreePositions(robot.tree_joints, robot.follower.loop_joints,
+                                   self._input_positions)
         self._following = False
         self._outputs.record_robot(robot.urdf, robot.transforms, self._host.now_ns())
         loops = robot.follower.loops
@@ -244,9 +297,11 @@ class RobotLoopsSubscription:
         host = self._host
         if host.control.paused:
             return  # ~/pause: not followed, not counted
-        message = deserialize_message(data, JointState)
-        stamp = message.header.stamp
-        stamp_ns = stamp.sec * 1_000_000_000 + stamp.nanosec
+        try:
+            stamp_ns, names, positions, velocities = self._decoder.decode(data)
+        except ValueError as error:  # not logged: it has no stamp, and readers would refuse it
+            self._loops_health.drop(LoopDrop(LoopRejection.MALFORMED, (), str(error)))
+            return
         robot = self._robot
         if robot is None:
             self._outputs.record_input(data, stamp_ns)
@@ -255,8 +310,7 @@ class RobotLoopsSubscription:
         follower = robot.follower
         planned = follower.plan is not None
         try:
-            followed = follower.follow(stamp_ns, message.name, message.position,
-                                       message.velocity)
+            followed = follower.follow(stamp_ns, names, positions, velocities)
         except LoopError as error:
             self._outputs.record_input(data, stamp_ns)
             self._loops_health.drop(LoopDrop(LoopRejection.NOT_PLANNED, (), str(error)))
@@ -266,7 +320,7 @@ class RobotLoopsSubscription:
         if followed is None:
             return  # none of the measured joints: e.g. this node's own output, heard back
         self._outputs.record_input(data, stamp_ns)
-        self._note_other_joints(message, follower)
+        self._tree.note_input(names, positions)
         if not planned:
             self._problem = None
             self._planned()
@@ -279,23 +333,13 @@ class RobotLoopsSubscription:
         self._following, self.stale = True, False
         self._outputs.publish_joint_states(followed.names, followed.positions,
                                            followed.velocities, stamp_ns)
-        # The whole robot as robot_state_publisher would pose it: the loops as closed, every
-        # other joint as the input last gave it (0 before that).
-        self._outputs.record_tf(
-            {name: followed.joints.get(name, self._input_positions.get(name, 0.0))
-             for name in robot.tree_joints}, stamp_ns)
+        # The whole robot as robot_state_publisher would pose it.
+        self._outputs.record_tf(self._tree.at_sample(followed.joints), stamp_ns)
         if first:
             self._show_activity()
         if self._schedule.due(stamp_ns) or first:
             self._schedule.sent(stamp_ns)
             host.publish_diagnostics(at_ns=stamp_ns)
-
-    def _note_other_joints(self, message: JointState, follower: RobotLoopsFollower) -> None:
-        """Keep the input's last finite value of each joint outside the loops (for /tf)."""
-        loop_joints = follower.loop_joints
-        for name, position in zip(message.name, message.position):
-            if name not in loop_joints and math.isfinite(position):
-                self._input_positions[name] = position
 
     def _check_freshness(self) -> None:
         """Report at once when the measured data goes stale."""

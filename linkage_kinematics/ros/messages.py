@@ -27,7 +27,11 @@ from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_N
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model import scene
-from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
+from linkage_kinematics.model.robot_transforms import (
+    MovingTransforms,
+    RobotTransforms,
+    Transform,
+)
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
@@ -288,12 +292,14 @@ class RobotStateTransforms:
     With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
     urdf_reader.UrdfError for a URDF it cannot read. The /tf of a joint state is written
     from the joints' prepared transforms (``RobotTransforms.moving``) and a prepared message,
-    both made again only when the joint state's names change.
+    both made again only when the joint state's names change; the /tf of the whole robot
+    (``tree_message``) from ones made once.
     """
 
     def __init__(self, urdf: str, frame_prefix: str) -> None:
         self._robot = RobotTransforms(urdf, frame_prefix)
         self._names: tuple[str, ...] | None = None
+        self._tree: tuple[MovingTransforms, TFMessageEncoder] | None = None
 
     @property
     def driven_joints(self) -> tuple[str, ...]:
@@ -317,3 +323,15 @@ class RobotStateTransforms:
             self._encoder = TFMessageEncoder(self._moving.frames)
             self._names = names
         return self._encoder.encode(self._moving.values(positions.values()), stamp_ns)
+
+    def tree_message(self, positions: Sequence[float], stamp_ns: int) -> bytes:
+        """
+        Return /tf for every driven joint at ``positions``, in ``driven_joints``' order.
+
+        The bytes ``message`` gives for those joints by name, without a mapping per state.
+        """
+        if self._tree is None:
+            moving = self._robot.moving(self._robot.driven_joints)
+            self._tree = moving, TFMessageEncoder(moving.frames)
+        moving, encoder = self._tree
+        return encoder.encode(moving.values(positions), stamp_ns)

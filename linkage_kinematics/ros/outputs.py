@@ -11,6 +11,7 @@ logged at the message's stamp, so subscribers receive exactly what the bag holds
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 import json
 import time
 from typing import Any, NamedTuple
@@ -257,10 +258,15 @@ class NodeOutputs:
         self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
         self._record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
 
-    def record_tf(self, positions: dict[str, float], stamp_ns: int) -> None:
-        """Log the /tf robot_state_publisher would publish at ``positions`` (joint → value)."""
+    def record_tf(self, positions: Sequence[float], stamp_ns: int) -> None:
+        """
+        Log the /tf robot_state_publisher would publish at ``positions``.
+
+        The positions of the recorded robot's ``driven_joints``, in that order.
+        """
         if self.recorder is not None and self._robot_transforms is not None:
-            self._record(TF_TOPIC, self._robot_transforms.message(positions, stamp_ns), stamp_ns)
+            self._record(TF_TOPIC, self._robot_transforms.tree_message(positions, stamp_ns),
+                         stamp_ns)
 
     def publish_statuses(self, stamp_ns: int, statuses: tuple[Status, ...]) -> None:
         """Publish several statuses in one array, each named '<node>: <task>'."""

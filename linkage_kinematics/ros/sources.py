@@ -17,6 +17,7 @@ from collections.abc import Callable
 import math
 from typing import Any, Protocol
 
+from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import Link, TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
@@ -124,8 +125,13 @@ class SourceHost(Protocol):
         """Destroy a timer made by ``create_timer``."""
 
     def create_subscription(self, msg_type: type, topic: str,
-                            callback: Callable[[Any], None], qos_profile: QoSProfile) -> object:
-        """Subscribe ``callback`` to ``topic`` (relative to the node's namespace)."""
+                            callback: Callable[[Any], None], qos_profile: QoSProfile, *,
+                            raw: bool = False) -> object:
+        """
+        Subscribe ``callback`` to ``topic`` (relative to the node's namespace).
+
+        ``raw``: the callback receives the message's CDR bytes rather than the message.
+        """
 
     def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
                       joints: TreeValues | None = None) -> None:
@@ -360,8 +366,10 @@ class MeasuredSubscription:
         host.set_activity(
             f'paused: {self._driver_name} is not followed until ~/resume' if host.control.paused
             else f'waiting for {self._driver_name} on measured_joint_states')
+        # raw: JointStateDecoder reads the bytes in a sixth of deserialize_message's time
+        self._decoder = JointStateDecoder()
         host.create_subscription(
-            JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS)
+            JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS, raw=True)
         self._freshness_timer = host.create_timer(0.25 * config.measured_timeout,
                                                   self._check_freshness)
 
@@ -424,12 +432,15 @@ class MeasuredSubscription:
         return ServiceAnswer(True, 'the motion starts afresh at the next valid sample' + (
             '; paused: ~/resume follows it' if paused else ''))
 
-    def _on_message(self, message: JointState) -> None:
+    def _on_message(self, data: bytes) -> None:
         if self._host.control.paused:
             return  # ~/pause: not followed, not counted
-        stamp = message.header.stamp
-        followed = self._follower.follow(stamp.sec * 1_000_000_000 + stamp.nanosec,
-                                         message.name, message.position, message.velocity)
+        try:
+            fields = self._decoder.decode(data)
+        except ValueError:
+            self.health.drop(Rejection.MALFORMED)
+            return
+        followed = self._follower.follow(*fields)
         if followed is None:
             return  # this node's own joint states, heard back
         if isinstance(followed, Rejection):

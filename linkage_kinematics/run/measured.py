@@ -77,6 +77,7 @@ class Rejection(StrEnum):
     STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
     UNREACHABLE = 'at a driver angle the loop cannot reach (or at a dead point)'
     JUMP = 'jumping further than measured.max_jump'
+    MALFORMED = 'whose bytes are not a well-formed JointState'
 
 
 class Estimate(StrEnum):
@@ -182,7 +183,7 @@ class MeasuredFollower:
         None for a message that is this node's own output (see ``__init__``).
         """
         try:
-            index = list(names).index(self._mapping.name)
+            index = names.index(self._mapping.name)
             measured_angle = positions[index]
         except (ValueError, IndexError):
             if names and self._own_names.issuperset(names):

@@ -46,6 +46,7 @@ class LoopRejection(StrEnum):
     STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
     UNREACHABLE = 'at joint values a loop cannot reach (or at a dead point)'
     JUMP = 'jumping further than measured.max_jump'
+    MALFORMED = 'whose bytes are not a well-formed JointState'
 
 
 @dataclass(frozen=True)
@@ -57,14 +58,15 @@ class LoopDrop:
     detail: str
 
 
-@dataclass(frozen=True)
+@dataclass
 class LoopSample:
     """
     The passive loop joints at one message, in solve order, and what came with them.
 
     ``joints`` holds every measured and solved loop joint's position (for /tf);
     ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
-    loop's known joint value (URDF units), by constraint.
+    loop's known joint value (URDF units), by constraint. A value, not frozen: a frozen
+    dataclass's seven ``object.__setattr__`` cost four times its plain ``__init__`` per sample.
     """
 
     stamp_ns: int
@@ -128,6 +130,7 @@ class RobotLoopsFollower:
                             for planned in plan.loops)
         self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
                                    if planned.known.name == name) for name in measured}
+        self._passive = plan.passive  # the solved joints' names, in the order solve gives them
         self._names: Sequence[str] | None = None  # the names _indices were found in
 
     def restart(self) -> None:
@@ -160,41 +163,49 @@ class RobotLoopsFollower:
             index = {name: i for i, name in enumerate(names)}
             self._names = names[:]
             self._indices = tuple(index.get(name) for name in measured)
+            self._present = tuple(i for i in self._indices if i is not None)
         indices = self._indices
-        if all(i is None for i in indices):
+        if not self._present:
             return None
-        count = len(positions)
-        missing = [name for name, i in zip(measured, indices) if i is None or i >= count]
-        if missing:
+        if len(self._present) < len(measured) or max(self._present) >= len(positions):
+            count = len(positions)
+            missing = [name for name, i in zip(measured, indices) if i is None or i >= count]
             return LoopDrop(LoopRejection.NO_JOINT, self._loops_of(missing),
                             f'no position of {missing}')
-        values = {name: positions[i] for name, i in zip(measured, indices)}
         count = len(velocities)
-        given = {name: velocities[i] for name, i in zip(measured, indices) if i < count}
-        bad = [name for name in measured if not math.isfinite(values[name])
-               or not math.isfinite(given.get(name, 0.0))]
-        if bad:
+        values, given, finite = {}, [], True
+        isfinite = math.isfinite
+        for name, i in zip(measured, indices):
+            value = values[name] = positions[i]
+            rate = velocities[i] if i < count else None
+            given.append(rate)
+            if not isfinite(value) or (rate is not None and not isfinite(rate)):
+                finite = False
+        if not finite:
+            bad = [name for name, rate in zip(measured, given)
+                   if not isfinite(values[name]) or not isfinite(0.0 if rate is None else rate)]
             return LoopDrop(LoopRejection.NON_FINITE, self._loops_of(bad),
                             f'{bad} not finite')
-        if self._last_stamp_ns is not None and stamp_ns <= self._last_stamp_ns:
+        last_stamp_ns = self._last_stamp_ns
+        if last_stamp_ns is not None and stamp_ns <= last_stamp_ns:
             return LoopDrop(LoopRejection.STAMP_NOT_NEWER, (), 'stamp not newer')
         last_values = self._last
-        jumps = []
-        for name in self._revolute:
-            if name in last_values:
+        if last_values:
+            jumps = []
+            for name in self._revolute:
                 # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are
                 # counted.
                 last = last_values[name]
-                values[name] += round((last - values[name]) / TWO_PI) * TWO_PI
-                if abs(values[name] - last) > self.max_jump:
+                value = values[name] = (values[name]
+                                        + round((last - values[name]) / TWO_PI) * TWO_PI)
+                if abs(value - last) > self.max_jump:
                     jumps.append(name)
-        if jumps:
-            return LoopDrop(LoopRejection.JUMP, self._loops_of(jumps), f'{jumps} jumped')
+            if jumps:
+                return LoopDrop(LoopRejection.JUMP, self._loops_of(jumps), f'{jumps} jumped')
         rates, estimates = {}, {}
-        for name in measured:
-            last = None if name not in last_values else (self._last_stamp_ns, last_values[name])
-            rates[name], estimates[name] = joint_velocity(stamp_ns, values[name],
-                                                          given.get(name), last)
+        for name, rate in zip(measured, given):
+            last = None if not last_values else (last_stamp_ns, last_values[name])
+            rates[name], estimates[name] = joint_velocity(stamp_ns, values[name], rate, last)
         try:
             solved, solved_rates = self.solver.solve(values, rates)
         except LoopSampleError as error:
@@ -203,7 +214,7 @@ class RobotLoopsFollower:
         self._last_stamp_ns, self._last = stamp_ns, values
         joints = {**values, **solved}
         return LoopSample(
-            stamp_ns, tuple(solved), tuple(solved.values()), tuple(solved_rates.values()),
+            stamp_ns, self._passive, tuple(solved.values()), tuple(solved_rates.values()),
             joints, estimates,
             {constraint: joints[known] for constraint, known in self._known})
 
