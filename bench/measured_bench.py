@@ -28,6 +28,7 @@ import tempfile
 import time
 
 from cost_bench import cpu_seconds
+from linkage_kinematics.bag.reader import iter_messages
 import node_bench
 from timing import markdown_table
 
@@ -35,6 +36,7 @@ HERE = pathlib.Path(__file__).resolve().parent
 RATE_HZ = 1000.0
 RELAY = 'minimal rclpy relay'
 RELAY_TOPIC = '/relay/joint_states'
+INPUT_TOPIC = '/encoder/joint_states'  # the followers' input, as the node's bag names it
 # The window's edges: samples published this close to its start or end may fall outside it.
 EDGE_S = 0.5
 
@@ -47,7 +49,7 @@ def percentile(values: list[float], fraction: float) -> float:
 def node_command(namespace: str, folder: str, arguments: list[str]) -> list[str]:
     """Return linkage_node's command line following the encoder, logging into ``folder``."""
     return [sys.executable, '-m', 'linkage_kinematics.ros.node', '--ros-args',
-            '-r', f'__ns:={namespace}', '-r', 'measured_joint_states:=/encoder/joint_states',
+            '-r', f'__ns:={namespace}', '-r', f'measured_joint_states:={INPUT_TOPIC}',
             '-p', 'source:=measured', '-p', f'log.folder:={folder}/bags', *arguments]
 
 
@@ -116,16 +118,39 @@ def follow_side_by_side(
                     process.send_signal(signal.SIGINT)
             for process in processes.values():
                 node_bench.stop(process)
+        # The node's bag holds every input it received and every joint state it published,
+        # each at the input's stamp: what the node itself did with each sample.
+        logged = {'received': set(), 'published': set()}
+        output_topic = outputs[name]
+        bag, = (pathlib.Path(folder) / 'bags').iterdir()  # the run's one bag folder
+        for message in iter_messages(bag, (INPUT_TOPIC, output_topic)):
+            kind = 'received' if message.topic == INPUT_TOPIC else 'published'
+            logged[kind].add(message.log_time_ns)
     shown = data.get('names', {}).get(outputs[name])
     if published is not None and set(shown or ()) != published:
         raise RuntimeError(f'{name} published {shown}, not the joints {sorted(published)}')
     cpu = {key: (after[key] - before[key]) / elapsed for key in processes}
-    return _figures(data['received'], sent, outputs, cpu)
+    figures = _figures(data['received'], sent, outputs, cpu)
+    expected = figures[name].pop('expected stamps')
+    figures[RELAY].pop('expected stamps')
+    # Only the loops node logs its input; the four-bar node's bag has its outputs alone.
+    received_by_node = logged['received'] & expected if logged['received'] else None
+    figures[name]['in the node'] = {
+        'published': len(logged['published'] & expected),
+        'received': None if received_by_node is None else len(received_by_node),
+        'dropped': None if received_by_node is None else len(
+            received_by_node - logged['published']),
+    }
+    return figures
 
 
 def _figures(received: dict[str, list[tuple[int, int]]], sent: list[int],
              outputs: dict[str, str], cpu: dict[str, float]) -> dict[str, dict[str, float]]:
-    """Return each follower's CPU, latencies and samples lost within the listener's window."""
+    """
+    Return each follower's CPU, latencies and samples lost within the listener's window.
+
+    Lost: not received by the listener (before the follower, in it, or on the way out).
+    """
     figures = {}
     all_arrivals = [arrival for samples in received.values() for _, arrival in samples]
     window = (min(all_arrivals) + EDGE_S * 1e9, max(all_arrivals) - EDGE_S * 1e9)
@@ -140,6 +165,7 @@ def _figures(received: dict[str, list[tuple[int, int]]], sent: list[int],
             'p99': percentile(latencies, 0.99),
             'missing': expected - {stamp for stamp, _ in samples},
             'expected': len(expected),
+            'expected stamps': expected,
         }
     # A sample neither output delivered was lost before both (the encoder's writer, or the
     # listener falling behind both), not by one follower.
@@ -162,8 +188,16 @@ def report(figures: dict[str, dict[str, float]]) -> str:
     goals = (
         f"\nCPU ratio node ÷ relay: {node['cpu'] / relay['cpu']:.2f} (goal ≤ 1.0); p99 "
         f"latency node − relay: {1e3 * (node['p99'] - relay['p99']):+.3f} ms (goal ≤ +0.5 ms); "
-        f"samples lost by the node: {node['lost']} (goal 0)."
+        f"samples the listener missed from the node: {node['lost']}."
     )
+    inside = node['in the node']
+    goals += (f"\nThe node's bag: a joint state for {inside['published']} of the "
+              f"{node['expected']} samples sent in the window")
+    if inside['received'] is not None:
+        goals += (f"; it received {inside['received']} of them and dropped "
+                  f"{inside['dropped']} (goal 0: no sample lost by the node)")
+    goals += '.'
+
     return table + '\n' + goals
 
 
