@@ -144,17 +144,20 @@ class JointStream:
         self.names = self.tree_names[self.published]
         self._driver = driver
         self._previous = (0.0, 0.0, 0.0)
+        # each joint's direction and offset, read once: ``values`` runs at every tick
+        self._coefficients = tuple((mapping.direction, mapping.offset)
+                                   for mapping in self._mappings)
 
     def values(self, state: LinkageState) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """
         Return the lab's positions (rad) and velocities (rad/s) at ``state``.
 
-        Of the whole tree (``tree_names``); ``published`` slices out those in ``names``.
+        Of the whole tree (``tree_names``); ``published`` slices out those in ``names``. Each
+        is ``JointMapping.to_lab`` of the node's position, and the velocity times its direction.
         """
         positions, velocities = tree_values(state, self._driver)
         self._previous = positions = unwrap_positions(positions, self._previous)
-        return (
-            tuple(mapping.to_lab(value) for mapping, value in zip(self._mappings, positions)),
-            tuple(mapping.direction * value
-                  for mapping, value in zip(self._mappings, velocities)),
-        )
+        (root, first, second), (root_rate, first_rate, second_rate) = positions, velocities
+        (d0, o0), (d1, o1), (d2, o2) = self._coefficients
+        return ((d0 * root + o0, d1 * first + o1, d2 * second + o2),
+                (d0 * root_rate, d1 * first_rate, d2 * second_rate))

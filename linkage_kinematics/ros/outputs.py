@@ -116,6 +116,7 @@ class NodeOutputs:
         self.description_topic = node.resolve_topic_name(ROBOT_DESCRIPTION_TOPIC)
         self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
+        self._prepared_for: RunConfiguration | None = None
         self._encoded: FourBar | None = None
         self._streamed: JointMap | None = None
         self._robot_transforms: messages.RobotStateTransforms | None = None
@@ -174,6 +175,9 @@ class NodeOutputs:
 
     def _prepare(self) -> None:
         """Prepare the encoders of the per-state messages for the geometry and joints."""
+        if self._prepared_for is self.config:
+            return  # a dataclass's != compares every field: once per configuration, not state
+        self._prepared_for = self.config
         if self._encoded != self.config.linkage:
             linkage = self.config.linkage
             self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
