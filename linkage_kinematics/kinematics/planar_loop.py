@@ -108,8 +108,13 @@ class PlanarLoop:
     @property
     def closure_gap(self) -> float:
         """|Σ links| (m): how far the all-zero pose is from closing (the exporter's rounding)."""
-        return math.hypot(sum(link[0] for link in self.links),
-                          sum(link[1] for link in self.links))
+        # Added in order, not with sum(): Python 3.12's sum() of floats compensates, and the
+        # gap is all rounding, so it would read differently on the 3.11 and 3.12 this runs on.
+        x = y = 0.0
+        for link_x, link_y in self.links:
+            x += link_x
+            y += link_y
+        return math.hypot(x, y)
 
 
 def _vectors(values: object) -> tuple[tuple[float, float], ...] | None:

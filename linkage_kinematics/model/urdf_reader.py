@@ -267,7 +267,9 @@ def _joint(joint: urdf_parser.Joint, links: set[str]) -> UrdfJoint:
     xyz = _vector(origin.xyz if origin is not None else (0.0, 0.0, 0.0), f'{where} origin xyz')
     rpy = _vector(origin.rpy if origin is not None else (0.0, 0.0, 0.0), f'{where} origin rpy')
     axis = _vector(joint.axis if joint.axis is not None else (1.0, 0.0, 0.0), f'{where} axis')
-    length = math.sqrt(sum(component * component for component in axis))
+    # Added in order, not with sum(): Python 3.12's sum() of floats compensates, so a unit axis
+    # would differ in its last bit between the 3.11 and 3.12 this package runs on.
+    length = math.sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2])
     if joint_type in MOVABLE_TYPES and length == 0.0:
         raise UrdfError(f'{where}: the axis is zero')
     if length > 0.0:

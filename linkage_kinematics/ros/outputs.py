@@ -89,10 +89,9 @@ class NodeOutputs:
     The node's publishers, the encoders of its per-state messages, and its recorder.
 
     Relative names resolve under the node's namespace (as joint_state_publisher's and
-    robot_state_publisher's do), so mechanisms in different namespaces never mix;
-    /diagnostics is absolute, diagnostic_updater's convention. Construction raises
-    ConfigurationError naming log.folder if the log cannot be written, StartupError for any
-    other reason, such as a message definition that cannot be found (before any folder is made).
+    robot_state_publisher's do); /diagnostics is absolute, diagnostic_updater's convention.
+    Construction raises ConfigurationError naming log.folder if the log cannot be written,
+    StartupError for any other reason (e.g. a message definition not found), before any folder.
     """
 
     def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
