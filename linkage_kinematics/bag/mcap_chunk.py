@@ -8,7 +8,7 @@ mcap 1.6.0's ``Writer.add_message`` costs about 3 µs per message in Python: a `
 dataclass, the statistics, the chunk builder's index entry (a tuple) and the record written
 with six small ``BytesIO`` writes and a seek back; ending a chunk writes its message indexes
 entry by entry. ``MessageChunk`` takes the place of the writer's chunk builder. A message
-record comes already packed (``MESSAGE_HEADER`` and the data: the bag writer's node packs it,
+record comes already packed (``message_header`` and the data: the bag writer's node packs it,
 so its child only copies runs of records), its index entries go into a list of integers per
 channel, packed in one go when the chunk ends, and the writer's statistics are updated once
 per run of records. The writer itself still writes everything else: the header, schemas and
@@ -37,22 +37,27 @@ from mcap.writer import Writer
 
 # A Message record up to its data: opcode, record length, channel id, sequence, log time,
 # publish time (mcap's Message.write, field by field).
-MESSAGE_HEADER = struct.Struct('<BQHIQQ')
-MESSAGE_OPCODE = Opcode.MESSAGE
+_MESSAGE_HEADER = struct.Struct('<BQHIQQ')
 _RECORD_PREFIX = 9  # every record's opcode and record length
 # The record length of a message besides its data: channel id to publish time.
-MESSAGE_FIELDS_SIZE = MESSAGE_HEADER.size - _RECORD_PREFIX
+_MESSAGE_FIELDS_SIZE = _MESSAGE_HEADER.size - _RECORD_PREFIX
 # What an index entry and a split need of a record: its length, channel, log and publish time.
 _RECORD_FIELDS = struct.Struct('<xQH4xQQ')
 _INDEX_HEADER = struct.Struct('<BQHI')  # opcode, record length, channel id, entries' length
 Records = bytes | bytearray  # Message records, one after the other
 
 
+def message_header(channel_id: int, log_time_ns: int, publish_time_ns: int,
+                   data_length: int) -> bytes:
+    """Return a Message record up to its ``data_length`` bytes of data (sequence 0)."""
+    return _MESSAGE_HEADER.pack(Opcode.MESSAGE, _MESSAGE_FIELDS_SIZE + data_length, channel_id,
+                                0, log_time_ns, publish_time_ns)
+
+
 def message_record(channel_id: int, log_time_ns: int, publish_time_ns: int,
                    data: bytes) -> bytes:
     """Return the MCAP Message record of one message (sequence 0, as the bag writer's)."""
-    return MESSAGE_HEADER.pack(MESSAGE_OPCODE, MESSAGE_FIELDS_SIZE + len(data), channel_id, 0,
-                               log_time_ns, publish_time_ns) + data
+    return message_header(channel_id, log_time_ns, publish_time_ns, len(data)) + data
 
 
 def record_fields(records: Records, offset: int) -> tuple[int, int, int, int, int]:
@@ -60,7 +65,7 @@ def record_fields(records: Records, offset: int) -> tuple[int, int, int, int, in
     length, channel_id, log_time_ns, publish_time_ns = _RECORD_FIELDS.unpack_from(
         records, offset)
     return (offset + _RECORD_PREFIX + length, channel_id, log_time_ns, publish_time_ns,
-            offset + MESSAGE_HEADER.size)
+            offset + _MESSAGE_HEADER.size)
 
 
 class _MessageIndex:

@@ -41,7 +41,7 @@ import time
 from typing import Any, BinaryIO
 
 from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
-from linkage_kinematics.bag.mcap_chunk import MESSAGE_FIELDS_SIZE, MESSAGE_HEADER, MESSAGE_OPCODE
+from linkage_kinematics.bag.mcap_chunk import message_header
 from linkage_kinematics.bag.writer import BagWriter
 from linkage_kinematics.run.limits import NO_SPLIT
 from linkage_kinematics.run.placement import set_process_affinity
@@ -120,8 +120,7 @@ class BagWriterProcess:
         """Queues one serialized message; a full or old batch goes to the child."""
         if self._failure is not None or self._closed:
             raise BagError(self._failure or f'bag {self.bag_path} is closed')
-        self._queued += MESSAGE_HEADER.pack(MESSAGE_OPCODE, MESSAGE_FIELDS_SIZE + len(data),
-                                            channel_id, 0, log_time_ns, publish_time_ns)
+        self._queued += message_header(channel_id, log_time_ns, publish_time_ns, len(data))
         self._queued += data
         if (len(self._queued) >= BATCH_SIZE
                 or time.monotonic() - self._batch_started >= BATCH_AGE):

@@ -30,6 +30,7 @@ from linkage_kinematics.kinematics.planar_loop import (
     known_joint_range,
     UnreachableError,
 )
+from linkage_kinematics.kinematics.solver import unwrap_near
 from linkage_kinematics.model.loop_geometry import derive_loop, Loop, LoopJoint
 from linkage_kinematics.model.loop_urdf import LoopError, read_robot
 
@@ -284,8 +285,8 @@ class LoopSolver:
             coordinates, state_rates = state.coordinates, state.rates
             for passive_place, joint_sign, index, revolute in passive:
                 position = joint_sign * coordinates[index]
-                if revolute:  # solver.unwrap_near, written out: a call costs more than it
-                    position += TWO_PI * round((previous[passive_place] - position) / TWO_PI)
+                if revolute:
+                    position = unwrap_near(position, previous[passive_place])
                 values.append(position)
                 rates.append(joint_sign * state_rates[index])
         self._known_values, self._branches = known_values, branches

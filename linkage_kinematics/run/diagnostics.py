@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import collections
 from dataclasses import dataclass
-from enum import IntEnum
+from enum import Enum, IntEnum
 import math
 
 from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
@@ -251,12 +251,14 @@ class Freshness:
 
     No valid sample for ``measured.timeout`` (node clock) makes the source's status ERROR, as
     diagnostic_updater's frequency status says ERROR when no event came in its window. Both
-    measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``).
+    measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``),
+    each with ``totals``, its dropped samples by reason (a member of ``reasons``).
     """
 
-    def __init__(self, start_ns: int) -> None:
+    def __init__(self, start_ns: int, reasons: type[Enum]) -> None:
         self.accepted = 0
         self.last_valid_ns: int | None = None
+        self.totals = dict.fromkeys(reasons, 0)
         self._start_ns = start_ns
 
     def _accepted_at(self, now_ns: int) -> None:
@@ -267,6 +269,19 @@ class Freshness:
         """Whether no valid sample came for ``timeout`` seconds (since the start, at first)."""
         since = self.last_valid_ns if self.last_valid_ns is not None else self._start_ns
         return (now_ns - since) * 1e-9 > timeout
+
+    def sample_values(self, now_ns: int) -> dict[str, str]:
+        """Return the key values of the samples: valid, dropped (by reason), the last's age."""
+        values = {
+            'valid samples': str(self.accepted),
+            'dropped samples': str(sum(self.totals.values())),
+        }
+        values.update({f'dropped {reason.value}': str(count)
+                       for reason, count in self.totals.items()})
+        values['last valid sample age (s)'] = (
+            'none yet' if self.last_valid_ns is None
+            else f'{(now_ns - self.last_valid_ns) * 1e-9:.3f}')
+        return values
 
     def _stale_problem(self, now_ns: int, timeout: float, sample: str) -> str | None:
         """Return the ERROR message naming ``sample`` when the data is stale, else None."""
@@ -287,8 +302,7 @@ class MeasuredHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns)
-        self.totals = dict.fromkeys(Rejection, 0)
+        super().__init__(start_ns, Rejection)
         self._window = dict.fromkeys(Rejection, 0)
         self.velocity: Estimate | None = None
 
@@ -315,17 +329,8 @@ class MeasuredHealth(Freshness):
 
     def values(self, now_ns: int, config: RunConfiguration) -> dict[str, str]:
         """Return the key values: counts, freshness, and which quantities are estimates."""
-        values = {
-            'source': 'measured',
-            'driver': config.driver.value,
-            'valid samples': str(self.accepted),
-            'dropped samples': str(sum(self.totals.values())),
-        }
-        values.update({f'dropped {rejection.value}': str(count)
-                       for rejection, count in self.totals.items()})
-        values['last valid sample age (s)'] = (
-            'none yet' if self.last_valid_ns is None
-            else f'{(now_ns - self.last_valid_ns) * 1e-9:.3f}')
+        values = {'source': 'measured', 'driver': config.driver.value,
+                  **self.sample_values(now_ns)}
         values['measured'] = f'{config.driver.value} angle' + (
             f', {config.driver.value} angular velocity'
             if self.velocity is Estimate.MEASURED else '')

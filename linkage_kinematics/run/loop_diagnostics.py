@@ -65,8 +65,7 @@ class LoopsHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns)
-        self.totals = _counts()
+        super().__init__(start_ns, LoopRejection)
         self._window = _counts()
         self.per_loop: dict[str, dict[LoopRejection, int]] = {}
         self._loop_window: dict[str, dict[LoopRejection, int]] = {}
@@ -179,14 +178,8 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
         'description from': view.description_from,
         'measured joints': ('not known yet' if plan is None else ', '.join(plan.measured)),
         'passive joints': ('not known yet' if plan is None else ', '.join(plan.passive)),
-        'valid samples': str(health.accepted),
-        'dropped samples': str(sum(health.totals.values())),
+        **health.sample_values(inputs.now_ns),
     }
-    values.update({f'dropped {reason.value}': str(count)
-                   for reason, count in health.totals.items()})
-    values['last valid sample age (s)'] = (
-        'none yet' if health.last_valid_ns is None
-        else f'{(inputs.now_ns - health.last_valid_ns) * 1e-9:.3f}')
     sample = health.last
     estimated = [] if sample is None else [
         f'{name} velocity ({how.value})'
