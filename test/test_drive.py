@@ -75,9 +75,14 @@ def test_flow_matches_closed_form_and_inverts(omega0, k, alpha_start, elapsed) -
     )
     assume(abs(alpha - alpha_start) > 1e-9 * (1.0 + abs(alpha_start)))
     back = drive.time_to(alpha_start, alpha)
-    # The inverse is as well conditioned as |dt/dα| = 1/|ω(α)| allows.
+    # The inverse is as well conditioned as |dt/dα| = 1/|ω(α)| allows, and carries the rounding
+    # of ω_s too: ∂t/∂ω_s = −(α − α_s)/(ω_s·ω(α)), large where ω_s is small by cancellation
+    # (ω0 = 3, k = 3, α_s = −0.99999: ω_s = 3e-5, relative rounding 1.5e-11).
     spacing = math.ulp(max(abs(alpha), abs(alpha_start), 1.0))
-    condition = 4.0 * spacing / abs(drive.angular_velocity(alpha))
+    omega_rounding_relative = (4 * 2.2e-16 * (abs(omega0) + abs(k * alpha_start))
+                               / abs(drive.angular_velocity(alpha_start)))
+    condition = (4.0 * spacing + omega_rounding_relative * abs(alpha - alpha_start)) / abs(
+        drive.angular_velocity(alpha))
     assert back == pytest.approx(exact_time(drive, alpha_start, alpha), rel=1e-13, abs=condition)
     assert back == pytest.approx(elapsed, rel=1e-9, abs=condition + 1e-12)
 
