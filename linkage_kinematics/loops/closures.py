@@ -1,0 +1,95 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The one model of a loop closure, whichever encoding a robot description wrote it in.
+
+A closure cuts a closed kinematic loop of a URDF tree: two frames, each fixed on a link, that
+the mechanism keeps together. Its ``ClosureKind`` says how much of them coincides:
+
+* ``PIN``: the two origins coincide and the two axes are aligned; the frames may turn about
+  that axis (a revolute joint, five equations);
+* ``BALL``: the two origins coincide (a spherical joint, three equations);
+* ``WELD``: the two frames coincide (a fixed joint, six equations).
+
+Three encodings are read (one reader module each): urdfdom PR #264's ``<constraint>`` element,
+Isaac Sim's ``<loop_joint>`` element, and the closure file of Pinocchio's
+toolbox-parallel-robots (the "Extended URDF" YAML side file). The closure file may also name
+the actuated joints and override URDF joints as spherical or universal joints
+(``JointOverride``). Lengths in metres, angles in radians.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+import enum
+
+Vector = tuple[float, float, float]
+
+
+class ClosureKind(enum.Enum):
+    """How much of the two frames of a closure coincides."""
+
+    PIN = 'pin'
+    BALL = 'ball'
+    WELD = 'weld'
+
+    @property
+    def equations(self) -> int:
+        """Return the number of scalar equations the closure imposes."""
+        return {ClosureKind.PIN: 5, ClosureKind.BALL: 3, ClosureKind.WELD: 6}[self]
+
+
+class Encoding(enum.Enum):
+    """Where a closure was read from; its value names the element or file for people."""
+
+    CONSTRAINT = '<constraint>'
+    LOOP_JOINT = '<loop_joint>'
+    CLOSURE_FILE = 'closure file'
+
+
+@dataclass(frozen=True)
+class ClosureSide:
+    """
+    One frame of a closure: fixed on ``link``, at ``xyz`` (m) turned by ``rpy`` (rad) from it.
+
+    ``axis`` is the unit axis of a pin in this frame; None where the encoding gave none.
+    """
+
+    link: str
+    xyz: Vector
+    rpy: Vector
+    axis: Vector | None = None
+
+
+@dataclass(frozen=True)
+class Closure:
+    """A loop closure: its name, kind and two frames, and the encoding it was read from."""
+
+    name: str
+    kind: ClosureKind
+    parent: ClosureSide
+    child: ClosureSide
+    encoding: Encoding
+
+
+class JointOverride(enum.Enum):
+    """
+    A URDF joint the closure file reads as another joint, about its joint frame's axes.
+
+    The value lists the rotation axes in order (the joint frame's, as toolbox-parallel-robots
+    names them: ``UJOINT_ZY`` turns about z, then about the turned y).
+    """
+
+    SPHERICAL = 'xyz'
+    UJOINT_XY = 'xy'
+    UJOINT_XZ = 'xz'
+    UJOINT_YX = 'yx'
+    UJOINT_YZ = 'yz'
+    UJOINT_ZX = 'zx'
+    UJOINT_ZY = 'zy'
+
+    @property
+    def axes(self) -> tuple[str, ...]:
+        """Return the joint frame's axes it turns about, in order."""
+        return tuple(self.value)
