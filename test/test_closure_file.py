@@ -71,7 +71,7 @@ def test_the_overrides_read_as_the_loaders_joints() -> None:
                              "'<stream end>' at line 1, column 21"),
     ('\tclosed_loop: []', "the closure file is not YAML: found character '\\t' that cannot "
                           'start any token at line 1, column 1'),
-    ('name_mot: [\x07]', "the closure file is not YAML: unacceptable character #x0007: special "
+    ('name_mot: [\x07]', 'the closure file is not YAML: unacceptable character #x0007: special '
                          'characters are not allowed in "<unicode string>", position 11'),
     ('', 'the closure file is empty'),
     ('- closed_loop', f'the closure file is not a mapping of keys {KEYS}'),
@@ -159,7 +159,7 @@ def test_a_coordinate_name_the_urdf_uses_is_refused() -> None:
 def test_a_name_of_a_link_and_of_a_joint_with_another_child_is_two_frames() -> None:
     extra = ('<link name="elbow"/><joint name="elbow_mount" type="fixed"><parent link="rod"/>'
              '<child link="elbow"/></joint>')
-    assert read("closed_loop: [[elbow, foot], [heel, foot]]\ntype: [3d, 3d]",
+    assert read('closed_loop: [[elbow, foot], [heel, foot]]\ntype: [3d, 3d]',
                 extra).problems == (
         "closed_loop: entry 1: 'elbow' names a link and a joint of another child link ('rod'): "
         'two frames',)

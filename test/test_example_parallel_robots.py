@@ -24,8 +24,10 @@ def described(urdf: str, closure_file: str | None = None) -> ClosureDescription:
     return description
 
 
-def frames(description: ClosureDescription) -> list[tuple[str, ClosureKind, ClosureSide,
-                                                           ClosureSide]]:
+Frames = list[tuple[str, ClosureKind, ClosureSide, ClosureSide]]
+
+
+def frames(description: ClosureDescription) -> Frames:
     return [(closure.name, closure.kind, closure.parent, closure.child)
             for closure in description.closures]
 

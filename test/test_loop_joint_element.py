@@ -38,7 +38,7 @@ def test_xyz_and_rpy_default_to_zero_as_isaac_sims_parser() -> None:
 
 @pytest.mark.parametrize('written', ['revolute', 'continuous'])
 def test_a_revolute_loop_joint_turns_about_its_frames_x_axis(written: str) -> None:
-    """USD's revolute joint turns about physics:axis, X by default; the exporter writes none."""
+    """A USD revolute joint turns about physics:axis, X by default; the exporter writes none."""
     closures, problems = read(loop_joint(kind=written))
     assert problems == ()
     assert closures[0].kind is ClosureKind.PIN
