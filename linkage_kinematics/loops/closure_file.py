@@ -50,7 +50,6 @@ KINDS = {'3d': ClosureKind.BALL, '3D': ClosureKind.BALL,
          '6d': ClosureKind.WELD, '6D': ClosureKind.WELD}
 KIND_WORDS = "'3d' (a ball: the frames' origins coincide) or '6d' (a weld: the frames coincide)"
 OVERRIDE_WORDS = ', '.join(override.name for override in JointOverride)
-ZERO = (0.0, 0.0, 0.0)
 
 
 def _content(text: str) -> dict:
@@ -123,7 +122,7 @@ def _closures(tree: UrdfTree, content: dict, problems: list[str]) -> tuple[Closu
             name = f'{pair[0]}C{pair[1]}'
             if name in names:
                 raise ClosureError(f'{where}: the pair {pair[0]!r}, {pair[1]!r} is listed twice')
-            sides = [ClosureSide(_frame_link(tree, frame, where), ZERO, ZERO) for frame in pair]
+            sides = [ClosureSide(_frame_link(tree, frame, where)) for frame in pair]
             names.add(name)
             closures.append(Closure(name, KINDS[kind], sides[0], sides[1], Encoding.CLOSURE_FILE))
         except ClosureError as error:

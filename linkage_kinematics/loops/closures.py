@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import enum
 
 Vector = tuple[float, float, float]
+ORIGIN: Vector = (0.0, 0.0, 0.0)
 
 
 class ClosureError(ValueError):
@@ -58,6 +59,8 @@ class ClosureSide:
     """
     One frame of a closure: fixed on ``link``, at ``xyz`` (m) turned by ``rpy`` (rad) from it.
 
+    Without ``xyz`` and ``rpy``, the link's own frame.
+
     ``axis`` is the unit axis of a pin in this frame, None for a ball or a weld. The readers
     give a pin's axis on both sides (each in its own frame, the encoding's default filled in),
     except for a ``<constraint>`` without ``<parent_axis>``: its parent's axis is None, and its
@@ -66,8 +69,8 @@ class ClosureSide:
     """
 
     link: str
-    xyz: Vector
-    rpy: Vector
+    xyz: Vector = ORIGIN
+    rpy: Vector = ORIGIN
     axis: Vector | None = None
 
 

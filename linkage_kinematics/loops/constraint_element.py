@@ -36,9 +36,15 @@ from linkage_kinematics.loops.closures import (
     ClosureKind,
     ClosureSide,
     Encoding,
+    ORIGIN,
     Vector,
 )
-from linkage_kinematics.loops.xml_values import robot_link, three_numbers, unit_axis
+from linkage_kinematics.loops.xml_values import (
+    robot_link,
+    three_numbers,
+    TYPE_WORDS,
+    unit_axis,
+)
 from linkage_kinematics.model.urdf_reader import UrdfTree
 import lxml.etree
 
@@ -49,8 +55,6 @@ TYPES = {
     'spherical': ClosureKind.BALL, 'spherical_joint': ClosureKind.BALL,
     'fixed': ClosureKind.WELD, 'link': ClosureKind.WELD,
 }
-SUPPORTED = "'revolute' (a pin), 'spherical' (a ball) or 'fixed' (a weld)"
-ZERO = (0.0, 0.0, 0.0)
 
 
 def _axis(element: lxml.etree._Element | None, where: str) -> Vector | None:
@@ -64,9 +68,9 @@ def _side(tree: UrdfTree, element: lxml.etree._Element, side: str, where: str,
           axis: Vector | None) -> ClosureSide:
     link = robot_link(tree, element.find(side), side, where)
     origin = element.find(f'{side}_origin')
-    xyz = three_numbers(origin.get('xyz') if origin is not None else None, ZERO,
+    xyz = three_numbers(origin.get('xyz') if origin is not None else None, ORIGIN,
                         f'{where} {side}_origin xyz')
-    rpy = three_numbers(origin.get('rpy') if origin is not None else None, ZERO,
+    rpy = three_numbers(origin.get('rpy') if origin is not None else None, ORIGIN,
                         f'{where} {side}_origin rpy')
     return ClosureSide(link, xyz, rpy, axis)
 
@@ -75,10 +79,10 @@ def _closure(tree: UrdfTree, element: lxml.etree._Element, name: str) -> Closure
     where = f'constraint {name!r}'
     written = element.get('type')
     if written is None:
-        raise ClosureError(f'{where}: no type: a constraint is {SUPPORTED}')
+        raise ClosureError(f'{where}: no type: a constraint is {TYPE_WORDS}')
     if written not in TYPES:
         raise ClosureError(f'{where}: type {written!r} is not supported: a constraint is '
-                           f'{SUPPORTED}')
+                           f'{TYPE_WORDS}')
     kind = TYPES[written]
     parent_axis = child_axis = None
     if kind is ClosureKind.PIN:

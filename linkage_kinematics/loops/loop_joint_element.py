@@ -45,9 +45,15 @@ from linkage_kinematics.loops.closures import (
     ClosureKind,
     ClosureSide,
     Encoding,
+    ORIGIN,
     Vector,
 )
-from linkage_kinematics.loops.xml_values import robot_link, three_numbers, unit_axis
+from linkage_kinematics.loops.xml_values import (
+    robot_link,
+    three_numbers,
+    TYPE_WORDS,
+    unit_axis,
+)
 from linkage_kinematics.model.urdf_reader import UrdfTree
 import lxml.etree
 
@@ -55,8 +61,6 @@ TYPES = {
     'revolute': ClosureKind.PIN, 'continuous': ClosureKind.PIN,
     'spherical': ClosureKind.BALL, 'fixed': ClosureKind.WELD,
 }
-SUPPORTED = "'revolute' (a pin), 'spherical' (a ball) or 'fixed' (a weld)"
-ZERO = (0.0, 0.0, 0.0)
 X_AXIS = (1.0, 0.0, 0.0)
 
 
@@ -64,8 +68,8 @@ def _side(tree: UrdfTree, element: lxml.etree._Element, tag: str, where: str,
           axis: Vector | None) -> ClosureSide:
     end = element.find(tag)
     link = robot_link(tree, end, tag, where)
-    xyz = three_numbers(end.get('xyz'), ZERO, f'{where} {tag} xyz')
-    rpy = three_numbers(end.get('rpy'), ZERO, f'{where} {tag} rpy')
+    xyz = three_numbers(end.get('xyz'), ORIGIN, f'{where} {tag} xyz')
+    rpy = three_numbers(end.get('rpy'), ORIGIN, f'{where} {tag} rpy')
     return ClosureSide(link, xyz, rpy, axis)
 
 
@@ -73,10 +77,10 @@ def _closure(tree: UrdfTree, element: lxml.etree._Element, name: str) -> Closure
     where = f'loop_joint {name!r}'
     written = element.get('type')
     if written is None:
-        raise ClosureError(f'{where}: no type: a loop_joint is {SUPPORTED}')
+        raise ClosureError(f'{where}: no type: a loop_joint is {TYPE_WORDS}')
     if written not in TYPES:
         raise ClosureError(f'{where}: type {written!r} is not supported: a loop_joint is '
-                           f'{SUPPORTED}')
+                           f'{TYPE_WORDS}')
     kind = TYPES[written]
     axis = None
     if kind is ClosureKind.PIN:

@@ -18,6 +18,9 @@ from linkage_kinematics.loops.closures import ClosureError, Vector
 from linkage_kinematics.model.urdf_reader import UrdfTree
 import lxml.etree
 
+# Both elements spell their three supported types alike.
+TYPE_WORDS = "'revolute' (a pin), 'spherical' (a ball) or 'fixed' (a weld)"
+
 
 def three_numbers(text: str | None, default: Vector, where: str) -> Vector:
     """Return an attribute of three finite numbers (xyz, rpy, an axis); ``default`` if absent."""
