@@ -61,7 +61,8 @@ def _content(text: str) -> dict:
         where = f' at line {mark.line + 1}, column {mark.column + 1}' if mark is not None else ''
         raise ClosureError(f'the closure file is not YAML: {error.problem}{where}') from None
     except yaml.YAMLError as error:
-        raise ClosureError('the closure file is not YAML: ' + ' '.join(str(error).split()))
+        raise ClosureError('the closure file is not YAML: '
+                           + ' '.join(str(error).split())) from None
     if content is None:
         raise ClosureError('the closure file is empty')
     if not isinstance(content, dict):
