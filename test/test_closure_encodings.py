@@ -7,9 +7,10 @@ from pathlib import Path
 import re
 
 from closure_urdf import tree
-from linkage_kinematics.loops.closures import ClosureKind, Encoding, JointOverride
+from linkage_kinematics.loops.closures import ClosureError, ClosureKind, Encoding, JointOverride
 from linkage_kinematics.loops.encodings import read_closures
 from linkage_kinematics.model.urdf_reader import read_urdf
+import pytest
 
 MIXED = """
   <constraint name="knee" type="revolute"><parent link="rod"/><child link="foot"/>
@@ -105,3 +106,8 @@ def test_the_documents_examples_read_as_it_says() -> None:
     assert description.closures[1].parent.xyz == (0.0, 0.0, -0.25)
     assert description.actuated == ('motor_ankle_1', 'motor_ankle_2')
     assert description.overrides == {'rod_top_joint': JointOverride.UJOINT_ZY}
+
+
+def test_a_closure_file_that_is_not_yaml_is_unreadable_input() -> None:
+    with pytest.raises(ClosureError, match='^the closure file is not YAML: '):
+        read_closures(tree(MIXED), 'closed_loop: [')

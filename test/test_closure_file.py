@@ -8,6 +8,7 @@ from linkage_kinematics.loops.closure_file import read_closure_file
 from linkage_kinematics.loops.closures import (
     Closure,
     ClosureDescription,
+    ClosureError,
     ClosureKind,
     ClosureSide,
     Encoding,
@@ -76,8 +77,10 @@ def test_the_overrides_read_as_the_loaders_joints() -> None:
     ('', 'the closure file is empty'),
     ('- closed_loop', f'the closure file is not a mapping of keys {KEYS}'),
 ])
-def test_a_text_that_is_not_such_a_file_is_one_problem(text: str, problem: str) -> None:
-    assert read(text) == ClosureDescription(problems=(problem,))
+def test_a_text_that_is_no_closure_file_is_unreadable(text: str, problem: str) -> None:
+    with pytest.raises(ClosureError) as raised:
+        read(text)
+    assert str(raised.value) == problem
 
 
 PAIR = "closed_loop: [[rod, foot]]\ntype: ['6d']\n"

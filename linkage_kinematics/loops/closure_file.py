@@ -27,8 +27,8 @@ URDF" of arXiv 2504.04767), which its loader (``example_parallel_robots/loader_t
 
 Where the loader reads a malformed file silently (unequal lists are cut short, an unknown
 ``type`` is a weld, an unknown ``name_mot`` is left out), this reader refuses it: one line for
-each problem, naming the key. Pure: PyYAML (its safe loader, as the loader's) and the URDF tree
-``model.urdf_reader`` read.
+each problem, naming the key; a text that is not such a file at all is a ``ClosureError``.
+Pure: PyYAML (its safe loader, as the loader's) and the URDF tree ``model.urdf_reader`` read.
 """
 
 from __future__ import annotations
@@ -208,13 +208,11 @@ def read_closure_file(tree: UrdfTree, text: str) -> ClosureDescription:
     Return the closures, actuated joints and joint overrides of closure file ``text``.
 
     Its frames and joints are those of ``tree``, the URDF it accompanies. What cannot be read is
-    one line of ``problems`` each, naming the key (the rest is still read); a text that is not
-    YAML, or not a mapping of the file's keys, is one problem and nothing else.
+    one line of ``problems`` each, naming the key (the rest is still read). Raises ClosureError,
+    one line, for a text that is no closure file at all (not YAML, empty, not a mapping of keys):
+    unreadable input, as a text that is no URDF is to ``read_urdf``.
     """
-    try:
-        content = _content(text)
-    except ClosureError as error:
-        return ClosureDescription(problems=(str(error),))
+    content = _content(text)
     problems = [f'{key!r}: not a key of a closure file ({", ".join(KEYS)})'
                 for key in content if key not in KEYS]
     closures = _closures(tree, content, problems)

@@ -31,6 +31,8 @@ def read_closures(tree: UrdfTree, closure_file: str | None = None) -> ClosureDes
     elements urdf_parser_py does not read); it is not parsed again. ``actuated`` and
     ``overrides`` are the closure file's (None and none without one). ``problems`` holds one
     line for each closure or entry that cannot be read, and for each name used by two closures.
+    Raises ClosureError (one line) for a closure file text that is not YAML, is empty or is not a
+    mapping of the file's keys: unreadable input, as UrdfError is for the URDF.
     """
     constraints, constraint_problems = read_constraints(tree)
     loop_joints, loop_joint_problems = read_loop_joints(tree)
