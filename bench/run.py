@@ -9,9 +9,11 @@ tf (one state's /tf bytes, prepared against the generic forward kinematics), nod
 tick, rates, jitter, latency and log size), cost (the node's CPU side by side with a minimal
 hand-written rclpy publisher, its highest sustained rate with the default placement and with
 cpu_affinity:=0), measured and loops (the measured source, and a URDF's four loops closed, each
-against a minimal hand-written rclpy relay) and memory (the node's resident memory over a long
-1 kHz run). Every section prints markdown tables for docs/benchmarks.md; the kinematics section
-also draws docs/benchmark_speed_error.png.
+against a minimal hand-written rclpy relay), parallel (parallel robots' loops closed per sample
+beside toolbox-parallel-robots, Pinocchio with Gauss–Newton and PlaCo, which it installs on first
+use: bench/peers.py) and memory (the node's resident memory over a long 1 kHz run). Every section
+prints markdown tables for docs/benchmarks.md; the kinematics section also draws
+docs/benchmark_speed_error.png, the parallel section docs/benchmark_parallel.png.
 """
 
 from __future__ import annotations
@@ -31,7 +33,8 @@ sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 from ros_domains import domain_lease  # noqa: E402
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'memory')
+SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'parallel',
+            'memory')
 # The sections that run nodes, each kind of run on its own ROS_DOMAIN_ID: the first one and the
 # four after it (node_bench's DOMAIN_* offsets).
 ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'memory')
@@ -48,6 +51,9 @@ def main(argv: list[str] | None = None) -> int:
                         help='run only this section (may be repeated)')
     parser.add_argument('--plot', default=str(ROOT / 'docs' / 'benchmark_speed_error.png'),
                         help='where to write the speed-against-error plot')
+    parser.add_argument('--parallel-plot',
+                        default=str(ROOT / 'docs' / 'benchmark_parallel.png'),
+                        help="where to write the parallel section's time-against-error plot")
     parser.add_argument('--memory-minutes', type=float, default=None,
                         help="length of the node's resident-memory run at 1 kHz "
                              '(default 10, 0.5 with --quick)')
@@ -128,6 +134,17 @@ def run_sections(arguments: argparse.Namespace, sections: Collection[str],
         print(loops_bench.path_run(arguments.quick, repetitions))
         print("\n## A URDF's loops closed, against a minimal hand-written relay\n")
         print(loops_bench.run(arguments.quick, ros_domain))
+    if 'parallel' in sections:
+        import parallel_bench
+        import peers
+
+        print('\n## Parallel robots closed per sample, against the peers\n')
+        versions = peers.activate(install=True)
+        print('peers: ' + ', '.join(f'{name} {version}' for name, version in versions.items()))
+        rows, notes = parallel_bench.run(arguments.quick, repetitions)
+        print(parallel_bench.table(rows, notes))
+        parallel_bench.plot(rows, arguments.parallel_plot)
+        print(f'\nplot written to {arguments.parallel_plot}')
     if 'memory' in sections:
         import node_bench
 
