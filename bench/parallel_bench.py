@@ -103,7 +103,10 @@ def reference(model: ParallelModel, trajectory: Trajectory,
     Return the reference's answer to every sample, in ``model.coordinates``' order.
 
     PROVISIONAL (REFERENCE_LABEL): Pinocchio's Gauss–Newton, 30 minimum-norm steps per sample,
-    in float64. C1's 50-digit mpmath reference replaces it here when it lands.
+    in float64. The slot for C1's 50-digit reference (test/closure_reference.py in its branch:
+    ``Reference(urdf, closures, overrides).solve(known, guess, unknown)``, idle freedoms held at
+    the assembled pose): the same samples from ``trajectory.pose``, its answers as mpf (the
+    errors are taken in mpmath), or every k-th sample if 500 take too long.
     """
     from parallel_peers import PinocchioGaussNewton
 
@@ -116,8 +119,11 @@ def ours_follower(model: ParallelModel):
     """
     Return the package's own follower of ``model``, or None while it has none (no row).
 
-    The slot for loops.newton (helper C1): a ``parallel_peers.Follower`` that starts from the
-    trajectory's assembled pose and closes each sample of ``model.actuated``.
+    The slot for the package's spatial closure (helper C1: loops.tree, structure, newton): a
+    ``parallel_peers.Follower`` whose ``start`` takes the trajectory's assembled pose (every
+    coordinate by name) and whose ``follow`` closes a sample of ``model.actuated`` and returns
+    every coordinate in ``model.coordinates``' order, built from ``model.source_urdf`` and
+    ``model.closure_file`` as the node reads them (not from the peers' rewritten URDF).
     """
     return None
 
@@ -202,7 +208,8 @@ def _row(model: ParallelModel, trajectory: Trajectory, label: str, answers: list
         if not all(map(math.isfinite, answer.positions)):
             continue
         for name, value, wanted in zip(model.coordinates, answer.positions, expected):
-            difference = value - wanted
+            # taken in the reference's type (mpf for a 50-digit one), then rounded
+            difference = float(value - wanted)
             if name not in prismatic:
                 difference = math.remainder(difference, 2.0 * math.pi)
             if name in idle:
@@ -217,7 +224,7 @@ def _row(model: ParallelModel, trajectory: Trajectory, label: str, answers: list
 def table(rows: Sequence[Row], notes: dict[str, str]) -> str:
     """Return the section's markdown: one row per model and follower, then the notes."""
     header = ['model', 'follower', 'worst error (rad, m)', 'idle coordinates: largest difference',
-              'time / sample: median', 'p90', 'not closed (of samples)']
+              'time / sample: median', 'p90', 'not closed (own verdict)']
     lines = markdown_table(header, [
         [row.model, row.follower, format_error(row.error),
          format_error(row.idle_difference) if row.idle_difference else '–',
