@@ -32,6 +32,8 @@ from dataclasses import dataclass, field, replace
 from decimal import Decimal, localcontext
 import math
 
+from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
+
 TWO_PI = 2.0 * math.pi
 # Cosine bounds k± (computed exactly from the float lengths) within this distance of ±1 are
 # treated as touching: the linkage is solved as the exact change-point linkage (s + l = p + q)
@@ -243,47 +245,6 @@ class FourBar:
 _PLAIN = 0
 _ROOTS = 1
 _TOUCH = 2
-# Digits of the one-time computation of the singular crank angles (decimal arithmetic).
-_DIGITS = 60
-_PI = Decimal('3.14159265358979323846264338327950288419716939937510582097494459230781640629')
-
-
-def _cos_sin(angle: Decimal) -> tuple[Decimal, Decimal]:
-    """Cos and sin of a decimal angle of a few radians, by their Taylor series."""
-    cosine = sine = Decimal(0)
-    term = Decimal(1)
-    tiny = Decimal(10) ** -(_DIGITS + 5)
-    order = 0
-    while abs(term) > tiny or order < 4:
-        if order % 4 == 0:
-            cosine += term
-        elif order % 4 == 1:
-            sine += term
-        elif order % 4 == 2:
-            cosine -= term
-        else:
-            sine -= term
-        order += 1
-        term = term * angle / order
-    return cosine, sine
-
-
-def _atan2(y: Decimal, x: Decimal) -> Decimal:
-    """atan2 in decimal: the float's value refined by Newton's method on x·sin θ − y·cos θ."""
-    if x == 0:
-        # exact, so that a pivot C straight above or below O puts α₀ on an exact float
-        return _PI / 2 if y > 0 else -_PI / 2
-    angle = Decimal(math.atan2(float(y), float(x)))
-    for _ in range(3):
-        cosine, sine = _cos_sin(angle)
-        angle += (y * cosine - x * sine) / (x * cosine + y * sine)
-    return angle
-
-
-def _split(value: Decimal) -> tuple[float, float]:
-    """Return the nearest float and the float nearest to what it leaves over (a double-double)."""
-    high = float(value)
-    return high, float(value - Decimal(high))
 
 
 @dataclass(frozen=True)
@@ -353,7 +314,7 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
     y_C), the dimensions the floats are roundings of where those are known (``from_exact``).
     """
     with localcontext() as context:
-        context.prec = _DIGITS
+        context.prec = DIGITS
         r, b, c, x_c, y_c = exact if exact is not None else (
             Decimal(linkage.crank_length), Decimal(linkage.coupler_length),
             Decimal(linkage.rocker_length), Decimal(linkage.ground_x),
@@ -383,8 +344,8 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
                 f'[{float(abs(ground - r)):.6g}, {float(ground + r):.6g}] m but AB and BC reach '
                 f'only [{float(abs(b - c)):.6g}, {float(b + c):.6g}] m'
             )
-        direction = _PI / 2 + _atan2(y_c, x_c)
-        opposite = direction + _PI
+        direction = PI / 2 + atan2(y_c, x_c)
+        opposite = direction + PI
         scale = float(2 * product)
 
         def factor(cosine: Decimal, bound: int, touch_at: Decimal, length: Decimal
@@ -395,16 +356,16 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
             Its extreme over a turn is at cos φ = ``bound``.
             """
             if abs(cosine - bound) <= TOUCH_TOLERANCE:
-                return LoopFactor(_TOUCH, float(length), _split(touch_at))
+                return LoopFactor(_TOUCH, float(length), split(touch_at))
             gap = product * (cosine - bound) * bound  # the factor's least value over a turn
             if gap > 0:
                 # Far from zero everywhere, d's own rounding is small beside the factor.
                 plain = gap >= Decimal('0.25') * (ground + r) ** 2
-                return LoopFactor(_PLAIN if plain else _TOUCH, float(length), _split(touch_at),
+                return LoopFactor(_PLAIN if plain else _TOUCH, float(length), split(touch_at),
                                   gap=float(gap))
-            half_width = _atan2((1 - cosine * cosine).sqrt(), cosine)
-            return LoopFactor(_ROOTS, float(length), _split(direction - half_width),
-                              _split(direction + half_width))
+            half_width = atan2((1 - cosine * cosine).sqrt(), cosine)
+            return LoopFactor(_ROOTS, float(length), split(direction - half_width),
+                              split(direction + half_width))
 
         stretched = factor(lowest_cosine, -1, opposite, b + c)
         folded = factor(highest_cosine, 1, direction, abs(b - c))
@@ -418,7 +379,7 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
     )
     change_points = tuple(part.first for part in (folded, stretched) if part.is_change)
     closure = LoopClosure(stretched, folded, scale, linkage.ground_length, float(b * b - c * c),
-                          _split(direction), _split(opposite), dead_points, change_points,
+                          split(direction), split(opposite), dead_points, change_points,
                           passes_through_pivot)
     return closure, _reachability(closure)
 

@@ -32,8 +32,8 @@ import math
 import operator
 
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
+from linkage_kinematics.kinematics.decimal_arithmetic import DIGITS
 from linkage_kinematics.kinematics.geometry import (
-    _DIGITS,
     FourBar,
     from_exact,
     GeometryError,
@@ -170,7 +170,7 @@ def _four_bar(loop: PlanarLoop, known: int) -> FourBar:
     ground = loop.links[known - 1]
     try:
         with localcontext() as context:
-            context.prec = _DIGITS
+            context.prec = DIGITS
             crank_x, crank_y = Decimal(crank[0]), Decimal(crank[1])
             to_c_x, to_c_y = -Decimal(ground[0]), -Decimal(ground[1])
             length = _length(crank)

@@ -47,12 +47,9 @@ from enum import Enum
 import math
 import operator
 
-from linkage_kinematics.kinematics.continuation import _turns_past, check_branch
+from linkage_kinematics.kinematics.continuation import check_branch, turns_past
+from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
 from linkage_kinematics.kinematics.geometry import (
-    _atan2,
-    _DIGITS,
-    _PI,
-    _split,
     GeometryError,
     TOUCH_TOLERANCE,
     TWO_PI,
@@ -129,14 +126,14 @@ def _sinusoid(constant: Decimal, amplitude: Decimal, phase: Decimal, sense: int,
     tolerance = Decimal(TOUCH_TOLERANCE)
     if constant - amplitude >= -tolerance * amplitude:
         gap = constant - amplitude
-        return Factor(True, True, 1.0, float(2 * amplitude), _split(centre),
+        return Factor(True, True, 1.0, float(2 * amplitude), split(centre),
                       gap=float(gap) if gap > tolerance * amplitude else 0.0)
     if constant + amplitude <= tolerance * amplitude:
         raise GeometryError(f'the loop cannot close at any angle: {what}')
     ratio = constant / amplitude
-    half_width = _atan2((1 - ratio * ratio).sqrt(), ratio)
-    return Factor(True, False, 1.0, float(2 * amplitude), _split(centre - half_width),
-                  _split(centre + half_width))
+    half_width = atan2((1 - ratio * ratio).sqrt(), ratio)
+    return Factor(True, False, 1.0, float(2 * amplitude), split(centre - half_width),
+                  split(centre + half_width))
 
 
 def _quadratic(centre: Decimal, radius_squared: Decimal, orientation: int, size: Decimal,
@@ -151,10 +148,10 @@ def _quadratic(centre: Decimal, radius_squared: Decimal, orientation: int, size:
         if orientation < 0:
             raise GeometryError(f'the loop cannot close at any displacement: {what}')
         gap = -radius_squared if radius_squared < -tolerance * size else Decimal(0)
-        return Factor(False, True, 1.0, 1.0, _split(centre), gap=float(gap))
+        return Factor(False, True, 1.0, 1.0, split(centre), gap=float(gap))
     radius = radius_squared.sqrt()
-    return Factor(False, False, float(orientation), 1.0, _split(centre - radius),
-                  _split(centre + radius))
+    return Factor(False, False, float(orientation), 1.0, split(centre - radius),
+                  split(centre + radius))
 
 
 def _angle(vector: Vector) -> float:
@@ -162,7 +159,7 @@ def _angle(vector: Vector) -> float:
 
 
 def _decimal_angle(vector: tuple[Decimal, Decimal]) -> Decimal:
-    return _atan2(vector[1], vector[0])
+    return atan2(vector[1], vector[0])
 
 
 def _arcs(factors: tuple[Factor, ...]) -> list[tuple[float, float]]:
@@ -218,7 +215,7 @@ class PrismaticLoop:
         self.angle_a = _angle(self.link_a)
         self.angle_c = _angle(self.link_c)
         with localcontext() as context:
-            context.prec = _DIGITS
+            context.prec = DIGITS
             _constants(self, links, slide)
         self.factors = _factors(self)
         self.range = _range(self)
@@ -416,8 +413,8 @@ class PrismaticLoop:
             if not factor.is_change:
                 continue
             if factor.periodic:
-                flips += abs(_turns_past(value_to, factor.first)
-                             - _turns_past(value_from, factor.first))
+                flips += abs(turns_past(value_to, factor.first)
+                             - turns_past(value_from, factor.first))
             else:
                 flips += ((offset_from(value_to, factor.first) >= 0.0)
                           != (offset_from(value_from, factor.first) >= 0.0))
@@ -442,7 +439,7 @@ def _constants(loop: PrismaticLoop, links: tuple[Vector, ...], slide: Vector) ->
     loop.m = (float(loop._m[0]), float(loop._m[1]))
     loop.offset = float(loop._offset)
     loop.along = float(loop._along)
-    loop.centre = _split(-loop._along)
+    loop.centre = split(-loop._along)
     loop.squares_a = float(loop._length_a ** 2)
     loop.squares = float(loop._length_a ** 2 - loop._length_c ** 2)
     loop.scale = float(max(loop._length_a, loop._length_c, abs(loop._m[0]),
@@ -452,7 +449,7 @@ def _constants(loop: PrismaticLoop, links: tuple[Vector, ...], slide: Vector) ->
 def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
     """Return the discriminant's factors for this case (module docstring)."""
     with localcontext() as context:
-        context.prec = _DIGITS
+        context.prec = DIGITS
         length_a, length_c, offset = loop._length_a, loop._length_c, loop._offset
         if loop.case is KnownCase.SLIDE:
             centre = -loop._along
@@ -470,15 +467,15 @@ def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
             what = (f'the pivots next to the slide are never {float(abs(offset)):.6g} m '
                     "apart (the slide line's offset)")
             return (_sinusoid(length_a ** 2 + length_c ** 2 - offset ** 2,
-                              2 * length_a * length_c, _PI - turn, 1, what),)
+                              2 * length_a * length_c, PI - turn, 1, what),)
         near, radius = ((loop.link_c, length_a) if loop.sense > 0
                         else (loop.link_a, length_c))
         near_length = (Decimal(near[0]) ** 2 + Decimal(near[1]) ** 2).sqrt()
         # e(φ) = e₀ + |v|·sin(κ − sense·φ), κ = arg ŝ − arg v
         kappa = _decimal_angle(loop._slide) - _decimal_angle(_decimal(near))
         what = (f'the circle of radius {float(radius):.6g} m never meets the slide line')
-        return (_sinusoid(radius - offset, near_length, kappa - _PI / 2, loop.sense, what),
-                _sinusoid(radius + offset, near_length, kappa + _PI / 2, loop.sense, what))
+        return (_sinusoid(radius - offset, near_length, kappa - PI / 2, loop.sense, what),
+                _sinusoid(radius + offset, near_length, kappa + PI / 2, loop.sense, what))
 
 
 def _range(loop: PrismaticLoop) -> KnownJointRange:
