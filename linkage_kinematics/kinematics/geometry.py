@@ -30,6 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from decimal import Decimal, localcontext
+from enum import Enum
 import math
 
 from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
@@ -242,30 +243,50 @@ class FourBar:
 # written as 4·OA·OC·sin²(½(α − a)), whose square root continues analytically through it.
 # A factor that stays away from zero is taken from d directly (the cheapest form).
 
-_PLAIN = 0
-_ROOTS = 1
-_TOUCH = 2
+DoubleDouble = tuple[float, float]
+
+
+class FactorForm(Enum):
+    """How a factor of a loop's discriminant is evaluated (``Factor``)."""
+
+    PLAIN = 'from the pin distance'
+    ROOTS = 'two roots'
+    TOUCH = 'touching zero'
 
 
 @dataclass(frozen=True)
-class LoopFactor:
+class Factor:
     """
-    One factor of Heron's product, and the form it is evaluated in (see the comment above).
+    One factor of a loop's discriminant, in the form that is exact near its zeros.
 
-    ``kind`` is ``_PLAIN`` (from d; ``length`` is AB + BC or |AB − BC|), ``_ROOTS`` (two dead
-    points ``first`` and ``second``, double-doubles) or ``_TOUCH`` (``gap`` + 4·OA·OC·sin²(½(α −
-    first)); ``gap`` = 0 at a change point).
+    The four-bar's two factors of Heron's product (see the comment above) and those of a loop
+    with a prismatic joint (``prismatic_loop``). With u(x, a) = sin(½(x − a)) for an angle
+    (``periodic``) or x − a for a displacement, each root a held as a double-double
+    (``singular_points`` evaluates them), the ``form`` is ``ROOTS``:
+    ``orientation``·``scale``·u(x, ``first``)·u(x, ``second``), two dead points; ``TOUCH``:
+    ``gap`` + ``scale``·u(x, ``first``)², a change point where ``gap`` = 0; or, for a four-bar's
+    factor far from zero everywhere, ``PLAIN``: taken from the pin distance d and ``length``. A
+    four-bar's ``length`` is AB + BC or |AB − BC| in every form.
     """
 
-    kind: int
-    length: float
-    first: tuple[float, float] = (0.0, 0.0)
-    second: tuple[float, float] = (0.0, 0.0)
+    form: FactorForm
+    scale: float
+    first: DoubleDouble = (0.0, 0.0)
+    second: DoubleDouble = (0.0, 0.0)
     gap: float = 0.0
+    orientation: float = 1.0
+    periodic: bool = True
+    length: float = 0.0
+
+    @property
+    def touching(self) -> bool:
+        """Return True for the TOUCH form: the factor touches zero or stays above it."""
+        return self.form is FactorForm.TOUCH
 
     @property
     def is_change(self) -> bool:
-        return self.kind == _TOUCH and self.gap == 0.0
+        """Return True where the factor touches zero: a change point."""
+        return self.form is FactorForm.TOUCH and self.gap == 0.0
 
 
 @dataclass(frozen=True)
@@ -280,8 +301,8 @@ class LoopClosure:
     use them.
     """
 
-    stretched: LoopFactor
-    folded: LoopFactor
+    stretched: Factor
+    folded: Factor
     scale: float
     ground: float
     squares: float
@@ -330,7 +351,8 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
                     f'got OA = {crank} m, AB = {coupler} m, BC = {rocker} m'
                 )
             closure = LoopClosure(
-                LoopFactor(_PLAIN, coupler + rocker), LoopFactor(_PLAIN, abs(coupler - rocker)),
+                Factor(FactorForm.PLAIN, 0.0, orientation=-1.0, length=coupler + rocker),
+                Factor(FactorForm.PLAIN, 0.0, length=abs(coupler - rocker)),
                 0.0, 0.0, float(b * b - c * c), (0.0, 0.0), (0.0, 0.0), (), (), False,
             )
             return closure, Reachability(((-math.pi, math.pi),), (), ())
@@ -349,23 +371,28 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
         scale = float(2 * product)
 
         def factor(cosine: Decimal, bound: int, touch_at: Decimal, length: Decimal
-                   ) -> LoopFactor:
+                   ) -> Factor:
             """
             Return the factor that vanishes where cos φ = ``cosine``.
 
-            Its extreme over a turn is at cos φ = ``bound``.
+            Its extreme over a turn is at cos φ = ``bound``. The factor is
+            ``bound``·2·OA·OC·(``cosine`` − cos φ), so ``bound`` is its orientation.
             """
+            orientation = float(bound)
             if abs(cosine - bound) <= TOUCH_TOLERANCE:
-                return LoopFactor(_TOUCH, float(length), split(touch_at))
+                return Factor(FactorForm.TOUCH, scale, split(touch_at), orientation=orientation,
+                              length=float(length))
             gap = product * (cosine - bound) * bound  # the factor's least value over a turn
             if gap > 0:
                 # Far from zero everywhere, d's own rounding is small beside the factor.
                 plain = gap >= Decimal('0.25') * (ground + r) ** 2
-                return LoopFactor(_PLAIN if plain else _TOUCH, float(length), split(touch_at),
-                                  gap=float(gap))
+                return Factor(FactorForm.PLAIN if plain else FactorForm.TOUCH, scale,
+                              split(touch_at), gap=float(gap), orientation=orientation,
+                              length=float(length))
             half_width = atan2((1 - cosine * cosine).sqrt(), cosine)
-            return LoopFactor(_ROOTS, float(length), split(direction - half_width),
-                              split(direction + half_width))
+            return Factor(FactorForm.ROOTS, scale, split(direction - half_width),
+                          split(direction + half_width), orientation=orientation,
+                          length=float(length))
 
         stretched = factor(lowest_cosine, -1, opposite, b + c)
         folded = factor(highest_cosine, 1, direction, abs(b - c))
@@ -374,7 +401,7 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
         passes_through_pivot = (folded.is_change
                                 and abs(b - c) <= Decimal(TOUCH_TOLERANCE) * (b + c))
     dead_points = tuple(
-        angle for part in (stretched, folded) if part.kind == _ROOTS
+        angle for part in (stretched, folded) if part.form is FactorForm.ROOTS
         for angle in (part.first, part.second)
     )
     change_points = tuple(part.first for part in (folded, stretched) if part.is_change)
@@ -404,11 +431,11 @@ def from_exact(dimensions: tuple[Decimal, Decimal, Decimal, Decimal, Decimal]) -
 def _reachability(closure: LoopClosure) -> Reachability:
     """Crank intervals where both factors are ≥ 0, ending at the dead points (φ₋ ≤ |φ| ≤ φ₊)."""
     stretched, folded = closure.stretched, closure.folded
-    if stretched.kind != _ROOTS and folded.kind != _ROOTS:
+    if stretched.form is not FactorForm.ROOTS and folded.form is not FactorForm.ROOTS:
         ends = [(closure.direction[0] - math.pi, closure.direction[0] + math.pi)]
-    elif folded.kind != _ROOTS:
+    elif folded.form is not FactorForm.ROOTS:
         ends = [(stretched.first[0], stretched.second[0])]
-    elif stretched.kind != _ROOTS:
+    elif stretched.form is not FactorForm.ROOTS:
         ends = [(folded.second[0], folded.first[0] + TWO_PI)]
     else:
         ends = [(folded.second[0], stretched.second[0]), (stretched.first[0], folded.first[0])]

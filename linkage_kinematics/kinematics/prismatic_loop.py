@@ -41,7 +41,6 @@ the change point; the rates there come from forms with the vanishing factor divi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from decimal import Decimal, localcontext
 from enum import Enum
 import math
@@ -50,6 +49,8 @@ import operator
 from linkage_kinematics.kinematics.continuation import check_branch, turns_past
 from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
 from linkage_kinematics.kinematics.geometry import (
+    Factor,
+    FactorForm,
     GeometryError,
     TOUCH_TOLERANCE,
     TWO_PI,
@@ -57,14 +58,14 @@ from linkage_kinematics.kinematics.geometry import (
 )
 from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.singular_points import (
-    half_sine,
+    factor_unit,
+    factor_value,
     offset_from,
     PIVOT_PASSAGE,
     too_close,
 )
 from linkage_kinematics.kinematics.solver import DeadPointError
 
-DoubleDouble = tuple[float, float]
 Vector = tuple[float, float]
 
 
@@ -74,45 +75,6 @@ class KnownCase(Enum):
     SLIDE = 'the prismatic joint'
     NEXT = 'a revolute joint next to the prismatic one'
     OPPOSITE = 'the revolute joint opposite the prismatic one'
-
-
-@dataclass(frozen=True)
-class Factor:
-    """
-    One factor of a discriminant, in the form that is exact near its zeros.
-
-    Periodic (in an angle): ``orientation``·``scale``·sin(½(x − first))·sin(½(x − second)) with
-    two roots, or ``gap`` + ``scale``·sin²(½(x − first)) where it only touches zero (``touching``).
-    Not periodic (in δ): the same with the offsets x − first, x − second for the sines.
-    """
-
-    periodic: bool
-    touching: bool
-    orientation: float
-    scale: float
-    first: DoubleDouble
-    second: DoubleDouble = (0.0, 0.0)
-    gap: float = 0.0
-
-    @property
-    def is_change(self) -> bool:
-        """Return True where the factor touches zero: a change point."""
-        return self.touching and self.gap == 0.0
-
-    def unit(self, value: float, point: DoubleDouble) -> float:
-        """sin(½(x − point)) for an angle, x − point for a displacement: exact near the point."""
-        if self.periodic:
-            return half_sine(value, point, math.sin)
-        return offset_from(value, point)
-
-    def evaluate(self, value: float) -> tuple[float, float]:
-        """Return the factor at ``value`` and its nearest root's unit (inf if it has none)."""
-        first = self.unit(value, self.first)
-        if self.touching:
-            return self.gap + self.scale * first * first, math.inf
-        second = self.unit(value, self.second)
-        return (self.orientation * self.scale * first * second,
-                min(abs(first), abs(second)) * (1.0 if self.periodic else 0.5))
 
 
 def _sinusoid(constant: Decimal, amplitude: Decimal, phase: Decimal, sense: int,
@@ -126,13 +88,13 @@ def _sinusoid(constant: Decimal, amplitude: Decimal, phase: Decimal, sense: int,
     tolerance = Decimal(TOUCH_TOLERANCE)
     if constant - amplitude >= -tolerance * amplitude:
         gap = constant - amplitude
-        return Factor(True, True, 1.0, float(2 * amplitude), split(centre),
+        return Factor(FactorForm.TOUCH, float(2 * amplitude), split(centre),
                       gap=float(gap) if gap > tolerance * amplitude else 0.0)
     if constant + amplitude <= tolerance * amplitude:
         raise GeometryError(f'the loop cannot close at any angle: {what}')
     ratio = constant / amplitude
     half_width = atan2((1 - ratio * ratio).sqrt(), ratio)
-    return Factor(True, False, 1.0, float(2 * amplitude), split(centre - half_width),
+    return Factor(FactorForm.ROOTS, float(2 * amplitude), split(centre - half_width),
                   split(centre + half_width))
 
 
@@ -148,10 +110,10 @@ def _quadratic(centre: Decimal, radius_squared: Decimal, orientation: int, size:
         if orientation < 0:
             raise GeometryError(f'the loop cannot close at any displacement: {what}')
         gap = -radius_squared if radius_squared < -tolerance * size else Decimal(0)
-        return Factor(False, True, 1.0, 1.0, split(centre), gap=float(gap))
+        return Factor(FactorForm.TOUCH, 1.0, split(centre), gap=float(gap), periodic=False)
     radius = radius_squared.sqrt()
-    return Factor(False, False, float(orientation), 1.0, split(centre - radius),
-                  split(centre + radius))
+    return Factor(FactorForm.ROOTS, 1.0, split(centre - radius), split(centre + radius),
+                  orientation=float(orientation), periodic=False)
 
 
 def _angle(vector: Vector) -> float:
@@ -230,7 +192,7 @@ class PrismaticLoop:
         """
         values = []
         for factor in self.factors:
-            result, nearest = factor.evaluate(value)
+            result, nearest = factor_value(factor, value)
             if result < 0.0:
                 raise self.range.unreachable(value)
             if result == 0.0 and not factor.touching or too_close(value, nearest):
@@ -249,7 +211,7 @@ class PrismaticLoop:
         side named by ``branch`` at ``value``, so σ_a = branch·sign(m); at m = 0 itself, where
         the sides meet, the side just past it (the sign of m's derivative).
         """
-        unit = factor.unit(value, factor.first)
+        unit = factor_unit(factor, value, factor.first)
         if unit != 0.0:
             return branch * math.copysign(1.0, unit)
         if factor.periodic:
@@ -323,8 +285,9 @@ class PrismaticLoop:
         across = self.offset + cross  # e = q × ŝ
         along = branch * math.sqrt(lower * upper)  # t
         first, second = self.factors
-        first_unit = abs(first.unit(angle, first.first)) if first.is_change else math.inf
-        second_unit = abs(second.unit(angle, second.first)) if second.is_change else math.inf
+        first_unit = abs(factor_unit(first, angle, first.first)) if first.is_change else math.inf
+        second_unit = (abs(factor_unit(second, angle, second.first)) if second.is_change
+                       else math.inf)
         # Q = e'/t, finite through a change point where e' and t vanish together
         if first_unit <= second_unit and first.is_change:
             sign = self._analytic_sign(branch, first, angle)
