@@ -85,91 +85,127 @@ def format_interval(interval: tuple[float, float]) -> str:
 @dataclass(frozen=True)
 class Reachability:
     """
-    Where the crank of a mechanism can go.
+    Where the coordinate that drives a loop can go: a four-bar's crank, or a loop's known joint.
 
-    ``intervals`` are the closed crank-angle intervals (rad) where the loop closes, each written
-    with its centre in (−π, π] and repeating every 2π. ``dead_points`` are the interval ends,
-    where coupler and rocker are collinear and the crank cannot drive further. ``change_points``
-    are crank angles inside an interval where both branches meet (Grashof equality linkages).
+    ``intervals`` are the closed intervals where the loop closes. An angle's (``periodic``: a
+    crank or a revolute joint, rad) are each written with its centre in (−π, π] and repeat every
+    2π; a displacement's (a prismatic joint, m) are plain. ``dead_points`` are the interval ends,
+    where the loop folds flat and the coordinate cannot drive further (none where an angle turns
+    fully). ``change_points`` lie inside an interval, where both assemblies meet (Grashof
+    equality linkages). ``joint`` is the loop joint that drives (``planar_loop``), None for a
+    four-bar's crank α; messages name it.
     """
 
     intervals: tuple[tuple[float, float], ...]
     dead_points: tuple[float, ...]
     change_points: tuple[float, ...]
+    periodic: bool = True
+    joint: int | None = None
 
     @property
     def full_rotation(self) -> bool:
-        """Return True when the crank can turn all the way round."""
-        return not self.dead_points
+        """Return True when the crank (or revolute joint) can turn all the way round."""
+        return self.periodic and not self.dead_points
 
-    def interval_containing(self, alpha: float) -> tuple[float, float] | None:
-        """Return the interval that holds ``alpha`` (modulo 2π), or None."""
+    def interval_containing(self, value: float) -> tuple[float, float] | None:
+        """Return the interval that holds ``value`` (modulo 2π for an angle), or None."""
         for low, high in self.intervals:
-            past_low = (alpha - low) % TWO_PI
-            if past_low <= high - low + ANGLE_TOLERANCE or past_low >= TWO_PI - ANGLE_TOLERANCE:
+            if self.periodic:
+                past_low = (value - low) % TWO_PI
+                if (past_low <= high - low + ANGLE_TOLERANCE
+                        or past_low >= TWO_PI - ANGLE_TOLERANCE):
+                    return (low, high)
+            elif low <= value <= high:
                 return (low, high)
         return None
 
-    def describe(self) -> str:
-        """Return the reachable set in degrees, for messages."""
-        if self.full_rotation:
-            return 'all crank angles (full rotation)'
-        return ' and '.join(format_interval(interval) for interval in self.intervals)
+    def contains(self, value: float) -> bool:
+        """Return True when the loop closes at ``value`` (modulo 2π for an angle)."""
+        return math.isfinite(value) and self.interval_containing(value) is not None
 
-    def require(self, alpha: float) -> tuple[float, float]:
+    def describe(self) -> str:
+        """Return the reachable set for messages: degrees for an angle, metres otherwise."""
+        if self.joint is None:
+            if self.full_rotation:
+                return 'all crank angles (full rotation)'
+            return ' and '.join(format_interval(interval) for interval in self.intervals)
+        if self.full_rotation:
+            return 'all angles (full rotation)'
+        if self.periodic:
+            return ' and '.join(
+                f'[{math.degrees(low):.6f}°, {math.degrees(high):.6f}°]'
+                for low, high in self.intervals) + ' (mod 360°)'
+        return ' and '.join(f'[{low:.9g} m, {high:.9g} m]' for low, high in self.intervals)
+
+    def unreachable(self, value: float) -> UnreachableError:
+        """Return the error for a ``value`` at which the loop does not close."""
+        if self.joint is None:
+            return UnreachableError(
+                f'crank angle α = {math.degrees(value):.6f}° is not reachable: the loop closes '
+                f'only for α in {self.describe()} (mod 360°)'
+            )
+        shown = f'{math.degrees(value):.9f}°' if self.periodic else f'{value!r} m'
+        return UnreachableError(
+            f'joint {self.joint} at {shown} is not reachable: the loop closes only for '
+            f'{self.describe()}'
+        )
+
+    def require(self, value: float) -> tuple[float, float]:
         """
-        Return the interval holding ``alpha``.
+        Return the interval holding ``value``.
 
         Raise UnreachableError naming the reachable set where none does.
         """
-        interval = self.interval_containing(alpha)
+        interval = self.interval_containing(value)
         if interval is None:
-            raise UnreachableError(
-                f'crank angle α = {math.degrees(alpha):.6f}° is not reachable: the loop closes '
-                f'only for α in {self.describe()} (mod 360°)'
-            )
+            raise self.unreachable(value)
         return interval
 
-    def dead_point_distance(self, alpha: float) -> float | None:
+    def dead_point_distance(self, value: float) -> float | None:
         """
-        Crank-angle distance (rad) from ``alpha`` to the nearest dead point (mod 2π).
+        Distance (rad or m) from ``value`` to the nearest dead point (mod 2π for an angle).
 
-        None when the crank turns fully (a linkage without dead points).
+        None where there is none (an angle that turns fully).
         """
-        return _nearest(self.dead_points, alpha)
+        return self._nearest(self.dead_points, value)
 
-    def change_point_distance(self, alpha: float) -> float | None:
+    def change_point_distance(self, value: float) -> float | None:
         """
-        Crank-angle distance (rad) from ``alpha`` to the nearest change point (mod 2π).
+        Distance (rad or m) from ``value`` to the nearest change point (mod 2π for an angle).
 
         Where the two assemblies meet and the motion continues smoothly; None if there is none.
         """
-        return _nearest(self.change_points, alpha)
+        return self._nearest(self.change_points, value)
 
-    def first_dead_point(self, alpha_from: float, alpha_to: float) -> float | None:
+    def first_dead_point(self, value_from: float, value_to: float) -> float | None:
         """
-        Return the first dead point the crank meets turning from ``alpha_from`` to ``alpha_to``.
+        Return the first dead point met on the way from ``value_from`` to ``value_to``.
 
-        ``alpha_to`` is included; the dead point is an unwrapped crank angle, None if the way is
-        clear.
+        ``value_to`` is included; for an angle the dead point is unwrapped (on the way's turn),
+        None if the way is clear.
 
-        Change points do not stop the crank (it continues through them on its smooth branch,
+        Change points do not stop the motion (it continues through them on its smooth branch,
         see ``kinematics.continued_branch``), so they are not counted here.
         """
-        direction = 1.0 if alpha_to > alpha_from else -1.0
-        travel = abs(alpha_to - alpha_from)
+        direction = 1.0 if value_to > value_from else -1.0
+        reach = abs(value_to - value_from) + (ANGLE_TOLERANCE if self.periodic else 0.0)
         nearest = None
         for point in self.dead_points:
-            distance = (direction * (point - alpha_from)) % TWO_PI
-            if distance <= travel + ANGLE_TOLERANCE and (nearest is None or distance < nearest):
+            distance = direction * (point - value_from)
+            if self.periodic:
+                distance %= TWO_PI
+            elif distance < 0.0:
+                continue  # behind the way
+            if distance <= reach and (nearest is None or distance < nearest):
                 nearest = distance
-        return None if nearest is None else alpha_from + direction * nearest
+        return None if nearest is None else value_from + direction * nearest
 
-
-def _nearest(points: tuple[float, ...], alpha: float) -> float | None:
-    if not points:
-        return None
-    return min(abs(wrap_angle(alpha - point)) for point in points)
+    def _nearest(self, points: tuple[float, ...], value: float) -> float | None:
+        if not points:
+            return None
+        if self.periodic:
+            return min(abs(wrap_angle(value - point)) for point in points)
+        return min(abs(value - point) for point in points)
 
 
 @dataclass(frozen=True)

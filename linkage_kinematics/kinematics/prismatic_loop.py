@@ -52,11 +52,11 @@ from linkage_kinematics.kinematics.geometry import (
     Factor,
     FactorForm,
     GeometryError,
+    Reachability,
     TOUCH_TOLERANCE,
     TWO_PI,
     wrap_angle,
 )
-from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.singular_points import (
     factor_unit,
     factor_value,
@@ -441,25 +441,23 @@ def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
                 _sinusoid(radius + offset, near_length, kappa + PI / 2, loop.sense, what))
 
 
-def _range(loop: PrismaticLoop) -> KnownJointRange:
+def _range(loop: PrismaticLoop) -> Reachability:
     change_points = tuple(factor.first[0] for factor in loop.factors if factor.is_change)
     if loop.case is KnownCase.SLIDE:
         stretched, folded = loop.factors
         low, high = stretched.first[0], stretched.second[0]
         intervals = (((low, folded.first[0]), (folded.second[0], high))
                      if not folded.touching else ((low, high),))
-        return KnownJointRange(loop.known, False, intervals,
-                               tuple(end for piece in intervals for end in piece),
-                               change_points)
+        return Reachability(intervals, tuple(end for piece in intervals for end in piece),
+                            change_points, periodic=False, joint=loop.known)
     arcs = _arcs(loop.factors)
     if not arcs:
         raise GeometryError(f'the loop cannot close at any angle of joint {loop.known}')
     full = arcs == [(-math.pi, math.pi)]
     intervals = tuple(_centred(arc) for arc in arcs)
-    return KnownJointRange(
-        loop.known, True, intervals,
-        () if full else tuple(end for piece in intervals for end in piece),
-        tuple(wrap_angle(point) for point in change_points))
+    return Reachability(
+        intervals, () if full else tuple(end for piece in intervals for end in piece),
+        tuple(wrap_angle(point) for point in change_points), joint=loop.known)
 
 
 def _minus(point: Vector, origin: Vector) -> Vector:
