@@ -19,7 +19,7 @@ import sys
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / 'linkage_kinematics'
-LAYERS = ('kinematics', 'model', 'run', 'bag', 'ros', 'cli')
+LAYERS = ('shared', 'kinematics', 'model', 'run', 'bag', 'ros', 'cli')
 PURE_LAYERS = ('kinematics', 'model', 'run')
 # What a pure module must not load, directly or through what it imports.
 NOT_PURE = ('rclpy', 'rosidl_parser', 'rosidl_runtime_py', 'mcap', 'mcap_ros2',
