@@ -21,7 +21,6 @@ from collections.abc import Callable, Mapping, Sequence
 import math
 import random
 
-from linkage_kinematics.bag.cdr import FixedShapeEncoder
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.model.robot_transforms import (
     quaternion_product,
@@ -31,6 +30,7 @@ from linkage_kinematics.model.robot_transforms import (
 )
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import FixedShapeEncoder
 from timing import format_seconds, interleaved_medians, markdown_table, paired_ratio
 
 STAMP_NS = 1_790_000_000_123_456_789

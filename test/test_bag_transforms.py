@@ -17,11 +17,11 @@ from pathlib import Path
 import tempfile
 from typing import Any
 
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition, type_description_hash
 from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
 from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import encode_cdr
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from node_process import NodeProcesses, PROCESS_TIMEOUT, REPOSITORY

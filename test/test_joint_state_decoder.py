@@ -20,7 +20,7 @@ import struct
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr, JointStateDecoder
+from linkage_kinematics.shared.cdr import encode_cdr, JointStateDecoder
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message

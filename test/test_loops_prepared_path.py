@@ -19,7 +19,6 @@ import math
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.ros.messages import JointStateEncoder
@@ -30,6 +29,7 @@ from linkage_kinematics.run.robot_loops import (
     read_loops,
     RobotLoopsFollower,
 )
+from linkage_kinematics.shared.cdr import encode_cdr
 from loop_robots import ROBOTS
 from loops_per_call import ReferenceFollower
 import pytest

@@ -20,7 +20,6 @@ import math
 import random
 import struct
 
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.model.joints import Driver, JointMap, JointMapping
 from linkage_kinematics.model.robot_transforms import (
@@ -31,6 +30,7 @@ from linkage_kinematics.model.robot_transforms import (
 )
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import encode_cdr
 import pytest
 from test_bag_transforms import EVERY_JOINT_URDF, moving_transforms
 

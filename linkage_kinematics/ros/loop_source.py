@@ -20,7 +20,6 @@ from dataclasses import replace
 import math
 from typing import Any, Protocol
 
-from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.model.loop_urdf import LoopError
 from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
@@ -48,6 +47,7 @@ from linkage_kinematics.run.robot_loops import (
     read_loops,
     RobotLoopsFollower,
 )
+from linkage_kinematics.shared.cdr import JointStateDecoder
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 

@@ -7,7 +7,7 @@ The node's messages, from a LinkageState: one way to make each.
 The per-tick messages and the scene are never built as rclpy messages: their encoders
 (``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write their CDR bytes
 straight from the state into a layout prepared once per geometry from a template message
-(``bag.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
+(``shared.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
 describe. The diagnostics are built (``diagnostic_array``) and encoded by ``encode_cdr``. None
 of this computes any kinematics: the values come from the value functions here
 (``joints.JointStream``, ``disk_orientation``) and from
@@ -22,7 +22,6 @@ import math
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, TransformStamped
-from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder
 from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
@@ -32,6 +31,7 @@ from linkage_kinematics.model.robot_transforms import (
     RobotTransforms,
     Transform,
 )
+from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA

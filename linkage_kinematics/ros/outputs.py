@@ -18,7 +18,6 @@ from typing import Any, NamedTuple
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
@@ -35,6 +34,7 @@ from linkage_kinematics.run.configuration import (
 )
 from linkage_kinematics.run.diagnostics import Level
 from linkage_kinematics.run.loop_diagnostics import Status
+from linkage_kinematics.shared.cdr import encode_cdr
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.publisher import Publisher

@@ -17,7 +17,6 @@ from collections.abc import Callable
 import math
 from typing import Any, Protocol
 
-from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import Link, TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
@@ -33,6 +32,7 @@ from linkage_kinematics.run.motion import (
     MotionSample,
     solve_sample,
 )
+from linkage_kinematics.shared.cdr import JointStateDecoder
 from rclpy.qos import QoSProfile
 from sensor_msgs.msg import JointState
 

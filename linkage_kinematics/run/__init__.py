@@ -9,5 +9,6 @@ from ``limits``), ``configuration`` (values checked against it into a RunConfigu
 sources ``motion`` (the drive law in time) and ``measured`` (a measured joint completed),
 ``control`` (~/pause, ~/resume, ~/reset), ``diagnostics`` (the status) and ``placement``
 (cpu_affinity).
-Imports only ``kinematics`` and ``model``.
+Imports only ``kinematics``, ``model`` and ``shared`` (rosbag2's split numbers and process
+affinity, both plain Python), never ``bag``.
 """

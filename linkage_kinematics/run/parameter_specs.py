@@ -37,10 +37,9 @@ from linkage_kinematics.run.limits import (
     MAX_RATE_HZ,
     MAX_TIME_CONSTANT,
     MAX_TIMEOUT,
-    MIN_SPLIT_SIZE,
     NO_CPU_AFFINITY,
-    NO_SPLIT,
 )
+from linkage_kinematics.shared.rosbag2_split import MIN_SPLIT_SIZE, NO_SPLIT
 
 NODE_NAME = 'linkage_node'
 

@@ -11,29 +11,11 @@ without crossing CPUs, and the bag writer process, on the other CPUs, cannot del
 
 from __future__ import annotations
 
-from collections.abc import Set
 import os
 
 from linkage_kinematics.run.configuration import ConfigurationError
 from linkage_kinematics.run.limits import NO_CPU_AFFINITY
-
-
-def set_process_affinity(pid: int, cpus: Set[int]) -> None:
-    """
-    Let every thread of process ``pid`` run only on ``cpus``.
-
-    Threads it starts later inherit their starter's CPUs. A process that has ended meanwhile is
-    left alone: whoever waits for it learns how it ended.
-    """
-    try:
-        threads = os.listdir(f'/proc/{pid}/task')
-    except FileNotFoundError:
-        return
-    for thread in threads:
-        try:
-            os.sched_setaffinity(int(thread), cpus)
-        except ProcessLookupError:
-            pass  # the thread ended meanwhile
+from linkage_kinematics.shared.affinity import set_process_affinity
 
 
 class CpuPlacement:
