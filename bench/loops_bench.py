@@ -32,10 +32,10 @@ import re
 
 from builtin_interfaces.msg import Time
 from linkage_kinematics.bag.cdr import encode_cdr, JointStateDecoder
-from linkage_kinematics.model.loops import find_loops
+from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
+from linkage_kinematics.loops.plan import find_loops, read_loops
 from linkage_kinematics.ros.loop_source import TreePositions
 from linkage_kinematics.ros.messages import JointStateEncoder, RobotStateTransforms
-from linkage_kinematics.run.robot_loops import LoopSample, read_loops, RobotLoopsFollower
 from loop_robots import excavator, four_bar_knee, ROBOTS
 from loops_per_call import ReferenceFollower
 import measured_bench

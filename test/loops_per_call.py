@@ -30,14 +30,14 @@ from linkage_kinematics.kinematics.planar_loop import (
     UnreachableError,
 )
 from linkage_kinematics.kinematics.solver import solve, unwrap_near
-from linkage_kinematics.model.loops import LoopSampleError
-from linkage_kinematics.run.measured import joint_velocity
-from linkage_kinematics.run.robot_loops import (
+from linkage_kinematics.loops.follower import (
     LoopDrop,
     LoopRejection,
     LoopSample,
     RobotLoopsFollower,
 )
+from linkage_kinematics.loops.intake import joint_velocity
+from linkage_kinematics.loops.solver import LoopSampleError
 
 
 def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,

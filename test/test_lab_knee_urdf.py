@@ -20,7 +20,8 @@ import xml.etree.ElementTree as ElementTree
 from linkage_kinematics.cli import check_loops
 from linkage_kinematics.kinematics.geometry import preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
-from linkage_kinematics.model.loops import find_loops, LoopSolver
+from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.solver import LoopSolver
 import pytest
 from reference import reference_state
 

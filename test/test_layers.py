@@ -4,9 +4,10 @@
 """
 The package's layers, read from its imports: each layer imports only the layers below it.
 
-kinematics ← model ← run ← bag ← ros ← cli (README: Architecture). Every import counts, those
-under ``if TYPE_CHECKING:`` and inside functions included, and no module imports itself back
-through others. The pure layers (kinematics, model, run) load no ROS, MCAP or ament module.
+kinematics ← model ← loops ← run ← bag ← ros ← cli (README: Architecture). Every import
+counts, those under ``if TYPE_CHECKING:`` and inside functions included, and no module imports
+itself back through others. The pure layers (kinematics, model, loops, run) load no ROS, MCAP or
+ament module.
 """
 
 from __future__ import annotations
@@ -19,8 +20,8 @@ import sys
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / 'linkage_kinematics'
-LAYERS = ('kinematics', 'model', 'run', 'bag', 'ros', 'cli')
-PURE_LAYERS = ('kinematics', 'model', 'run')
+LAYERS = ('kinematics', 'model', 'loops', 'run', 'bag', 'ros', 'cli')
+PURE_LAYERS = ('kinematics', 'model', 'loops', 'run')
 # What a pure module must not load, directly or through what it imports.
 NOT_PURE = ('rclpy', 'rosidl_parser', 'rosidl_runtime_py', 'mcap', 'mcap_ros2',
             'ament_index_python', 'builtin_interfaces', 'sensor_msgs', 'std_msgs')

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from typing import Any
 
+from linkage_kinematics.loops.intake import Estimate
 from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription, TreePositions
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
-from linkage_kinematics.run.measured import Estimate
 from loop_robots import ROBOTS
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-model.loops: a URDF's <constraint> loops read, checked, ordered and solved.
+A URDF's <constraint> loops read, checked, ordered and solved (loops: description to solver).
 
 The test robots (test/loop_robots.py) are drawn with derived, non-aligned frames; their
 solutions are checked against test/loop_reference.py (mpmath Newton on all constraints at once,
@@ -17,8 +17,9 @@ from linkage_kinematics.kinematics.continuation import continued_branch
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.kinematics.solver import CrankRates, solve
-from linkage_kinematics.model.loop_urdf import LoopError, read_robot
-from linkage_kinematics.model.loops import find_loops, LoopSampleError, LoopSolver
+from linkage_kinematics.loops.description import LoopError, read_robot
+from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.model.urdf import urdf_text
 import loop_reference
 from loop_robots import DEPTH_1, ROBOTS

@@ -22,14 +22,14 @@ from builtin_interfaces.msg import Time
 from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind
-from linkage_kinematics.ros.messages import JointStateEncoder
-from linkage_kinematics.run.robot_loops import (
+from linkage_kinematics.loops.follower import (
     LoopDrop,
     LoopRejection,
     LoopSample,
-    read_loops,
     RobotLoopsFollower,
 )
+from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.ros.messages import JointStateEncoder
 from loop_robots import ROBOTS
 from loops_per_call import ReferenceFollower
 import pytest

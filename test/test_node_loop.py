@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The node's own URDF as a ``<constraint>`` loop, read by ``model.loops`` as a lab's would be.
+The node's own URDF as a ``<constraint>`` loop, read by ``loops.plan`` as a lab's would be.
 
 For each preset, each driver and each joint mapping: one four-bar loop without a problem, whose
 dimensions are the four-bar's; its constraint frames parallel at the zero pose and coinciding
@@ -17,6 +17,7 @@ import re
 
 from linkage_kinematics.kinematics.geometry import FourBar, preset, PRESETS, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates, DeadPointError, solve
+from linkage_kinematics.loops.plan import find_loops
 from linkage_kinematics.model.joints import (
     Driver,
     JointMap,
@@ -26,7 +27,6 @@ from linkage_kinematics.model.joints import (
     TREE_ORDER,
     tree_values,
 )
-from linkage_kinematics.model.loops import find_loops
 from linkage_kinematics.model.robot_transforms import RobotTransforms
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
@@ -175,7 +175,7 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
     """
     The follower's passive joints, solved by the node's loop, are the four-bar mapping's.
 
-    Solved through ``model.loops``, they are what ``JointStream`` gives of the closed-form
+    Solved through ``loops.solver``, they are what ``JointStream`` gives of the closed-form
     state, to 1e-12: over the driver's whole range (to 0.1 % of it from a dead point) on both
     branches, the driver's lab value wrapping at ±π; the velocities relative to their size
     (they grow without bound at the dead points).

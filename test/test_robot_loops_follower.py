@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-run.robot_loops and run.loop_diagnostics: a robot's loops followed message by message, no ROS.
+loops.follower and run.loop_diagnostics: a robot's loops followed message by message, no ROS.
 
 The follower's answers are checked against test/loop_reference.py (mpmath, sharing nothing with
 the package); its refusals, one by one, name the loops they concern; the statuses say so.
@@ -13,20 +13,20 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from linkage_kinematics.model.loop_urdf import LoopError
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.follower import (
+    LoopDrop,
+    LoopRejection,
+    LoopSample,
+    RobotLoopsFollower,
+)
+from linkage_kinematics.loops.intake import Estimate
+from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
-from linkage_kinematics.run.measured import Estimate
 from linkage_kinematics.run.parameter_specs import parameter_specs
-from linkage_kinematics.run.robot_loops import (
-    LoopDrop,
-    LoopRejection,
-    LoopSample,
-    read_loops,
-    RobotLoopsFollower,
-)
 import loop_reference
 from loop_robots import ROBOTS
 import pytest

@@ -19,7 +19,7 @@ import sys
 import threading
 import time
 
-from linkage_kinematics.model.loop_urdf import LoopError, read_robot
+from linkage_kinematics.loops.description import LoopError, read_robot
 from linkage_kinematics.model.robot_transforms import RobotTransforms
 from linkage_kinematics.model.urdf_reader import (
     JointType,
@@ -141,7 +141,7 @@ def test_the_parsers_notes_are_kept_not_printed_and_its_hook_is_restored(
         'Unknown tag "lab_extension" in /robot[@name=\'r\']')
     # as urdfdom, the first of two origins
     assert tree.joints['j'].origin_translation == (1.0, 0.0, 0.0)
-    # the <constraint> is left to loop_urdf, in the tree the parser read
+    # the <constraint> is left to loops.description, in the tree the parser read
     assert [element.get('name') for element in tree.element.iter('constraint')] == ['pin']
     RobotTransforms(text)
     assert xml_reflection_core.on_error is before

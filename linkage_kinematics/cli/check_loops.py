@@ -23,9 +23,8 @@ import sys
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
-from linkage_kinematics.model.loop_geometry import Loop, LoopJoint
-from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.loops import (
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.plan import (
     find_loops,
     LoopPlan,
     mimic_warnings,
@@ -33,6 +32,7 @@ from linkage_kinematics.model.loops import (
     zero_pose_branch,
     zero_pose_warnings,
 )
+from linkage_kinematics.loops.planar import Loop, LoopJoint
 
 PROGRAM = 'linkage-check-loops'
 EXIT_PROBLEMS = 1

@@ -22,10 +22,10 @@ it: the joint's axis is direction·z and its origin is turned by −direction·o
 that the child frame turns by direction·(q − offset), the node's value, as above.
 
 The pivot the tree leaves open is written as the loop's cut joint, a revolute ``<constraint>``
-(urdfdom PR #264, as ``model.loops`` reads it; robot_state_publisher's parser ignores it) named
-``pivot_c`` or ``pivot_o``: its parent frame is the pivot on the root link, its child frame the
-chain's end, (BC, 0, 0) in the rocker or (OA, 0, 0) in the disk, turned so that the two frames
-are parallel at the zero pose. They coincide wherever the loop closes; the zero pose (every
+(urdfdom PR #264, as ``loops.description`` reads it; robot_state_publisher's parser ignores it)
+named ``pivot_c`` or ``pivot_o``: its parent frame is the pivot on the root link, its child frame
+the chain's end, (BC, 0, 0) in the rocker or (OA, 0, 0) in the disk, turned so that the two
+frames are parallel at the zero pose. They coincide wherever the loop closes; the zero pose (every
 joint at 0) is in general not such a pose, so there they differ by its closure gap.
 
 The root link (``frame_id``, by default ``linkage_base``) shows both ground pivots.

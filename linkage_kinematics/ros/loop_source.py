@@ -6,7 +6,7 @@ The measured source of ``loops:=robot_description``: every loop of a lab's URDF,
 
 ``RobotLoopsSubscription`` is a ``Source``: it reads the robot description (the parameter
 ``robot_description``, or the relative ``robot_description`` topic as robot_state_publisher
-publishes it), feeds each ``measured_joint_states`` message to a ``run.robot_loops``
+publishes it), feeds each ``measured_joint_states`` message to a ``loops.follower``
 ``RobotLoopsFollower`` and publishes the passive loop joints it solves on ``joint_states``,
 stamped as the input. The node publishes no URDF, ``linkage/state`` or markers of its own
 then: those describe its own four-bar. Its bag holds the input, the completed joint states,
@@ -21,7 +21,9 @@ import math
 from typing import Any, Protocol
 
 from linkage_kinematics.bag.cdr import JointStateDecoder
-from linkage_kinematics.model.loop_urdf import LoopError
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.follower import LoopDrop, LoopRejection, RobotLoopsFollower
+from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
@@ -35,19 +37,8 @@ from linkage_kinematics.ros.outputs import (
 from linkage_kinematics.ros.sources import SourceHost
 from linkage_kinematics.run.configuration import RunConfiguration
 from linkage_kinematics.run.control import ServiceAnswer
-from linkage_kinematics.run.diagnostics import RateMeter, StatusInputs, StatusSchedule
-from linkage_kinematics.run.loop_diagnostics import (
-    loop_statuses,
-    LoopsHealth,
-    LoopsView,
-    Status,
-)
-from linkage_kinematics.run.robot_loops import (
-    LoopDrop,
-    LoopRejection,
-    read_loops,
-    RobotLoopsFollower,
-)
+from linkage_kinematics.run.diagnostics import RateMeter, Status, StatusInputs, StatusSchedule
+from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 

@@ -33,8 +33,7 @@ from linkage_kinematics.run.configuration import (
     RunConfiguration,
     SourceKind,
 )
-from linkage_kinematics.run.diagnostics import Level
-from linkage_kinematics.run.loop_diagnostics import Status
+from linkage_kinematics.run.diagnostics import Level, Status
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.publisher import Publisher

@@ -24,8 +24,7 @@ from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.outputs import MEASURED_QOS, MEASURED_TOPIC
 from linkage_kinematics.run.configuration import EndBehavior, RunConfiguration
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
-from linkage_kinematics.run.diagnostics import MeasuredHealth, StatusInputs
-from linkage_kinematics.run.loop_diagnostics import Status
+from linkage_kinematics.run.diagnostics import MeasuredHealth, Status, StatusInputs
 from linkage_kinematics.run.measured import MeasuredFollower, Rejection
 from linkage_kinematics.run.motion import (
     dead_point_problem,

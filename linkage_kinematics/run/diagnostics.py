@@ -24,10 +24,11 @@ from enum import Enum, IntEnum
 import math
 
 from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
+from linkage_kinematics.loops.intake import Estimate
 from linkage_kinematics.model.joints import Driver, Link
 from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, SourceKind
 from linkage_kinematics.run.control import RunState
-from linkage_kinematics.run.measured import Estimate, Rejection
+from linkage_kinematics.run.measured import Rejection
 from linkage_kinematics.run.motion import blocked_note
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
@@ -178,6 +179,17 @@ class Level(IntEnum):
     WARN = 1
     ERROR = 2
     STALE = 3
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic_msgs/DiagnosticStatus: its task (after the node's name) and content."""
+
+    task: str
+    hardware_id: str
+    level: Level
+    message: str
+    values: dict[str, str]
 
 
 def driver_angle(config: RunConfiguration, state: LinkageState) -> float:

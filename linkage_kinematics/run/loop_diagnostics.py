@@ -18,34 +18,24 @@ from dataclasses import dataclass
 import math
 
 from linkage_kinematics.kinematics.planar_loop import JointKind
-from linkage_kinematics.model.loops import LoopPlan, PlannedLoop
-from linkage_kinematics.run.diagnostics import (
-    Freshness,
-    Level,
-    LOG_DISABLED,
-    NOT_MEASURED,
-    StatusInputs,
-)
-from linkage_kinematics.run.measured import Estimate
-from linkage_kinematics.run.robot_loops import (
+from linkage_kinematics.loops.follower import (
     dead_point_distances,
     LoopDrop,
     LoopRejection,
     LoopSample,
 )
+from linkage_kinematics.loops.intake import Estimate
+from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
+from linkage_kinematics.run.diagnostics import (
+    Freshness,
+    Level,
+    LOG_DISABLED,
+    NOT_MEASURED,
+    Status,
+    StatusInputs,
+)
 
 NODE_TASK = 'robot loops'
-
-
-@dataclass(frozen=True)
-class Status:
-    """One diagnostic_msgs/DiagnosticStatus: its task (after the node's name) and content."""
-
-    task: str
-    hardware_id: str
-    level: Level
-    message: str
-    values: dict[str, str]
 
 
 def _counts() -> dict[LoopRejection, int]:

@@ -11,7 +11,7 @@ at it: the crank directly, the rocker through the mechanism seen from C (``inver
 
 The passive joints come the general way, as from a lab's URDF: the node's own URDF for the
 configuration (``model.urdf``, whose ``<constraint>`` closes its loop) is read by
-``model.loops``, planned with the driver measured, and its ``LoopSolver`` turns the driver's lab
+``loops.plan``, planned with the driver measured, and its ``LoopSolver`` turns the driver's lab
 value and velocity into the passive joints' lab values and velocities. The four-bar's
 ``LinkageState`` (``linkage/state``, the scene, diagnostics) still comes from its closed form:
 it holds the accelerations and pins the loop solver does not compute.
@@ -53,14 +53,10 @@ from linkage_kinematics.kinematics.solver import (
     solve,
     unwrap_near,
 )
+from linkage_kinematics.loops.intake import Estimate, joint_velocity
+from linkage_kinematics.loops.plan import find_loops, LoopPlan, RobotLoops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER, TreeValues
-from linkage_kinematics.model.loops import (
-    find_loops,
-    LoopPlan,
-    LoopSampleError,
-    LoopSolver,
-    RobotLoops,
-)
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.run.configuration import RunConfiguration
 
@@ -78,31 +74,6 @@ class Rejection(StrEnum):
     UNREACHABLE = 'at a driver angle the loop cannot reach (or at a dead point)'
     JUMP = 'jumping further than measured.max_jump'
     MALFORMED = 'whose bytes are not a well-formed JointState'
-
-
-class Estimate(StrEnum):
-    """How the driver's angular velocity of a sample was obtained."""
-
-    MEASURED = 'measured'
-    BACKWARD_DIFFERENCE = 'estimated (backward difference of angles)'
-    FIRST_SAMPLE = 'estimated (0: first sample without velocity)'
-
-
-def joint_velocity(stamp_ns: int, value: float, measured: float | None,
-                   last: tuple[int, float] | None) -> tuple[float, Estimate]:
-    """
-    Return a measured joint's velocity at ``value`` (stamp ``stamp_ns``) and how it was obtained.
-
-    ``measured`` when the message carries it; else the backward difference from ``last``
-    (its stamp in ns and its value, unwrapped to ``value``'s turn) over the header stamps, and 0
-    for a first sample (``last`` None).
-    """
-    if measured is not None:
-        return measured, Estimate.MEASURED
-    if last is None:
-        return 0.0, Estimate.FIRST_SAMPLE
-    last_stamp_ns, last_value = last
-    return (value - last_value) / ((stamp_ns - last_stamp_ns) * 1e-9), Estimate.BACKWARD_DIFFERENCE
 
 
 @dataclass(frozen=True)

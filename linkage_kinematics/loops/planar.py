@@ -34,7 +34,7 @@ import math
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, PlanarLoop
-from linkage_kinematics.model.loop_urdf import Constraint, LoopError, Robot, tree_path
+from linkage_kinematics.loops.description import Constraint, LoopError, Robot, tree_path
 from linkage_kinematics.model.urdf_reader import JointType, MOVABLE_TYPES, ROTATING_TYPES
 import numpy as np
 

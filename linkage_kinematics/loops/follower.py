@@ -6,14 +6,13 @@ The measured source of ``loops:=robot_description``: a robot's loops closed mess
 
 ``RobotLoopsFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
 positions, velocities), picks the measured joints by name and closes every ``<constraint>``
-loop of the robot's URDF from them (``model.loops``: ``find_loops``, ``RobotLoops.plan``,
-``LoopSolver``). It returns a ``LoopSample``, the passive loop joints' positions and velocities
-(URDF units, rad or m), or a ``LoopDrop``, why the message was dropped and which loops it
-concerned. A measured joint without a velocity gets the measured mode's estimate
-(``measured.joint_velocity``: the backward difference over the header stamps, 0 for a first
-sample). A revolute measured joint is unwrapped across turns, as the measured mode's driver is,
-and ``measured.max_jump`` (rad) applies to it; a prismatic one's length (m) has no such bound.
-No ROS.
+loop of the robot's URDF from them (``plan.RobotLoops.plan``, ``solver.LoopSolver``). It
+returns a ``LoopSample``, the passive loop joints' positions and velocities (URDF units, rad or
+m), or a ``LoopDrop``, why the message was dropped and which loops it concerned. A measured
+joint without a velocity gets the measured mode's estimate (``intake.joint_velocity``: the
+backward difference over the header stamps, 0 for a first sample). A revolute measured joint
+is unwrapped across turns, as the measured mode's driver is, and ``measured.max_jump`` (rad)
+applies to it; a prismatic one's length (m) has no such bound. No ROS.
 """
 
 from __future__ import annotations
@@ -25,15 +24,9 @@ import math
 
 from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
-from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.loops import (
-    find_loops,
-    LoopPlan,
-    LoopSampleError,
-    LoopSolver,
-    RobotLoops,
-)
-from linkage_kinematics.run.measured import Estimate, joint_velocity
+from linkage_kinematics.loops.intake import Estimate, joint_velocity
+from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 
 
 class LoopRejection(StrEnum):
@@ -76,21 +69,6 @@ class LoopSample:
     joints: dict[str, float]
     estimates: dict[str, Estimate]
     known_values: dict[str, float]
-
-
-def read_loops(urdf: str) -> RobotLoops:
-    """
-    Return a robot description's loops; LoopError, one line, if any cannot be closed.
-
-    The line names every problem (the parser's, each constraint's); a robot without any
-    ``<constraint>`` is refused too: there is nothing to close.
-    """
-    loops = find_loops(urdf)
-    if loops.problems:
-        raise LoopError('; '.join(loops.problems))
-    if not loops.loops:
-        raise LoopError(f'robot {loops.robot_name!r} has no <constraint> loop to close')
-    return loops
 
 
 class RobotLoopsFollower:
