@@ -29,6 +29,7 @@ from linkage_kinematics.loops.follower import (
     RobotLoopsFollower,
 )
 from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.ros.messages import JointStateEncoder
 from loop_robots import ROBOTS
 from loops_per_call import ReferenceFollower
@@ -85,8 +86,8 @@ def sweep(name: str, revolute: bool) -> list[tuple[int, list[str], list[float], 
 @pytest.mark.parametrize('name', sorted(ROBOTS))
 def test_the_prepared_path_gives_the_per_call_paths_bits(name: str) -> None:
     """Every sample, drop and estimate of the sweep equals the reference's, float bits too."""
-    follower = RobotLoopsFollower(read_loops(ROBOTS[name].urdf()), ROBOTS[name].measured_joints,
-                                  {}, math.pi / 2)
+    follower = RobotLoopsFollower(read_loops(read_urdf(ROBOTS[name].urdf())),
+                                  ROBOTS[name].measured_joints, {}, math.pi / 2)
     reference = ReferenceFollower(follower)
     revolute = follower.plan.loops[0].known.kind is JointKind.REVOLUTE
     reasons = set()
@@ -114,8 +115,8 @@ def test_the_prepared_path_gives_the_per_call_paths_bits(name: str) -> None:
 @pytest.mark.parametrize('stamp_ns', [0, 1_700_000_000_123_456_789, -1_500_000_001])
 def test_the_output_encoder_writes_encode_cdrs_bytes(name: str, stamp_ns: int) -> None:
     """The prepared joint_states bytes equal encode_cdr of the message built field by field."""
-    follower = RobotLoopsFollower(read_loops(ROBOTS[name].urdf()), ROBOTS[name].measured_joints,
-                                  {}, math.pi / 2)
+    follower = RobotLoopsFollower(read_loops(read_urdf(ROBOTS[name].urdf())),
+                                  ROBOTS[name].measured_joints, {}, math.pi / 2)
     encoder = None
     for stamp, names, positions, velocities in sweep(name, False)[:SAMPLES:37]:
         sample = follower.follow(stamp, names, positions, velocities)

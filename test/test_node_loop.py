@@ -12,6 +12,7 @@ the element is the only thing robot_state_publisher's reading of the text does n
 
 from __future__ import annotations
 
+from dataclasses import replace
 import math
 import re
 
@@ -28,7 +29,8 @@ from linkage_kinematics.model.joints import (
     tree_values,
 )
 from linkage_kinematics.model.robot_transforms import RobotTransforms
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description, urdf_text
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
 from linkage_kinematics.run.measured import FollowedSample, MeasuredFollower, Rejection
 from linkage_kinematics.run.parameter_specs import parameter_specs
@@ -36,6 +38,7 @@ import loop_reference
 import numpy as np
 import pytest
 import urchin
+from urdf_parser_py import urdf as urdf_parser
 
 # The kite (a change-point linkage) is solved from its URDF, whose link vectors are rounded
 # components at the zero pose: within a few degrees of its change point the rates amplify that
@@ -72,7 +75,7 @@ def _lengths_in_loop_order(linkage: FourBar, driver: Driver) -> tuple[float, ...
 def test_the_nodes_urdf_has_one_four_bar_loop_of_the_linkages_dimensions(
         name: str, driver: Driver, mapping: str) -> None:
     urdf = _node_urdf(name, driver, mapping)
-    loops = find_loops(urdf)
+    loops = find_loops(read_urdf(urdf))
     assert (loops.problems, loops.parser_messages) == ((), ())
     (loop,) = loops.loops
     assert loop.constraint == ('pivot_c' if driver is Driver.CRANK else 'pivot_o')
@@ -123,8 +126,8 @@ def test_robot_state_publishers_reading_is_that_of_the_text_without_the_constrai
     without = urdf.replace(element, '')
     assert without.endswith('  </joint>\n</robot>\n')
     values = {name: 0.3 for name in LAB.names(TREE_ORDER[driver])}
-    with_constraint = RobotTransforms(urdf)
-    plain = RobotTransforms(without)
+    with_constraint = RobotTransforms(read_urdf(urdf))
+    plain = RobotTransforms(read_urdf(without))
     assert with_constraint.fixed_transforms() == plain.fixed_transforms()
     names = list(values)
     moving, plain_moving = with_constraint.moving(names), plain.moving(names)
@@ -244,3 +247,30 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     # the state is the new geometry's: the joints match it only if they come from its loop
     for index in range(80, 100):
         check(index, math.remainder(0.4 - 0.12 * index, TWO_PI))
+
+
+def test_the_nodes_description_is_parsed_once_for_its_loop_and_its_tf(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """
+    The measured mode's loop and the log's TF read one parse of the node's URDF text.
+
+    A follower, a second follower of the same joints, a new threshold and the outputs'
+    ``node_description`` (its tree gives /tf_static and /tf) parse the text once in all; a new
+    geometry is a new text, parsed once more.
+    """
+    parses = []
+    parse = urdf_parser.Robot.from_xml
+    monkeypatch.setattr(urdf_parser.Robot, 'from_xml',
+                        lambda *arguments: parses.append(arguments) or parse(*arguments))
+    node_description.cache_clear()
+    config = _config('grashof_crank_rocker', Driver.CRANK, 'lab', 1)
+    follower = MeasuredFollower(config)
+    MeasuredFollower(config)
+    follower.reconfigure(replace(config, max_jump=0.5))
+    description = node_description(config.linkage, config.frame_id, config.joints, config.driver)
+    assert description.text == urdf_text(config.linkage, config.frame_id, config.joints,
+                                         config.driver)
+    assert description.tree.joints.keys() == {'knee_motor', 'knee_link', 'knee_output'}
+    assert len(parses) == 1
+    MeasuredFollower(_config('kite', Driver.CRANK, 'lab', 1))
+    assert len(parses) == 2

@@ -22,6 +22,7 @@ from linkage_kinematics.loops.follower import (
 )
 from linkage_kinematics.loops.intake import Estimate
 from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
@@ -40,7 +41,7 @@ CYLINDERS = list(ROBOTS['excavator'].measured_joints)
 
 def follower(urdf: str, measured: tuple[str, ...] = (), max_jump: float = math.pi / 2,
              branches: dict[str, int] | None = None) -> RobotLoopsFollower:
-    return RobotLoopsFollower(read_loops(urdf), measured, branches or {}, max_jump)
+    return RobotLoopsFollower(read_loops(read_urdf(urdf)), measured, branches or {}, max_jump)
 
 
 def test_the_knee_without_velocities_is_estimated_and_matches_the_reference() -> None:
@@ -129,12 +130,10 @@ def test_descriptions_that_cannot_be_closed_are_refused_in_one_line() -> None:
     broken = KNEE.replace('<constraint name="knee_rear_pin" type="revolute">',
                           '<constraint name="knee_rear_pin" type="prismatic">')
     with pytest.raises(LoopError, match='knee_rear_pin') as refusal:
-        read_loops(broken)
+        read_loops(read_urdf(broken))
     assert '\n' not in str(refusal.value)
     with pytest.raises(LoopError, match="robot 'plain' has no <constraint> loop to close"):
-        read_loops('<robot name="plain"><link name="a"/></robot>')
-    with pytest.raises(LoopError):
-        read_loops('not a robot')
+        read_loops(read_urdf('<robot name="plain"><link name="a"/></robot>'))
 
 
 def test_a_branch_override_picks_the_other_assembly() -> None:

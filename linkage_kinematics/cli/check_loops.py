@@ -33,6 +33,7 @@ from linkage_kinematics.loops.plan import (
     zero_pose_warnings,
 )
 from linkage_kinematics.loops.planar import Loop, LoopJoint
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 
 PROGRAM = 'linkage-check-loops'
 EXIT_PROBLEMS = 1
@@ -160,8 +161,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USAGE
     problems: list[str] = []
     try:
-        loops = find_loops(text)
-    except LoopError as error:
+        loops = find_loops(read_urdf(text))
+    except UrdfError as error:
         print(f'{PROGRAM}: {error}', file=sys.stderr)
         return EXIT_PROBLEMS
     problems += loops.problems

@@ -23,6 +23,7 @@ from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import branch_of, DeadPointError, UnreachableError
 from linkage_kinematics.loops.description import LoopError, read_robot
 from linkage_kinematics.loops.planar import derive_loop, Loop, LoopJoint
+from linkage_kinematics.model.urdf_reader import UrdfTree
 
 BRANCHES = (-1, 1)
 # A pin open by more than this fraction of the loop's longest link at the zero pose: not an
@@ -159,14 +160,13 @@ class RobotLoops:
                         zero_pose_warnings(self.loops) + mimic_warnings(self.loops, measured))
 
 
-def find_loops(urdf: str) -> RobotLoops:
+def find_loops(tree: UrdfTree) -> RobotLoops:
     """
-    Read every ``<constraint>``'s loop from a URDF text.
+    Read every ``<constraint>``'s loop of a parsed URDF.
 
-    Raises LoopError for a text that is not a URDF robot, or whose joints do not form a tree;
-    constraints that cannot be closed are returned as ``problems``.
+    Constraints that cannot be closed are returned as ``problems``.
     """
-    robot = read_robot(urdf)
+    robot = read_robot(tree)
     loops, problems = [], list(robot.constraint_problems)
     for constraint in robot.constraints:
         try:
@@ -174,17 +174,17 @@ def find_loops(urdf: str) -> RobotLoops:
         except LoopError as error:
             problems.append(str(error))
     return RobotLoops(robot.name, frozenset(robot.joints), tuple(loops), tuple(problems),
-                      robot.parser_messages)
+                      tree.parser_messages)
 
 
-def read_loops(urdf: str) -> RobotLoops:
+def read_loops(tree: UrdfTree) -> RobotLoops:
     """
-    Return a robot description's loops; LoopError, one line, if any cannot be closed.
+    Return a parsed robot description's loops; LoopError, one line, if any cannot be closed.
 
-    The line names every problem (the parser's, each constraint's); a robot without any
-    ``<constraint>`` is refused too: there is nothing to close.
+    The line names every constraint's problem; a robot without any ``<constraint>`` is refused
+    too: there is nothing to close.
     """
-    loops = find_loops(urdf)
+    loops = find_loops(tree)
     if loops.problems:
         raise LoopError('; '.join(loops.problems))
     if not loops.loops:

@@ -24,7 +24,7 @@ from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import LoopDrop, LoopRejection, RobotLoopsFollower
 from linkage_kinematics.loops.plan import read_loops
-from linkage_kinematics.model.urdf_reader import UrdfError
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
     MEASURED_QOS,
@@ -55,11 +55,11 @@ class ClosedRobot:
 
     def __init__(self, urdf: str, config: RunConfiguration) -> None:
         """Read ``urdf``; LoopError or UrdfError, one line naming the problem, if it cannot."""
-        loops = read_loops(urdf)
+        tree = read_urdf(urdf)  # once, for the loops and for robot_state_publisher's TF
         self.urdf = urdf
-        self.follower = RobotLoopsFollower(loops, config.loop_measured_joints,
+        self.follower = RobotLoopsFollower(read_loops(tree), config.loop_measured_joints,
                                            dict(config.loop_branches), config.max_jump)
-        self.transforms = RobotStateTransforms(urdf, config.frame_prefix)
+        self.transforms = RobotStateTransforms(tree, config.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
 

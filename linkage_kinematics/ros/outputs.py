@@ -25,7 +25,7 @@ from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream, TreeValues
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.ros import messages
 from linkage_kinematics.run.configuration import (
     ConfigurationError,
@@ -216,25 +216,23 @@ class NodeOutputs:
                   stamp_ns)
 
     def publish_description(self, stamp_ns: int) -> None:
-        """
-        Publish the URDF, if it is published and the geometry or the joints are new.
-
-        And log the /tf_static robot_state_publisher would publish for it (also where the lab's
-        own URDF is used: the node's has the lab's joints).
-        """
+        """Publish the URDF if published and its geometry or joints are new; log its /tf_static."""
         config = self.config
         described = (config.linkage, config.joints)
         if self._described == described or config.loops is LoopsSource.ROBOT_DESCRIPTION:
             return
         self._described = described
-        text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
+        description = node_description(config.linkage, config.frame_id, config.joints,
+                                       config.driver)
         if self._publishers.robot_description is not None:
-            self.send(self._publishers.robot_description, encode_cdr(String(data=text)),
-                      stamp_ns)
+            self.send(self._publishers.robot_description,
+                      encode_cdr(String(data=description.text)), stamp_ns)
+        # robot_state_publisher's TF, also where a lab runs it on its own URDF: the node's URDF
+        # has the lab's joints
         if self.recorder is not None:
-            self._robot_transforms = messages.RobotStateTransforms(text, config.frame_prefix)
-            self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(stamp_ns),
-                         stamp_ns)
+            self._robot_transforms = tf = messages.RobotStateTransforms(
+                description.tree, config.frame_prefix)
+            self._record(TF_STATIC_TOPIC, tf.static_message(stamp_ns), stamp_ns)
 
     # loops robot_description: the lab's description, its closed loops and their input
 

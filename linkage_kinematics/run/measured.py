@@ -57,7 +57,7 @@ from linkage_kinematics.loops.intake import Estimate, joint_velocity
 from linkage_kinematics.loops.plan import find_loops, LoopPlan, RobotLoops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER, TreeValues
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.run.configuration import RunConfiguration
 
 # Far below any distance between two change points, far above the rounding of the loop's
@@ -276,4 +276,5 @@ class MeasuredFollower:
 
 def _node_loops(config: RunConfiguration) -> RobotLoops:
     """Return the loop of the node's own URDF for ``config`` (one four-bar, ``model.urdf``)."""
-    return find_loops(urdf_text(config.linkage, config.frame_id, config.joints, config.driver))
+    return find_loops(node_description(config.linkage, config.frame_id, config.joints,
+                                       config.driver).tree)
