@@ -24,10 +24,10 @@ from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.loops.follower import (
     LoopDrop,
-    LoopRejection,
     LoopSample,
     RobotLoopsFollower,
 )
+from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.ros.messages import JointStateEncoder
@@ -107,8 +107,8 @@ def test_the_prepared_path_gives_the_per_call_paths_bits(name: str) -> None:
         assert isinstance(got, LoopSample)
         assert bits(vars(got)) == bits(vars(expected))
     # the sweep reached every refusal it means to (a reference that never refuses proves less)
-    assert reasons == {LoopRejection.NON_FINITE, LoopRejection.STAMP_NOT_NEWER,
-                       LoopRejection.JUMP if revolute else LoopRejection.UNREACHABLE}
+    assert reasons == {DropReason.NON_FINITE, DropReason.STAMP_NOT_NEWER,
+                       DropReason.JUMP if revolute else DropReason.JOINTS_UNREACHABLE}
 
 
 @pytest.mark.parametrize('name', sorted(ROBOTS))

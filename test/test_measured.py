@@ -27,10 +27,11 @@ import xml.etree.ElementTree as ElementTree
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.kinematics.geometry import FourBar, preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
+from linkage_kinematics.loops.intake import DropReason, FOUR_BAR_DROPS
 from linkage_kinematics.model.joints import Driver, JointStream, Link, TREE_ORDER
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.run.configuration import build_configuration, SourceKind
-from linkage_kinematics.run.measured import MeasuredFollower, Rejection
+from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
 from node_process import (
     Listener,
@@ -435,11 +436,12 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, n
     assert_stamps_are_the_inputs(run, samples, ('coupler_joint', 'rocker_joint'))
     warnings = ' '.join(status.message for status in statuses()
                         if status.level == DiagnosticStatus.WARN)
-    for rejection in Rejection:
+    for rejection in FOUR_BAR_DROPS:
         assert rejection.value in warnings
     values = {item.key: item.value for item in statuses()[-1].values}
-    expected = {Rejection.NON_FINITE: 2, Rejection.NO_DRIVER: 1, Rejection.STAMP_NOT_NEWER: 2,
-                Rejection.UNREACHABLE: 1, Rejection.JUMP: 1, Rejection.MALFORMED: 1}
+    expected = {DropReason.NON_FINITE: 2, DropReason.NO_DRIVER: 1,
+                DropReason.STAMP_NOT_NEWER: 2, DropReason.DRIVER_UNREACHABLE: 1,
+                DropReason.JUMP: 1, DropReason.MALFORMED: 1}
     for rejection, count in expected.items():
         assert values[f'dropped {rejection.value}'] == str(count)
     assert values['dropped samples'] == '8'

@@ -18,6 +18,7 @@ import re
 
 from linkage_kinematics.kinematics.geometry import FourBar, preset, PRESETS, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates, DeadPointError, solve
+from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.loops.plan import find_loops
 from linkage_kinematics.model.joints import (
     Driver,
@@ -32,7 +33,7 @@ from linkage_kinematics.model.robot_transforms import RobotTransforms
 from linkage_kinematics.model.urdf import node_description, urdf_text
 from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
-from linkage_kinematics.run.measured import FollowedSample, MeasuredFollower, Rejection
+from linkage_kinematics.run.measured import FollowedSample, MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import loop_reference
 import numpy as np
@@ -193,7 +194,7 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
         lab_angle = math.remainder(driver_mapping.to_lab(angle), TWO_PI)
         followed = follower.follow(index + 1, [driver_mapping.name], [lab_angle],
                                    [driver_mapping.direction * omega])
-        if followed is Rejection.UNREACHABLE:
+        if followed is DropReason.DRIVER_UNREACHABLE:
             # the kite's pin A on C: the closed form refuses it too (the motion is undetermined)
             with pytest.raises(DeadPointError, match='undetermined'):
                 solve(config.driven_linkage, angle, CrankRates(omega, 0.0), branch)

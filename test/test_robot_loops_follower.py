@@ -16,11 +16,10 @@ from typing import Any
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import (
     LoopDrop,
-    LoopRejection,
     LoopSample,
     RobotLoopsFollower,
 )
-from linkage_kinematics.loops.intake import Estimate
+from linkage_kinematics.loops.intake import DropReason, Estimate
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
@@ -82,14 +81,14 @@ def test_bad_samples_are_dropped_naming_their_loops_and_leave_the_motion_as_it_w
     good = excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])
     assert isinstance(good, LoopSample)
     drops = [
-        (excavator.follow(2, CYLINDERS[:2], [0.0, 0.0], []), LoopRejection.NO_JOINT,
+        (excavator.follow(2, CYLINDERS[:2], [0.0, 0.0], []), DropReason.NO_JOINT,
          ('bucket_cylinder_pin',)),
-        (excavator.follow(2, CYLINDERS, [0.0, math.inf, 0.0], []), LoopRejection.NON_FINITE,
+        (excavator.follow(2, CYLINDERS, [0.0, math.inf, 0.0], []), DropReason.NON_FINITE,
          ('stick_cylinder_pin',)),
         (excavator.follow(2, CYLINDERS, [0.0, 0.0, 0.0], [math.nan, 0.0, 0.0]),
-         LoopRejection.NON_FINITE, ('boom_cylinder_pin',)),
-        (excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], []), LoopRejection.STAMP_NOT_NEWER, ()),
-        (excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []), LoopRejection.UNREACHABLE,
+         DropReason.NON_FINITE, ('boom_cylinder_pin',)),
+        (excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], []), DropReason.STAMP_NOT_NEWER, ()),
+        (excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []), DropReason.JOINTS_UNREACHABLE,
          ('boom_cylinder_pin',)),
     ]
     for drop, reason, constraints in drops:
@@ -105,7 +104,7 @@ def test_bad_samples_are_dropped_naming_their_loops_and_leave_the_motion_as_it_w
     knee = follower(KNEE, max_jump=0.5)
     knee.follow(1, ['knee_front'], [0.0], [])
     jump = knee.follow(2, ['knee_front'], [0.6], [])
-    assert (jump.reason, jump.constraints) == (LoopRejection.JUMP, ('knee_rear_pin',))
+    assert (jump.reason, jump.constraints) == (DropReason.JUMP, ('knee_rear_pin',))
 
 
 def test_measured_joints_come_from_the_first_message_and_own_output_is_ignored() -> None:

@@ -5,48 +5,32 @@
 The measured source of ``loops:=robot_description``: a robot's loops closed message by message.
 
 ``RobotLoopsFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
-positions, velocities), picks the measured joints by name and closes every ``<constraint>``
-loop of the robot's URDF from them (``plan.RobotLoops.plan``, ``solver.LoopSolver``). It
-returns a ``LoopSample``, the passive loop joints' positions and velocities (URDF units, rad or
-m), or a ``LoopDrop``, why the message was dropped and which loops it concerned. A measured
-joint without a velocity gets the measured mode's estimate (``intake.joint_velocity``: the
-backward difference over the header stamps, 0 for a first sample). A revolute measured joint
-is unwrapped across turns, as the measured mode's driver is, and ``measured.max_jump`` (rad)
-applies to it; a prismatic one's length (m) has no such bound. No ROS.
+positions, velocities), takes the measured joints in through the measured modes' one
+``intake.Intake`` and closes every ``<constraint>`` loop of the robot's URDF from them
+(``plan.RobotLoops.plan``, ``solver.LoopSolver``). It returns a ``LoopSample``, the passive loop
+joints' positions and velocities (URDF units, rad or m), or a ``LoopDrop``, why the message was
+dropped and which loops it concerned. A measured joint without a velocity gets the intake's
+estimate (the backward difference over the header stamps, 0 for a first sample). A revolute
+measured joint is unwrapped across turns, as the four-bar's driver is, and ``measured.max_jump``
+(rad) applies to it; a prismatic one's length (m) has no such bound. No ROS.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from enum import StrEnum
-import math
 
-from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
-from linkage_kinematics.loops.intake import Estimate, joint_velocity
+from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
 from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
-
-
-class LoopRejection(StrEnum):
-    """Why an input message was dropped (the text names it in diagnostics)."""
-
-    NO_DESCRIPTION = 'before the robot description was closed'
-    NOT_PLANNED = 'while the measured joints cannot close the loops'
-    NO_JOINT = 'without every measured joint'
-    NON_FINITE = 'with a NaN or infinite position or velocity'
-    STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
-    UNREACHABLE = 'at joint values a loop cannot reach (or at a dead point)'
-    JUMP = 'jumping further than measured.max_jump'
-    MALFORMED = 'whose bytes are not a well-formed JointState'
 
 
 @dataclass(frozen=True)
 class LoopDrop:
     """A dropped message: why, the loops it concerned (none: every loop) and the detail."""
 
-    reason: LoopRejection
+    reason: DropReason
     constraints: tuple[str, ...]
     detail: str
 
@@ -83,39 +67,48 @@ class RobotLoopsFollower:
     def __init__(self, loops: RobotLoops, measured: Sequence[str],
                  branches: Mapping[str, int], max_jump: float) -> None:
         self.loops = loops
-        self.max_jump = max_jump
+        self._max_jump = max_jump
         self._branches = dict(branches)
         self.loop_joints = frozenset(name for loop in loops.loops for name in loop.names)
         self.solver: LoopSolver | None = None
+        self._intake: Intake | None = None
         if measured:
             self._plan(tuple(measured))
-        self.restart()
 
     @property
     def plan(self) -> LoopPlan | None:
         """Return the loops in solve order, None until the measured joints are known."""
         return None if self.solver is None else self.solver.plan
 
+    @property
+    def max_jump(self) -> float:
+        """Return how far (rad) a revolute measured joint may move from one sample to the next."""
+        return self._max_jump
+
+    @max_jump.setter
+    def max_jump(self, value: float) -> None:
+        self._max_jump = value
+        if self._intake is not None:
+            self._intake.max_jump = value
+
     def _plan(self, measured: tuple[str, ...]) -> None:
         plan = self.loops.plan(measured, self._branches)
         self.solver = LoopSolver(plan)
-        # resolved once per plan rather than per message: the revolute measured joints (in
-        # measured order), each loop's constraint and known joint, the loops each feeds
+        # resolved once per plan rather than per message: the revolute measured joints (the
+        # intake unwraps them), each loop's constraint and known joint, the loops each feeds
         revolute = {planned.known.name for planned in plan.loops
                     if planned.measured and planned.known.kind is JointKind.REVOLUTE}
-        self._revolute = tuple(name for name in plan.measured if name in revolute)
+        self._intake = Intake(plan.measured, revolute, self._max_jump, DropReason.NO_JOINT)
         self._known = tuple((planned.loop.constraint, planned.known.name)
                             for planned in plan.loops)
         self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
                                    if planned.known.name == name) for name in measured}
         self._passive = plan.passive  # the solved joints' names, in the order solve gives them
-        self._names: Sequence[str] | None = None  # the names _indices were found in
 
     def restart(self) -> None:
         """Forget the motion: the next valid message starts it again on the planned branches."""
-        self._last_stamp_ns: int | None = None
-        self._last: dict[str, float] = {}  # measured joint → its last value used, unwrapped
         if self.solver is not None:
+            self._intake.restart()
             self.solver.reset()
 
     def _loops_of(self, names: Sequence[str]) -> tuple[str, ...]:
@@ -135,65 +128,24 @@ class RobotLoopsFollower:
             if not carried:
                 return None
             self._plan(carried)
+        taken = self._intake.take(stamp_ns, names, positions, velocities)
+        if taken.__class__ is not tuple:
+            return None if taken is None else LoopDrop(taken.reason,
+                                                       self._loops_of(taken.joints),
+                                                       taken.detail)
+        _, values, rates, estimates = taken
         measured = self.solver.plan.measured
-        if names != self._names:
-            # A source sends the same names message after message: found once, not per message.
-            index = {name: i for i, name in enumerate(names)}
-            self._names = names[:]
-            self._indices = tuple(index.get(name) for name in measured)
-            self._present = tuple(i for i in self._indices if i is not None)
-        indices = self._indices
-        if not self._present:
-            return None
-        if len(self._present) < len(measured) or max(self._present) >= len(positions):
-            count = len(positions)
-            missing = [name for name, i in zip(measured, indices) if i is None or i >= count]
-            return LoopDrop(LoopRejection.NO_JOINT, self._loops_of(missing),
-                            f'no position of {missing}')
-        count = len(velocities)
-        values, given, finite = {}, [], True
-        isfinite = math.isfinite
-        for name, i in zip(measured, indices):
-            value = values[name] = positions[i]
-            rate = velocities[i] if i < count else None
-            given.append(rate)
-            if not isfinite(value) or (rate is not None and not isfinite(rate)):
-                finite = False
-        if not finite:
-            bad = [name for name, rate in zip(measured, given)
-                   if not isfinite(values[name]) or not isfinite(0.0 if rate is None else rate)]
-            return LoopDrop(LoopRejection.NON_FINITE, self._loops_of(bad),
-                            f'{bad} not finite')
-        last_stamp_ns = self._last_stamp_ns
-        if last_stamp_ns is not None and stamp_ns <= last_stamp_ns:
-            return LoopDrop(LoopRejection.STAMP_NOT_NEWER, (), 'stamp not newer')
-        last_values = self._last
-        if last_values:
-            jumps = []
-            for name in self._revolute:
-                # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are
-                # counted.
-                last = last_values[name]
-                value = values[name] = (values[name]
-                                        + round((last - values[name]) / TWO_PI) * TWO_PI)
-                if abs(value - last) > self.max_jump:
-                    jumps.append(name)
-            if jumps:
-                return LoopDrop(LoopRejection.JUMP, self._loops_of(jumps), f'{jumps} jumped')
-        rates, estimates = {}, {}
-        for name, rate in zip(measured, given):
-            last = None if not last_values else (last_stamp_ns, last_values[name])
-            rates[name], estimates[name] = joint_velocity(stamp_ns, values[name], rate, last)
+        measured_values = dict(zip(measured, values))
         try:
-            solved, solved_rates = self.solver.solve(values, rates)
+            solved, solved_rates = self.solver.solve(measured_values, dict(zip(measured, rates)))
         except LoopSampleError as error:
-            return LoopDrop(LoopRejection.UNREACHABLE,
+            return LoopDrop(DropReason.JOINTS_UNREACHABLE,
                             () if error.constraint is None else (error.constraint,), str(error))
-        self._last_stamp_ns, self._last = stamp_ns, values
-        joints = {**values, **solved}
+        self._intake.keep(stamp_ns, values)
+        joints = {**measured_values, **solved}
         return LoopSample(
             stamp_ns, self._passive, tuple(solved.values()), tuple(solved_rates.values()),
-            joints, estimates,
+            joints, dict(zip(measured, estimates)),
             {constraint: joints[known] for constraint, known in self._known})
 
 

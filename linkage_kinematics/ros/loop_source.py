@@ -22,7 +22,8 @@ from typing import Any, Protocol
 
 from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.loops.description import LoopError
-from linkage_kinematics.loops.follower import LoopDrop, LoopRejection, RobotLoopsFollower
+from linkage_kinematics.loops.follower import LoopDrop, RobotLoopsFollower
+from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 from linkage_kinematics.ros.messages import RobotStateTransforms
@@ -291,12 +292,12 @@ class RobotLoopsSubscription:
         try:
             stamp_ns, names, positions, velocities = self._decoder.decode(data)
         except ValueError as error:  # not logged: it has no stamp, and readers would refuse it
-            self._loops_health.drop(LoopDrop(LoopRejection.MALFORMED, (), str(error)))
+            self._loops_health.drop(LoopDrop(DropReason.MALFORMED, (), str(error)))
             return
         robot = self._robot
         if robot is None:
             self._outputs.record_input(data, stamp_ns)
-            self._loops_health.drop(LoopDrop(LoopRejection.NO_DESCRIPTION, (), ''))
+            self._loops_health.drop(LoopDrop(DropReason.NO_DESCRIPTION, (), ''))
             return
         follower = robot.follower
         planned = follower.plan is not None
@@ -304,7 +305,7 @@ class RobotLoopsSubscription:
             followed = follower.follow(stamp_ns, names, positions, velocities)
         except LoopError as error:
             self._outputs.record_input(data, stamp_ns)
-            self._loops_health.drop(LoopDrop(LoopRejection.NOT_PLANNED, (), str(error)))
+            self._loops_health.drop(LoopDrop(DropReason.NOT_PLANNED, (), str(error)))
             self._report('the measured joints cannot close the loops: '
                          + str(error).replace('\n', '; '))
             return

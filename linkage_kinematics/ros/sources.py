@@ -19,13 +19,14 @@ from typing import Any, Protocol
 
 from linkage_kinematics.bag.cdr import JointStateDecoder
 from linkage_kinematics.kinematics.solver import LinkageState
+from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.model.joints import Link, TreeValues
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.outputs import MEASURED_QOS, MEASURED_TOPIC
 from linkage_kinematics.run.configuration import EndBehavior, RunConfiguration
 from linkage_kinematics.run.control import RunControl, ServiceAnswer
 from linkage_kinematics.run.diagnostics import MeasuredHealth, Status, StatusInputs
-from linkage_kinematics.run.measured import MeasuredFollower, Rejection
+from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.motion import (
     dead_point_problem,
     DriveLawRun,
@@ -437,12 +438,12 @@ class MeasuredSubscription:
         try:
             fields = self._decoder.decode(data)
         except ValueError:
-            self.health.drop(Rejection.MALFORMED)
+            self.health.drop(DropReason.MALFORMED)
             return
         followed = self._follower.follow(*fields)
         if followed is None:
             return  # this node's own joint states, heard back
-        if isinstance(followed, Rejection):
+        if isinstance(followed, DropReason):
             self.health.drop(followed)
             return
         self.health.accept(self._host.now_ns(), followed.velocity)

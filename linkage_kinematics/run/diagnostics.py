@@ -20,15 +20,14 @@ from __future__ import annotations
 
 import collections
 from dataclasses import dataclass
-from enum import Enum, IntEnum
+from enum import IntEnum
 import math
 
 from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
-from linkage_kinematics.loops.intake import Estimate
+from linkage_kinematics.loops.intake import DropReason, Estimate, FOUR_BAR_DROPS
 from linkage_kinematics.model.joints import Driver, Link
 from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, SourceKind
 from linkage_kinematics.run.control import RunState
-from linkage_kinematics.run.measured import Rejection
 from linkage_kinematics.run.motion import blocked_note
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
@@ -264,10 +263,11 @@ class Freshness:
     No valid sample for ``measured.timeout`` (node clock) makes the source's status ERROR, as
     diagnostic_updater's frequency status says ERROR when no event came in its window. Both
     measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``),
-    each with ``totals``, its dropped samples by reason (a member of ``reasons``).
+    each with ``totals``, its dropped samples by reason (one of its mode's ``reasons``, in the
+    order its key values list them).
     """
 
-    def __init__(self, start_ns: int, reasons: type[Enum]) -> None:
+    def __init__(self, start_ns: int, reasons: tuple[DropReason, ...]) -> None:
         self.accepted = 0
         self.last_valid_ns: int | None = None
         self.totals = dict.fromkeys(reasons, 0)
@@ -314,11 +314,11 @@ class MeasuredHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns, Rejection)
-        self._window = dict.fromkeys(Rejection, 0)
+        super().__init__(start_ns, FOUR_BAR_DROPS)
+        self._window = dict.fromkeys(FOUR_BAR_DROPS, 0)
         self.velocity: Estimate | None = None
 
-    def drop(self, rejection: Rejection) -> None:
+    def drop(self, rejection: DropReason) -> None:
         self.totals[rejection] += 1
         self._window[rejection] += 1
 
@@ -336,7 +336,7 @@ class MeasuredHealth(Freshness):
             f'dropped {count} sample{"s" if count > 1 else ""} {rejection.value}'
             for rejection, count in self._window.items() if count
         )
-        self._window = dict.fromkeys(Rejection, 0)
+        self._window = dict.fromkeys(FOUR_BAR_DROPS, 0)
         return warnings
 
     def values(self, now_ns: int, config: RunConfiguration) -> dict[str, str]:

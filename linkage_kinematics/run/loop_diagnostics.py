@@ -21,10 +21,9 @@ from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.loops.follower import (
     dead_point_distances,
     LoopDrop,
-    LoopRejection,
     LoopSample,
 )
-from linkage_kinematics.loops.intake import Estimate
+from linkage_kinematics.loops.intake import DropReason, Estimate, LOOPS_DROPS
 from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
 from linkage_kinematics.run.diagnostics import (
     Freshness,
@@ -38,11 +37,11 @@ from linkage_kinematics.run.diagnostics import (
 NODE_TASK = 'robot loops'
 
 
-def _counts() -> dict[LoopRejection, int]:
-    return dict.fromkeys(LoopRejection, 0)
+def _counts() -> dict[DropReason, int]:
+    return dict.fromkeys(LOOPS_DROPS, 0)
 
 
-def _dropped(count: int, reason: LoopRejection) -> str:
+def _dropped(count: int, reason: DropReason) -> str:
     return f'dropped {count} message{"s" if count > 1 else ""} {reason.value}'
 
 
@@ -55,10 +54,10 @@ class LoopsHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns, LoopRejection)
+        super().__init__(start_ns, LOOPS_DROPS)
         self._window = _counts()
-        self.per_loop: dict[str, dict[LoopRejection, int]] = {}
-        self._loop_window: dict[str, dict[LoopRejection, int]] = {}
+        self.per_loop: dict[str, dict[DropReason, int]] = {}
+        self._loop_window: dict[str, dict[DropReason, int]] = {}
         self.last: LoopSample | None = None
 
     def drop(self, drop: LoopDrop) -> None:
@@ -144,7 +143,7 @@ def _loop_status(inputs: StatusInputs, view: LoopsView, planned: PlannedLoop,
     counts = health.per_loop.get(constraint, _counts())
     values['dropped samples'] = str(sum(counts.values()))
     values.update({f'dropped {reason.value}': str(count) for reason, count in counts.items()
-                   if reason is not LoopRejection.NO_DESCRIPTION})
+                   if reason is not DropReason.NO_DESCRIPTION})
     notes = list(warnings)
     if (distance is not None and known.kind is JointKind.REVOLUTE
             and distance < inputs.config.dead_point_warning):
