@@ -26,6 +26,7 @@ from linkage_kinematics.run.configuration import build_configuration, Configurat
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
+from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import loop_reference
 from loop_robots import ROBOTS
@@ -123,6 +124,17 @@ def test_measured_joints_come_from_the_first_message_and_own_output_is_ignored()
                                    [0.0] * 4, [])
     with pytest.raises(LoopError, match="measured joint 'nothing' is not a joint"):
         follower(KNEE, ('nothing',))
+
+
+def test_a_joint_named_twice_counts_at_its_first_place_in_both_modes() -> None:
+    """As robot_state_publisher reads a joint state: its map keeps a name's first position."""
+    twice, once = follower(KNEE, ('knee_front',)), follower(KNEE, ('knee_front',))
+    sample = twice.follow(1, ['knee_front', 'knee_front'], [0.1, 0.3], [0.5, 0.7])
+    assert sample == once.follow(1, ['knee_front'], [0.1], [0.5])
+    crank = build_configuration({**{spec.name: spec.default for spec in parameter_specs('paper')},
+                                 'source': 'measured', 'log.enabled': False})
+    followed = MeasuredFollower(crank).follow(1, ['crank_joint', 'crank_joint'], [0.1, 0.3], [])
+    assert followed.joints == MeasuredFollower(crank).follow(1, ['crank_joint'], [0.1], []).joints
 
 
 def test_descriptions_that_cannot_be_closed_are_refused_in_one_line() -> None:
