@@ -200,7 +200,8 @@ def test_the_statuses_say_what_each_loop_does_and_what_was_dropped() -> None:
     excavator = follower(EXCAVATOR, tuple(CYLINDERS))
     health = LoopsHealth(0)
     health.accept(0, excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], [0.1, 0.2, 0.3]))
-    health.drop(excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []))
+    drop = excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], [])
+    health.drop(drop.reason, drop.constraints)
     node, *loops = statuses(health, excavator.plan)
     assert [status.task for status in loops] == [
         f'loop {planned.loop.constraint}' for planned in excavator.plan.loops]

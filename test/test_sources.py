@@ -18,13 +18,10 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import TreeValues
+from linkage_kinematics.ros.drive_law_source import DriveLawTimer
 from linkage_kinematics.ros.exit_codes import ExitCode
-from linkage_kinematics.ros.sources import (
-    DriveLawTimer,
-    MeasuredSubscription,
-    RunStatus,
-    SourceHost,
-)
+from linkage_kinematics.ros.measured_source import MeasuredSubscription
+from linkage_kinematics.ros.source import RunStatus, SourceHost
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
 from linkage_kinematics.run.control import RunControl
 from linkage_kinematics.run.motion import dead_point_problem

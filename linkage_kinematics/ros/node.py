@@ -8,10 +8,11 @@ Publishes the linkage's exact state as the drive law turns the crank, or as a me
 moves it.
 
 A thin shell that wires pure modules to ROS: ``run.configuration`` validates the parameter
-values into a frozen RunConfiguration; one of the two sources of ``ros.sources`` gives the
-states, over ``motion.DriveLawRun`` (the drive law on the node's timer) or
-``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states`` message), with
-this node as its ``SourceHost``; ``run.diagnostics`` says what ``/diagnostics`` reports;
+values into a frozen RunConfiguration; one source gives the states, with this node as its
+``source.SourceHost``: ``drive_law_source`` over ``motion.DriveLawRun`` (the drive law on the
+node's timer), ``measured_source`` over ``measured.MeasuredFollower`` (the driver joint of each
+``measured_joint_states`` message) or ``loop_source`` over ``loops.follower`` (every loop of a
+lab's URDF); ``run.diagnostics`` says what ``/diagnostics`` reports;
 ``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
 documented in README.md.
 """
@@ -26,8 +27,10 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import TreeValues
+from linkage_kinematics.ros.drive_law_source import DriveLawTimer
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.loop_source import robot_from_parameter, RobotLoopsSubscription
+from linkage_kinematics.ros.measured_source import MeasuredSubscription
 from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
 from linkage_kinematics.ros.parameters import (
     add_ranges,
@@ -35,12 +38,7 @@ from linkage_kinematics.ros.parameters import (
     keep_declared_types,
     parameter_values,
 )
-from linkage_kinematics.ros.sources import (
-    DriveLawTimer,
-    MeasuredSubscription,
-    RunStatus,
-    Source,
-)
+from linkage_kinematics.ros.source import RunStatus, Source
 from linkage_kinematics.run.configuration import (
     build_configuration,
     ConfigurationError,

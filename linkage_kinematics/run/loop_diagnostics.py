@@ -18,11 +18,7 @@ from dataclasses import dataclass
 import math
 
 from linkage_kinematics.kinematics.planar_loop import JointKind
-from linkage_kinematics.loops.follower import (
-    dead_point_distances,
-    LoopDrop,
-    LoopSample,
-)
+from linkage_kinematics.loops.follower import dead_point_distances, LoopSample
 from linkage_kinematics.loops.intake import DropReason, Estimate, LOOPS_DROPS
 from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
 from linkage_kinematics.run.diagnostics import (
@@ -60,13 +56,13 @@ class LoopsHealth(Freshness):
         self._loop_window: dict[str, dict[DropReason, int]] = {}
         self.last: LoopSample | None = None
 
-    def drop(self, drop: LoopDrop) -> None:
+    def drop(self, reason: DropReason, constraints: tuple[str, ...] = ()) -> None:
         """Count a dropped message, for the node and for each loop it concerned."""
-        self.totals[drop.reason] += 1
-        self._window[drop.reason] += 1
-        for constraint in drop.constraints:
+        self.totals[reason] += 1
+        self._window[reason] += 1
+        for constraint in constraints:
             for counts in (self.per_loop, self._loop_window):
-                counts.setdefault(constraint, _counts())[drop.reason] += 1
+                counts.setdefault(constraint, _counts())[reason] += 1
 
     def accept(self, now_ns: int, sample: LoopSample) -> None:
         """Note a message followed at node-clock time ``now_ns``."""
