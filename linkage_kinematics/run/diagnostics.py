@@ -258,20 +258,31 @@ def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
 
 class Freshness:
     """
-    How fresh a measured source's data is: its valid samples, and when the last one came.
+    A measured source's samples: the valid ones, when the last came, and those dropped, by reason.
 
     No valid sample for ``measured.timeout`` (node clock) makes the source's status ERROR, as
     diagnostic_updater's frequency status says ERROR when no event came in its window. Both
     measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``),
     each with ``totals``, its dropped samples by reason (one of its mode's ``reasons``, in the
-    order its key values list them).
+    order its key values list them), and those since its last status (``_take_window``).
     """
 
     def __init__(self, start_ns: int, reasons: tuple[DropReason, ...]) -> None:
         self.accepted = 0
         self.last_valid_ns: int | None = None
         self.totals = dict.fromkeys(reasons, 0)
+        self._window = dict.fromkeys(reasons, 0)
         self._start_ns = start_ns
+
+    def drop(self, reason: DropReason) -> None:
+        """Count a dropped sample."""
+        self.totals[reason] += 1
+        self._window[reason] += 1
+
+    def _take_window(self) -> dict[DropReason, int]:
+        """Return the drops since the last call, by reason, and start a new window."""
+        window, self._window = self._window, dict.fromkeys(self.totals, 0)
+        return window
 
     def _accepted_at(self, now_ns: int) -> None:
         self.accepted += 1
@@ -315,12 +326,7 @@ class MeasuredHealth(Freshness):
 
     def __init__(self, start_ns: int) -> None:
         super().__init__(start_ns, FOUR_BAR_DROPS)
-        self._window = dict.fromkeys(FOUR_BAR_DROPS, 0)
         self.velocity: Estimate | None = None
-
-    def drop(self, rejection: DropReason) -> None:
-        self.totals[rejection] += 1
-        self._window[rejection] += 1
 
     def accept(self, now_ns: int, velocity: Estimate) -> None:
         self._accepted_at(now_ns)
@@ -332,12 +338,10 @@ class MeasuredHealth(Freshness):
 
     def take_warnings(self) -> tuple[str, ...]:
         """Return the drops since the last call, one text per reason, and start a new window."""
-        warnings = tuple(
-            f'dropped {count} sample{"s" if count > 1 else ""} {rejection.value}'
-            for rejection, count in self._window.items() if count
+        return tuple(
+            f'dropped {count} sample{"s" if count > 1 else ""} {reason.value}'
+            for reason, count in self._take_window().items() if count
         )
-        self._window = dict.fromkeys(FOUR_BAR_DROPS, 0)
-        return warnings
 
     def values(self, now_ns: int, config: RunConfiguration) -> dict[str, str]:
         """Return the key values: counts, freshness, and which quantities are estimates."""

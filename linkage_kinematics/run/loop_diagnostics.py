@@ -51,15 +51,13 @@ class LoopsHealth(Freshness):
 
     def __init__(self, start_ns: int) -> None:
         super().__init__(start_ns, LOOPS_DROPS)
-        self._window = _counts()
         self.per_loop: dict[str, dict[DropReason, int]] = {}
         self._loop_window: dict[str, dict[DropReason, int]] = {}
         self.last: LoopSample | None = None
 
     def drop(self, reason: DropReason, constraints: tuple[str, ...] = ()) -> None:
         """Count a dropped message, for the node and for each loop it concerned."""
-        self.totals[reason] += 1
-        self._window[reason] += 1
+        super().drop(reason)
         for constraint in constraints:
             for counts in (self.per_loop, self._loop_window):
                 counts.setdefault(constraint, _counts())[reason] += 1
@@ -75,11 +73,12 @@ class LoopsHealth(Freshness):
 
     def take_warnings(self) -> tuple[tuple[str, ...], dict[str, tuple[str, ...]]]:
         """Return the drops since the last call (the node's, each loop's) and start anew."""
-        node = tuple(_dropped(count, reason) for reason, count in self._window.items() if count)
+        node = tuple(_dropped(count, reason)
+                     for reason, count in self._take_window().items() if count)
         loops = {constraint: tuple(_dropped(count, reason)
                                    for reason, count in counts.items() if count)
                  for constraint, counts in self._loop_window.items()}
-        self._window, self._loop_window = _counts(), {}
+        self._loop_window = {}
         return node, loops
 
 
