@@ -101,7 +101,7 @@ def test_rate_is_measured_over_the_last_window() -> None:
 
 def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
     config = configuration(mode='fixed_step', alpha_step=math.radians(0.25))
-    state = solve(config.linkage, 0.3, DriveLaw(2.0))
+    state = solve(config.geometry.linkage, 0.3, DriveLaw(2.0))
     values = drive_law_values(config=config, run_state=RunState.RUNNING, state=state,
                               achieved_rate=231.26, missed_deadlines=3, log_file='bags/run',
                               log_size=101_588)
@@ -122,6 +122,7 @@ def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
 def test_residual_reads_in_scientific_notation() -> None:
     config = configuration()
     values = drive_law_values(config=config, run_state=RunState.RUNNING,
-                              state=solve(config.linkage, 0.7, DriveLaw(2.0)), achieved_rate=0.0)
+                              state=solve(config.geometry.linkage, 0.7, DriveLaw(2.0)),
+                              achieved_rate=0.0)
     residual = values['loop closure residual']
     assert re.fullmatch(r'\d\.\d\de[+-]\d\d', residual) and float(residual) < 1e-12

@@ -118,7 +118,7 @@ def test_reset_starts_afresh_and_stale_data_is_an_error() -> None:
     send(host, START_NS + 2 * PERIOD_NS, 0.25)
     assert 'first sample' in node_status(host, source).values['estimated']
     assert source.stale is False
-    host.clock_ns += round(2e9 * host.config.measured_timeout)
+    host.clock_ns += round(2e9 * host.config.measured.timeout)
     (freshness,) = host.timers
     freshness.callback()
     assert source.stale

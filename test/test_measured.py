@@ -462,7 +462,8 @@ def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configur
     assert {name: values[name] for name in LAB_JOINTS} == LAB_JOINTS
     defaults = {spec.name: spec.default for spec in parameter_specs(values['preset'])}
     config = build_configuration({**defaults, **values})
-    assert (config.source, config.driver, config.publish_robot_description) == (
+    joints = config.joints
+    assert (joints.source, joints.driver, joints.publish_robot_description) == (
         SourceKind.MEASURED, Driver.CRANK, False)
     # The README's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
     state = MeasuredFollower(config).follow(1, ['knee_motor'], [-0.1], [1.0]).state
@@ -486,17 +487,17 @@ def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(
     defaults = {spec.name: spec.default for spec in parameter_specs('grashof_crank_rocker')}
     config = build_configuration({**defaults, **mapping, 'source': 'measured',
                                   'driver': driver.value})
-    linkage = config.linkage
-    urdf = urdf_text(linkage, config.frame_id, config.joints, driver)
+    linkage = config.geometry.linkage
+    urdf = urdf_text(linkage, config.outputs.frame_id, config.joints.lab, driver)
     order = TREE_ORDER[driver]
-    names = config.joints.names(order)
+    names = config.joints.lab.names(order)
     assert {joint.get('name') for joint in ElementTree.fromstring(urdf).iter('joint')} == set(
         names)
-    stream = JointStream(config.joints, driver, include_driver=False)
+    stream = JointStream(config.joints.lab, driver, include_driver=False)
     assert stream.names == names[1:]
-    driver_mapping = config.joints[Link(driver.value)]
+    driver_mapping = config.joints.lab[Link(driver.value)]
     follower = MeasuredFollower(config)
-    interval = config.driven_linkage.reachability.intervals[0]
+    interval = config.geometry.driven_linkage.reachability.intervals[0]
     low, high = interval
     span = high - low if high - low < TWO_PI else TWO_PI
     end = (linkage.rocker_length, (linkage.ground_x, linkage.ground_y)) if (

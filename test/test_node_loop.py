@@ -161,7 +161,7 @@ def _config(geometry: str, driver: Driver, mapping: str, branch: int) -> RunConf
 
 def _sweep(config: RunConfiguration) -> list[float]:
     """Return driver angles (node convention) to and fro over its range, two turns if it turns."""
-    low, high = config.driven_linkage.reachability.intervals[0]
+    low, high = config.geometry.driven_linkage.reachability.intervals[0]
     if high - low >= TWO_PI:  # a full turn: two turns forwards, through any change points
         return [low + 2.0 * TWO_PI * index / 720 for index in range(721)]
     # close to both dead points (where the closed forms' own error grows as 1/√distance)
@@ -185,9 +185,9 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
     (they grow without bound at the dead points).
     """
     config = _config(geometry, driver, mapping, branch)
-    driver_mapping = config.joints[Link(driver.value)]
+    driver_mapping = config.joints.lab[Link(driver.value)]
     follower = MeasuredFollower(config)
-    stream = JointStream(config.joints, driver, include_driver=True)
+    stream = JointStream(config.joints.lab, driver, include_driver=True)
     angles = _sweep(config)
     for index, angle in enumerate(angles):
         omega = 0.7 + 0.3 * math.cos(index)
@@ -197,7 +197,7 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
         if followed is DropReason.DRIVER_UNREACHABLE:
             # the kite's pin A on C: the closed form refuses it too (the motion is undetermined)
             with pytest.raises(DeadPointError, match='undetermined'):
-                solve(config.driven_linkage, angle, CrankRates(omega, 0.0), branch)
+                solve(config.geometry.driven_linkage, angle, CrankRates(omega, 0.0), branch)
             continue
         assert isinstance(followed, FollowedSample), (angle, followed)
         positions, velocities = stream.values(followed.state)
@@ -228,8 +228,8 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     """
     config = _config('grashof_crank_rocker', Driver.CRANK, 'lab', 1)
     follower = MeasuredFollower(config)
-    stream = JointStream(config.joints, Driver.CRANK, include_driver=True)
-    name = config.joints.crank.name
+    stream = JointStream(config.joints.lab, Driver.CRANK, include_driver=True)
+    name = config.joints.lab.crank.name
 
     def check(stamp: int, lab_angle: float) -> None:
         followed = follower.follow(stamp, [name], [lab_angle], [-1.0])
@@ -239,7 +239,7 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     for index in range(1, 80):  # a turn and a half of the crank, unwrapped by the stream
         check(index, math.remainder(0.4 - 0.12 * index, TWO_PI))
     smaller = build_configuration({**{spec.name: spec.default for spec in parameter_specs(
-        'grashof_crank_rocker')}, **{f'joints.{link}.{key}': getattr(config.joints[link], key)
+        'grashof_crank_rocker')}, **{f'joints.{link}.{key}': getattr(config.joints.lab[link], key)
                                      for link in TREE_ORDER[Driver.CRANK]
                                      for key in ('name', 'direction', 'offset')},
         'source': 'measured', 'crank_length': 0.25})
@@ -267,10 +267,11 @@ def test_the_nodes_description_is_parsed_once_for_its_loop_and_its_tf(
     config = _config('grashof_crank_rocker', Driver.CRANK, 'lab', 1)
     follower = MeasuredFollower(config)
     MeasuredFollower(config)
-    follower.reconfigure(replace(config, max_jump=0.5))
-    description = node_description(config.linkage, config.frame_id, config.joints, config.driver)
-    assert description.text == urdf_text(config.linkage, config.frame_id, config.joints,
-                                         config.driver)
+    follower.reconfigure(replace(config, measured=replace(config.measured, max_jump=0.5)))
+    parts = (config.geometry.linkage, config.outputs.frame_id, config.joints.lab,
+             config.joints.driver)
+    description = node_description(*parts)
+    assert description.text == urdf_text(*parts)
     assert description.tree.joints.keys() == {'knee_motor', 'knee_link', 'knee_output'}
     assert len(parses) == 1
     MeasuredFollower(_config('kite', Driver.CRANK, 'lab', 1))

@@ -169,8 +169,8 @@ def configuration(**overrides: Any) -> Any:
 def test_the_loop_parameters_are_validated_naming_them() -> None:
     config = configuration(**{'loops.branches': ['knee_rear_pin=-1', 'b=+1'],
                               'loops.measured_joints': ['knee_front']})
-    assert config.loop_branches == (('knee_rear_pin', -1), ('b', 1))
-    assert config.loop_measured_joints == ('knee_front',)
+    assert config.loops.branches == (('knee_rear_pin', -1), ('b', 1))
+    assert config.loops.measured_joints == ('knee_front',)
     for name, value, message in (
             ('loops.branches', ['pin=2'], "entry 'pin=2' is not CONSTRAINT=1 or CONSTRAINT=-1"),
             ('loops.branches', ['a=1', 'a=-1'], 'gives a constraint more than one branch'),

@@ -110,7 +110,7 @@ class DriveLawTimer:
         A paused one stays paused there, and its state at alpha_start is published once, as a
         simulator's reset shows the initial pose, so that subscribers stop showing the held one.
         """
-        answer = self._host.control.reset(self._host.config.alpha_start)
+        answer = self._host.control.reset(self._host.config.motion.alpha_start)
         self._back_to_start()
         self._reset_pose_due = self._host.control.paused
         self._timer.reset()
@@ -129,7 +129,7 @@ class DriveLawTimer:
                 # Waiting at alpha_start (autostart false, or reset while paused): its scene,
                 # and after a reset its state too.
                 config = host.config
-                at_start = solve_sample(config, MotionSample(config.alpha_start))
+                at_start = solve_sample(config, MotionSample(config.motion.alpha_start))
                 host.set_activity(host.control.activity(None))
                 if reset_pose_due:
                     host.publish_state(at_start, now_ns, 0.0)
@@ -144,7 +144,7 @@ class DriveLawTimer:
             if due.met_dead_point:
                 host.publish_diagnostics(dead_point_problem(host.config), due.at_ns)
             if due.state is None:
-                if host.config.end_behavior is EndBehavior.STOP:
+                if host.config.motion.end_behavior is EndBehavior.STOP:
                     self._cannot_go_on(due.refusal)
                     return
                 continue  # loop and bounce turn round at the dead point, which has no state
@@ -152,8 +152,8 @@ class DriveLawTimer:
                 host.set_activity('moving')
             host.publish_state(due.state, due.at_ns, due.sample.motion_time)
             if due.sample.final:
-                host.finish(
-                    f'reached alpha_end = {math.degrees(host.config.alpha_end):.6f}°; stopped')
+                alpha_end = host.config.motion.alpha_end
+                host.finish(f'reached alpha_end = {math.degrees(alpha_end):.6f}°; stopped')
                 return
         if blocked:
             self._cannot_go_on(None)
@@ -163,5 +163,5 @@ class DriveLawTimer:
 
     def _cannot_go_on(self, detail: str | None) -> None:
         config = self._host.config
-        self._host.fail(dead_point_problem(config) if config.blocked_at is not None
+        self._host.fail(dead_point_problem(config) if config.motion.blocked_at is not None
                         else f'the crank cannot go on: {detail}')

@@ -56,9 +56,9 @@ class ClosedRobot:
         """Read ``urdf``; LoopError or UrdfError, one line naming the problem, if it cannot."""
         tree = read_urdf(urdf)  # once, for the loops and for robot_state_publisher's TF
         self.urdf = urdf
-        self.follower = RobotLoopsFollower(read_loops(tree), config.loop_measured_joints,
-                                           dict(config.loop_branches), config.max_jump)
-        self.transforms = RobotStateTransforms(tree, config.frame_prefix)
+        self.follower = RobotLoopsFollower(read_loops(tree), config.loops.measured_joints,
+                                           dict(config.loops.branches), config.measured.max_jump)
+        self.transforms = RobotStateTransforms(tree, config.outputs.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
 
@@ -119,10 +119,10 @@ def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
 
     Raises StartupError, one line naming the problem, for a description that cannot be closed.
     """
-    if not config.robot_description:
+    if not config.loops.robot_description:
         return None
     try:
-        return ClosedRobot(config.robot_description, config)
+        return ClosedRobot(config.loops.robot_description, config)
     except (LoopError, UrdfError) as error:
         raise StartupError('cannot close the loops of parameter robot_description: '
                            + str(error).replace('\n', '; ')) from None
@@ -237,7 +237,7 @@ class RobotLoopsSubscription(MeasuredInput):
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: the thresholds (timeout, jump)."""
         if self._robot is not None:
-            self._robot.follower.max_jump = new.max_jump
+            self._robot.follower.max_jump = new.measured.max_jump
         self._retime(new)
 
     def restart(self) -> None:

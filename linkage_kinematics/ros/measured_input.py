@@ -44,7 +44,7 @@ class MeasuredInput(ABC):
         self._decoder = JointStateDecoder()
         host.create_subscription(JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS,
                                  raw=True)
-        self._timeout = host.config.measured_timeout
+        self._timeout = host.config.measured.timeout
         self._freshness_timer = host.create_timer(0.25 * self._timeout, self._check_freshness)
 
     @abstractmethod
@@ -61,8 +61,8 @@ class MeasuredInput(ABC):
 
     def _retime(self, new: RunConfiguration) -> None:
         """Check freshness four times per ``measured.timeout`` of ``new``, if it changed."""
-        if new.measured_timeout != self._timeout:
-            self._timeout = new.measured_timeout
+        if new.measured.timeout != self._timeout:
+            self._timeout = new.measured.timeout
             self._host.destroy_timer(self._freshness_timer)
             self._freshness_timer = self._host.create_timer(0.25 * self._timeout,
                                                             self._check_freshness)
@@ -100,7 +100,7 @@ class MeasuredInput(ABC):
     def _check_freshness(self) -> None:
         """Report at once when the measured data goes stale."""
         host = self._host
-        if not self.stale and self._health.is_stale(host.now_ns(), host.config.measured_timeout):
+        if not self.stale and self._health.is_stale(host.now_ns(), host.config.measured.timeout):
             self.stale = True
             self._forget_motion()  # a long gap: the next valid sample starts afresh
             host.publish_diagnostics()

@@ -27,7 +27,7 @@ class MeasuredSubscription(MeasuredInput):
         config = host.config
         self._follower = MeasuredFollower(config)
         self.health = MeasuredHealth(host.now_ns())
-        self._driver_name = config.joints[Link(config.driver.value)].name
+        self._driver_name = config.joints.lab[Link(config.joints.driver.value)].name
         super().__init__(host, self.health)
         self._show_activity()
 
@@ -51,10 +51,10 @@ class MeasuredSubscription(MeasuredInput):
 
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: thresholds, and the lab's names and mapping."""
-        if new.joints != self._follower.config.joints:
+        if new.joints.lab != self._follower.config.joints.lab:
             # The lab's names and mapping: the driver is read anew under them.
             self._follower = MeasuredFollower(new)
-            self._driver_name = new.joints[Link(new.driver.value)].name
+            self._driver_name = new.joints.lab[Link(new.joints.driver.value)].name
         else:
             self._follower.reconfigure(new)
         self._retime(new)

@@ -99,15 +99,15 @@ class LinkageNode(RunStatus, Node):
         self._rate_meter = RateMeter()
         self._status_schedule = StatusSchedule()
         self._placement = CpuPlacement()
-        self._place(config.cpu_affinity)
-        loops = config.loops is LoopsSource.ROBOT_DESCRIPTION
+        self._place(config.logging.cpu_affinity)
+        loops = config.loops.source is LoopsSource.ROBOT_DESCRIPTION
         # A description given as a parameter is read before anything is published or written.
         robot = robot_from_parameter(config) if loops else None
         self.outputs = NodeOutputs(self, config, self.parameter_values(),
                                    self._placement.bag_writer_cpus)
         if self.outputs.recorder is not None:
             self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
-        self._marker_timer = self.create_timer(1.0 / config.display_rate_hz,
+        self._marker_timer = self.create_timer(1.0 / config.outputs.display_rate_hz,
                                                self.publish_markers)
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         self.add_pre_set_parameters_callback(keep_declared_types)
@@ -116,7 +116,7 @@ class LinkageNode(RunStatus, Node):
         self._source: Source
         if loops:
             self._source = RobotLoopsSubscription(self, self.outputs, robot)
-        elif config.source is SourceKind.MEASURED:
+        elif config.joints.source is SourceKind.MEASURED:
             self._source = MeasuredSubscription(self)
         else:
             self._source = DriveLawTimer(self)
@@ -137,7 +137,7 @@ class LinkageNode(RunStatus, Node):
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
             config = build_configuration({**current, **updates})
-            self._placement.check(config.cpu_affinity)
+            self._placement.check(config.logging.cpu_affinity)
         except ConfigurationError as error:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
@@ -161,16 +161,16 @@ class LinkageNode(RunStatus, Node):
         )
         if blocked_note(new) is not None:
             self.get_logger().warning(blocked_note(new))
-        if new.display_rate_hz != old.display_rate_hz:
+        if new.outputs.display_rate_hz != old.outputs.display_rate_hz:
             self.destroy_timer(self._marker_timer)
-            self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
+            self._marker_timer = self.create_timer(1.0 / new.outputs.display_rate_hz,
                                                    self.publish_markers)
-        if new.cpu_affinity != old.cpu_affinity:
-            self._place(new.cpu_affinity)
+        if new.logging.cpu_affinity != old.logging.cpu_affinity:
+            self._place(new.logging.cpu_affinity)
             if self.outputs.recorder is not None:
                 self.outputs.recorder.run_writer_on(
                     self._placement.bag_writer_cpus or self._placement.available)
-        if new.joints != old.joints:
+        if new.joints.lab != old.joints.lab:
             self.publish_description()  # the lab's names, axes and offsets
         if restarts:
             self.forget_state()

@@ -141,7 +141,7 @@ def _loop_status(inputs: StatusInputs, view: LoopsView, planned: PlannedLoop,
                    if reason is not DropReason.NO_DESCRIPTION})
     notes = list(warnings)
     if (distance is not None and known.kind is JointKind.REVOLUTE
-            and distance < inputs.config.dead_point_warning):
+            and distance < inputs.config.outputs.dead_point_warning):
         notes.append(f'{known.name} is {math.degrees(distance):.3f}° from a dead point')
     if notes:
         level, message = Level.WARN, '; '.join(notes)
@@ -192,7 +192,7 @@ def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
     """
     health = view.health
     node_warnings, loop_warnings = health.take_warnings()
-    stale = health.problem(inputs.now_ns, inputs.config.measured_timeout)
+    stale = health.problem(inputs.now_ns, inputs.config.measured.timeout)
     if stale is not None and inputs.activity.startswith('waiting'):
         stale = f'{stale}; {inputs.activity}'  # say what the node still waits for
     problem = inputs.problem or stale

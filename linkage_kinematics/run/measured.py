@@ -100,14 +100,16 @@ class MeasuredFollower:
     """Follows the measured driver joint; one per run, ``restart`` forgets the motion."""
 
     def __init__(self, config: RunConfiguration) -> None:
+        joints = config.joints
         self.config = config
-        self._mapping = config.joints[Link(config.driver.value)]
+        self._mapping = joints.lab[Link(joints.driver.value)]
         # Messages that hold only the joints this node publishes are its own output coming
         # back (it may listen on the topic it publishes to): ignored, not counted.
-        self._passive = tuple(config.joints[link] for link in TREE_ORDER[config.driver][1:])
+        self._passive = tuple(joints.lab[link] for link in TREE_ORDER[joints.driver][1:])
         self._intake = Intake(
-            (self._mapping.name,), (self._mapping.name,), config.max_jump, DropReason.NO_DRIVER,
-            own_output=(mapping.name for mapping in self._passive), mappings=(self._mapping,))
+            (self._mapping.name,), (self._mapping.name,), config.measured.max_jump,
+            DropReason.NO_DRIVER, own_output=(mapping.name for mapping in self._passive),
+            mappings=(self._mapping,))
         self._loops = _node_loops(config)
         # The passive joints published last (lab values), kept across restarts so that they
         # stay continuous; at first the node's zero, as every joint stream starts.
@@ -128,9 +130,9 @@ class MeasuredFollower:
         New thresholds (timeout, jump, filter) go on following the same motion; a new geometry
         (a new loop) comes with a restart of the motion.
         """
-        if config.linkage != self.config.linkage:
+        if config.geometry.linkage != self.config.geometry.linkage:
             self._loops = _node_loops(config)
-        self._intake.max_jump = config.max_jump
+        self._intake.max_jump = config.measured.max_jump
         self.config = config
 
     def follow(
@@ -203,7 +205,8 @@ class MeasuredFollower:
         """
         config = self.config
         nearby = encoder_angle + _CHANGE_POINT_CLEARANCE
-        branch = continued_branch(config.driven_linkage, encoder_angle, config.branch, nearby)
+        branch = continued_branch(config.geometry.driven_linkage, encoder_angle,
+                                  config.motion.branch, nearby)
         (loop,) = self._loops.loops
         known = loop.joint(self._mapping.name)
         branch = continued_branch_of(loop.planar, known.index,
@@ -217,7 +220,7 @@ class MeasuredFollower:
             return 0.0
         interval = (stamp_ns - last.stamp_ns) * 1e-9
         raw = (omega - last.omega) / interval
-        time_constant = self.config.acceleration_time_constant
+        time_constant = self.config.measured.acceleration_time_constant
         keep = math.exp(-interval / time_constant) if time_constant > 0.0 else 0.0
         return keep * last.omega_dot + (1.0 - keep) * raw
 
@@ -230,18 +233,18 @@ class MeasuredFollower:
         reached from its first sample through any change points, with α unwrapped.
         """
         config = self.config
-        driven = config.driven_linkage
+        driven = config.geometry.driven_linkage
         first = self._first
         if first is None:
-            branch = config.branch
+            branch = config.motion.branch
         else:
-            branch = continued_branch(driven, first.encoder_angle, config.branch,
+            branch = continued_branch(driven, first.encoder_angle, config.motion.branch,
                                       encoder_angle, turns=turns)
         rates = CrankRates(omega, omega_dot)
-        if config.driver is Driver.CRANK:
+        if config.joints.driver is Driver.CRANK:
             state = solve(driven, encoder_angle, rates, branch)
             return replace(state, alpha=state.alpha + turns * TWO_PI) if turns else state
-        state = solve_from_rocker(config.linkage, driven, encoder_angle, rates, branch)
+        state = solve_from_rocker(config.geometry.linkage, driven, encoder_angle, rates, branch)
         if self._last is None:
             return state
         # The crank driven by the rocker may turn fully (a double crank): α stays continuous.
@@ -250,5 +253,5 @@ class MeasuredFollower:
 
 def _node_loops(config: RunConfiguration) -> RobotLoops:
     """Return the loop of the node's own URDF for ``config`` (one four-bar, ``model.urdf``)."""
-    return find_loops(node_description(config.linkage, config.frame_id, config.joints,
-                                       config.driver).tree)
+    return find_loops(node_description(config.geometry.linkage, config.outputs.frame_id,
+                                       config.joints.lab, config.joints.driver).tree)
