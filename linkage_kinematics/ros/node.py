@@ -197,7 +197,7 @@ class LinkageNode(RunStatus, Node):
         if change is not None:
             self.get_logger().info(change)
 
-    # the source's host (sources.SourceHost): publishing, and the status it changes
+    # the source's host (source.SourceHost): publishing, and the status it changes
 
     def now_ns(self) -> int:
         """Return the node clock's time (ns)."""

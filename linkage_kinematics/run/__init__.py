@@ -7,7 +7,8 @@ One run of the node, as pure Python (no rclpy): what the node decides, without R
 ``parameter_specs`` (each parameter's default, descriptor text and contract: kind, unit, range
 from ``limits``), ``configuration`` (values checked against it into a RunConfiguration), the
 four-bar's two sources ``motion`` (the drive law in time) and ``measured`` (a measured joint
-completed), ``control`` (~/pause, ~/resume, ~/reset), ``diagnostics`` (the statuses of the
-four-bar) and ``loop_diagnostics`` (those of ``loops:=robot_description``), and ``placement``
-(cpu_affinity). Imports only ``kinematics``, ``model`` and ``loops``.
+completed), ``control`` (~/pause, ~/resume, ~/reset), ``diagnostics`` (the four-bar's status,
+the ``Status`` every source reports in, and the measured samples' ``Freshness``) and
+``loop_diagnostics`` (the health and statuses of ``loops:=robot_description``), and
+``placement`` (cpu_affinity). Imports only ``kinematics``, ``model`` and ``loops``.
 """
