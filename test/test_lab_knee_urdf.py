@@ -20,7 +20,9 @@ import xml.etree.ElementTree as ElementTree
 from linkage_kinematics.cli import check_loops
 from linkage_kinematics.kinematics.geometry import preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
-from linkage_kinematics.model.loops import find_loops, LoopSolver
+from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.solver import LoopSolver
+from linkage_kinematics.model.urdf_reader import read_urdf
 import pytest
 from reference import reference_state
 
@@ -57,7 +59,7 @@ def foot_end(text: str, positions: dict[str, float]) -> tuple[float, float]:
 
 def test_the_loop_solver_completes_the_knee_as_the_reference_does() -> None:
     text = URDF.read_text(encoding='utf-8')
-    solver = LoopSolver(find_loops(text).plan(['knee_motor']))
+    solver = LoopSolver(find_loops(read_urdf(text)).plan(['knee_motor']))
     link_zero, output_zero = reference_passive(ALPHA_AT_ZERO)
     # a whole turn of the motor in small steps, as an encoder reports it (wrapped at ±π)
     for index in range(-180, 181):
@@ -75,7 +77,8 @@ def test_the_loop_solver_completes_the_knee_as_the_reference_does() -> None:
 
 def test_the_readme_sample_and_printout_are_what_the_package_gives() -> None:
     readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
-    solver = LoopSolver(find_loops(URDF.read_text(encoding='utf-8')).plan(['knee_motor']))
+    solver = LoopSolver(
+        find_loops(read_urdf(URDF.read_text(encoding='utf-8'))).plan(['knee_motor']))
     positions, _ = solver.solve({'knee_motor': -0.1}, {'knee_motor': 1.0})
     assert f"`knee_link` = {positions['knee_link']:.4f} rad".replace('-', '−') in readme
     assert f"{positions['knee_output']:.4f} rad".replace('-', '−') in readme

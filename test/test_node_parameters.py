@@ -203,28 +203,30 @@ def test_a_spec_without_what_its_kind_needs_is_refused():
 
 def test_defaults_are_the_seed_run_swinging_until_stopped():
     config = build_configuration(configuration_values())
-    assert config.linkage == PAPER
-    assert config.drive == DriveLaw(2.0, 0.0)
-    assert (config.alpha_start, config.alpha_end, config.end_behavior, config.mode) == (
+    assert config.geometry.linkage == PAPER
+    assert config.motion.drive == DriveLaw(2.0, 0.0)
+    motion = config.motion
+    assert (motion.alpha_start, motion.alpha_end, motion.end_behavior, motion.mode) == (
         0.0, math.pi / 2.0, 'bounce', 'real_time')
     assert config.autostart
-    assert config.blocked_at is None
-    assert config.segment_duration == math.pi / 4.0
+    assert config.motion.blocked_at is None
+    assert config.motion.segment_duration == math.pi / 4.0
     assert set(configuration_values()) == set(PARAMETER_NAMES)
 
 
 def test_explicit_geometry_overrides_the_preset_and_integers_are_accepted():
     config = build_configuration(configuration_values(crank_length=0.25, ground_x=1))
-    assert config.linkage == FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, 1.0, 0.0)
+    assert config.geometry.linkage == FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length,
+                                              1.0, 0.0)
     explicit = build_configuration(configuration_values(preset=''))
-    assert explicit.linkage == PAPER and explicit.preset == ''
+    assert explicit.geometry.linkage == PAPER and explicit.geometry.preset == ''
 
 
 def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
     config = build_configuration(configuration_values(omega0=-1.0, alpha_end=-1.0))
-    assert config.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
-    assert config.segment_end == config.blocked_at
-    assert config.segment_duration == DriveLaw(-1.0).time_to(0.0, config.blocked_at)
+    assert config.motion.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
+    assert config.motion.segment_end == config.motion.blocked_at
+    assert config.motion.segment_duration == DriveLaw(-1.0).time_to(0.0, config.motion.blocked_at)
 
 
 # A lab's linkage whose crank can reach neither 0 nor 90° (only about 135°–315°): the drive
@@ -242,8 +244,9 @@ BEYOND_DEFAULTS = {'preset': '', 'crank_length': 0.3, 'coupler_length': 1.0,
 def test_measured_mode_does_not_check_the_drive_law(overrides):
     values = configuration_values(source='measured', **overrides)
     config = build_configuration(values)
-    assert config.source == 'measured'
-    assert (config.blocked_at, config.segment_duration, config.step_count) == (None, 0.0, 1)
+    assert config.joints.source == 'measured'
+    motion = config.motion
+    assert (motion.blocked_at, motion.segment_duration, motion.step_count) == (None, 0.0, 1)
     # The same values with the drive law are refused: the guard decides, not the values.
     with pytest.raises(ConfigurationError):
         build_configuration({**values, 'source': 'drive_law'})

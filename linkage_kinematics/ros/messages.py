@@ -31,6 +31,7 @@ from linkage_kinematics.model.robot_transforms import (
     RobotTransforms,
     Transform,
 )
+from linkage_kinematics.model.urdf_reader import UrdfTree
 from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
@@ -289,15 +290,14 @@ class RobotStateTransforms:
     """
     The /tf_static and /tf messages robot_state_publisher publishes for one URDF, as bytes.
 
-    With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
-    urdf_reader.UrdfError for a URDF it cannot read. The /tf of a joint state is written
-    from the joints' prepared transforms (``RobotTransforms.moving``) and a prepared message,
-    both made again only when the joint state's names change; the /tf of the whole robot
-    (``tree_message``) from ones made once.
+    Of a parsed URDF, with robot_state_publisher's ``frame_prefix``; see ``robot_transforms``.
+    The /tf of a joint state is written from the joints' prepared transforms
+    (``RobotTransforms.moving``) and a prepared message, both made again only when the joint
+    state's names change; the /tf of the whole robot (``tree_message``) from ones made once.
     """
 
-    def __init__(self, urdf: str, frame_prefix: str) -> None:
-        self._robot = RobotTransforms(urdf, frame_prefix)
+    def __init__(self, tree: UrdfTree, frame_prefix: str) -> None:
+        self._robot = RobotTransforms(tree, frame_prefix)
         self._names: tuple[str, ...] | None = None
         self._tree: tuple[MovingTransforms, TFMessageEncoder] | None = None
 
