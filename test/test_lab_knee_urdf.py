@@ -2,8 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-urdf/lab_knee.urdf, the worked example of docs/following_loops.md: the lab knee closed from its
-``<constraint>``.
+urdf/lab_knee.urdf, docs/following_loops.md's worked example: the knee closed by ``<constraint>``.
 
 The URDF is config/measured_lab.yaml's knee drawn assembled at the zero pose; the loop solver
 must give the passive joints the reference gives, with no direction or offset written by hand,

@@ -178,7 +178,8 @@ def test_the_parameter_reference_states_each_real_parameters_range_as_validated(
         for name in re.findall(r'`([^`]+)`', cells[1]):
             for link in Link:
                 stated[name.replace('<joint>', link.value)] = (
-                    documented_number(interval[2]), documented_number(interval[3]), interval[1] == '(')
+                    documented_number(interval[2]), documented_number(interval[3]),
+                    interval[1] == '(')
     reals = {spec.name: spec for spec in parameter_specs('') if spec.kind is Kind.REAL}
     assert set(reals) <= set(stated)
     for name, spec in reals.items():
