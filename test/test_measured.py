@@ -465,7 +465,7 @@ def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configur
     joints = config.joints
     assert (joints.source, joints.driver, joints.publish_robot_description) == (
         SourceKind.MEASURED, Driver.CRANK, False)
-    # The README's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
+    # docs/following_loops.md's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
     state = MeasuredFollower(config).follow(1, ['knee_motor'], [-0.1], [1.0]).state
     assert state.alpha == pytest.approx(0.5, abs=1e-15)
     assert math.remainder(state.gamma - state.alpha - 0.2, TWO_PI) == pytest.approx(

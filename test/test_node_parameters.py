@@ -121,7 +121,7 @@ def test_the_descriptors_range_is_the_one_validated(spec):
     if spec.kind is Kind.REAL:
         (interval,) = descriptor.floating_point_range
         low, high = interval.from_value, interval.to_value
-        # The descriptor cannot show an open end: its description says it (README, Parameters).
+        # The descriptor cannot show an open end: its description says it (docs/parameters.md).
         open_low = 'greater than' in descriptor.description
         assert spec.interval.open_low == open_low
         bounds = (f'greater than {low:g} {spec.unit} and at most {high:g} {spec.unit}' if open_low
@@ -154,8 +154,8 @@ def test_an_integer_parameter_refuses_what_lies_between_its_off_value_and_its_ra
 SUPERSCRIPTS = str.maketrans('⁰¹²³⁴⁵⁶⁷⁸⁹', '0123456789')
 
 
-def readme_number(text: str) -> float:
-    """Return a bound as README writes it: 0, 10000, −10⁶, π/2, 2π."""
+def documented_number(text: str) -> float:
+    """Return a bound as docs/parameters.md writes it: 0, 10000, −10⁶, π/2, 2π."""
     sign, text = (-1.0, text[1:]) if text.startswith('−') else (1.0, text)
     power = re.fullmatch(r'10([⁰-⁹]+)', text)
     if power:
@@ -165,10 +165,10 @@ def readme_number(text: str) -> float:
     return sign * value
 
 
-def test_readme_states_each_real_parameters_range_as_validated():
-    """The README's Parameters table gives each real parameter's range as its spec has it."""
-    readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
-    table = readme[readme.index('## Parameters'):readme.index('**Geometry.**')]
+def test_the_parameter_reference_states_each_real_parameters_range_as_validated():
+    """docs/parameters.md's table gives each real parameter's range as its spec has it."""
+    reference = (REPOSITORY / 'docs' / 'parameters.md').read_text(encoding='utf-8')
+    table = reference[reference.index('## Parameters'):reference.index('**Geometry.**')]
     stated = {}
     for row in table.splitlines():
         cells = row.split('|')
@@ -178,7 +178,8 @@ def test_readme_states_each_real_parameters_range_as_validated():
         for name in re.findall(r'`([^`]+)`', cells[1]):
             for link in Link:
                 stated[name.replace('<joint>', link.value)] = (
-                    readme_number(interval[2]), readme_number(interval[3]), interval[1] == '(')
+                    documented_number(interval[2]), documented_number(interval[3]),
+                    interval[1] == '(')
     reals = {spec.name: spec for spec in parameter_specs('') if spec.kind is Kind.REAL}
     assert set(reals) <= set(stated)
     for name, spec in reals.items():
