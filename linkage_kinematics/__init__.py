@@ -11,5 +11,5 @@ layers above share: CDR bytes, rosbag2's split numbers, process affinity), ``kin
 pure library, numpy only), ``model`` (the mechanism as ROS tools see it), ``run`` (what the node
 decides, no rclpy) and ``bag`` (MCAP bags) side by side, neither importing the other, ``ros``
 (the thin rclpy shell of ``linkage_node``) and ``cli`` (the command-line tools). The contracts
-in .importlinter state the layers; README.md, Architecture, shows the tree.
+in .importlinter state the layers; CONTRIBUTING.md, Architecture, shows the tree.
 """

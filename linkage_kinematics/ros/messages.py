@@ -82,7 +82,7 @@ class LinkageStateEncoder:
     """
     The bytes of ``linkage/state`` of one linkage and frame, straight from a state.
 
-    The full state as one trajectory point (README, "Topics"): the coordinates of
+    The full state as one trajectory point (docs/parameters.md, "Topics"): the coordinates of
     ``bag.state_layout``, and as ``time_from_start`` the drive-law time since the motion left
     alpha_start.
     """

@@ -14,7 +14,7 @@ node's timer), ``measured_source`` over ``measured.MeasuredFollower`` (the drive
 ``measured_joint_states`` message) or ``loop_source`` over ``loops.follower`` (every loop of a
 lab's URDF); ``run.diagnostics`` says what ``/diagnostics`` reports;
 ``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
-documented in README.md.
+documented in docs/parameters.md.
 """
 
 from __future__ import annotations
@@ -70,13 +70,13 @@ DIAGNOSTICS_PERIOD = 1.0  # s
 
 class LinkageNode(RunStatus, Node):
     """
-    Publishes the linkage's state as its source moves it (README: Topics, Parameters).
+    Publishes the linkage's state as its source moves it (docs/parameters.md: Topics, Parameters).
 
     Markers at display_rate_hz, diagnostics at 1 Hz and whenever the activity changes.
     Construction raises ConfigurationError for bad parameters before anything is published or
-    written. ``exit_code`` becomes an ExitCode when the run has ended (see README). The node is
-    its source's ``SourceHost`` and owns the run's status (``RunStatus``: activity, problem,
-    exit code), which the source changes only through it.
+    written. ``exit_code`` becomes an ExitCode when the run has ended (docs/parameters.md,
+    exit statuses). The node is its source's ``SourceHost`` and owns the run's status
+    (``RunStatus``: activity, problem, exit code), which the source changes only through it.
     """
 
     def __init__(self, **node_options: Any) -> None:
@@ -339,12 +339,13 @@ def main(args: list[str] | None = None) -> int:
             return ExitCode.CONFIGURATION
         # The events executor dispatches timers and services from C++ instead of rebuilding a
         # wait set in Python for every callback: at 1 kHz it halves the process's CPU
-        # (docs/benchmarks.md, section 3). On simulated time rclpy 7.1.6's events executor
-        # runs a timer created at run time (a rate_hz change) twice at its first /clock step,
-        # which also shifts its schedule by a period, so there the node keeps rclpy's default
-        # executor. The events executor's spin() busy-waits without running timers; spin_once
-        # returns after each callback, and at the latest after the timeout, so the signal
-        # handlers above run and the loop sees the end of the run.
+        # (docs/benchmarks.md, "The node against a minimal hand-written publisher"). On
+        # simulated time rclpy 7.1.6's events executor runs a timer created at run time (a
+        # rate_hz change) twice at its first /clock step, which also shifts its schedule by a
+        # period, so there the node keeps rclpy's default executor. The events executor's
+        # spin() busy-waits without running timers; spin_once returns after each callback, and
+        # at the latest after the timeout, so the signal handlers above run and the loop sees
+        # the end of the run.
         if node.get_parameter('use_sim_time').value:
             executor: Executor = SingleThreadedExecutor()
         else:

@@ -26,7 +26,7 @@ from rclpy.qos import QoSProfile
 
 
 class Source(Protocol):
-    """What the node asks of its source, whichever it is (README: Start control, Diagnostics)."""
+    """What the node asks of its source, whichever it is (docs/parameters.md: Services)."""
 
     @property
     def health(self) -> MeasuredHealth | None:

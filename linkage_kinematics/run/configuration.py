@@ -8,7 +8,7 @@ Pure functions of parameter values (name → value), no ROS: ``parameter_value``
 against its spec (``parameter_specs``: kind, unit, range, choices), ``build_configuration``
 every value and then what they imply together (the geometry, distinct joint names, the motion),
 raising ConfigurationError naming the first bad parameter; the node, the demo and the tests all
-validate through it. README.md documents each parameter.
+validate through it. docs/parameters.md documents each parameter.
 
 A ``RunConfiguration`` holds the values in the groups ``parameter_specs`` declares them in, one
 frozen dataclass each: ``geometry``, ``motion`` (with the pass it implies), ``outputs``,
@@ -187,8 +187,9 @@ class RunConfiguration:
         """
         Whether switching from ``other`` to this configuration changes the motion itself.
 
-        The geometry or the motion (README: Run-time changes); a threshold, a rate of the
-        display, the lab's joint names change what is reported or how, not where the crank is.
+        The geometry or the motion (docs/parameters.md: run-time changes); a threshold, a rate
+        of the display, the lab's joint names change what is reported or how, not where the
+        crank is.
         The pass follows from these, and the read-only parameters never change at run time.
         """
         return (self.geometry.linkage != other.geometry.linkage

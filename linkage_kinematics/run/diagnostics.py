@@ -7,13 +7,13 @@ What the node's diagnostics say and when, without ROS.
 ``assess`` gives the status's level and message and ``report`` its whole content, from the
 ``StatusInputs`` the node has at that moment;
 ``MeasuredHealth`` is the measured source's record of dropped samples and of the time since
-the last valid one. ``key_values`` formats the status's key values (README, "Diagnostics") so
-that a viewer shows them as they are: counts as integers, small residuals in scientific
-notation, and in each mode only the rate it uses. ``StatusSchedule`` says which states a
-status goes out with: one at least every ``STATUS_PERIOD`` of mechanism time, so that a
-replayed bag's diagnostics move with the mechanism. ``RateMeter`` measures the achieved state
-rate over the last ``RATE_WINDOW``, so that statuses that close together do not report the
-jitter of a few ticks.
+the last valid one. ``key_values`` formats the status's key values (docs/parameters.md,
+"Diagnostics") so that a viewer shows them as they are: counts as integers, small residuals
+in scientific notation, and in each mode only the rate it uses. ``StatusSchedule`` says which
+states a status goes out with: one at least every ``STATUS_PERIOD`` of mechanism time, so that
+a replayed bag's diagnostics move with the mechanism. ``RateMeter`` measures the achieved
+state rate over the last ``RATE_WINDOW``, so that statuses that close together do not report
+the jitter of a few ticks.
 """
 
 from __future__ import annotations
@@ -95,7 +95,7 @@ class RateMeter:
 @dataclass(frozen=True, kw_only=True)
 class StatusInputs:
     """
-    What one status is made of, as the node has it when it sends one (README, Diagnostics).
+    What one status is made of, as the node has it when it sends one (docs/parameters.md).
 
     ``run_state`` says whether the motion runs or is paused and ``state`` is the latest state
     (None before the first). ``problem`` makes the status ERROR (the crank cannot go on, the
@@ -119,7 +119,7 @@ class StatusInputs:
 
 
 def key_values(inputs: StatusInputs) -> dict[str, str]:
-    """Return the status's key values (README, Diagnostics) as diagnostic_msgs/KeyValue texts."""
+    """Return the status's key values (docs/parameters.md) as diagnostic_msgs/KeyValue texts."""
     config, state, health = inputs.config, inputs.state, inputs.health
     motion = config.motion
     log_file, log_size = inputs.log_file, inputs.log_size
@@ -243,7 +243,7 @@ def assess(
 
 def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
     """
-    Return the level, message and key values of one status (README, Diagnostics).
+    Return the level, message and key values of one status (docs/parameters.md, Diagnostics).
 
     A measured source's drops since the last status make it WARN and its staleness ERROR.
     """

@@ -185,7 +185,7 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
 
 def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
     """
-    Return the node's status and one per loop (README, Diagnostics).
+    Return the node's status and one per loop (docs/parameters.md, Diagnostics).
 
     The node's: ERROR for ``inputs.problem`` (a description that cannot be closed, the log
     failed) or stale data, WARN for drops since the last status, else OK with the activity.

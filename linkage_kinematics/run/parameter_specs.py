@@ -328,7 +328,7 @@ def _measured_specs() -> tuple[ParameterSpec, ...]:
 
 
 def _loop_specs() -> tuple[ParameterSpec, ...]:
-    """Return which loops the measured source closes, and how (README, Closing a robot's loops)."""
+    """Return which loops the measured source closes, and how (docs/following_loops.md)."""
     return (
         ParameterSpec('loops', LoopsSource.PARAMETERS.value,
                       'parameters: the four-bar of the geometry parameters; robot_description: '

@@ -6,7 +6,7 @@ Where the node's process runs: the ``cpu_affinity`` parameter (as ros2_control's
 
 On one CPU the executor's timer thread and the thread running the callbacks wake each other
 without crossing CPUs, and the bag writer process, on the other CPUs, cannot delay either
-(docs/benchmarks.md, section 3). No ROS.
+(docs/benchmarks.md, "The node against a minimal hand-written publisher"). No ROS.
 """
 
 from __future__ import annotations
