@@ -131,7 +131,8 @@ def test_the_parsers_notes_are_kept_not_printed_and_its_hook_is_restored(
 ) -> None:
     before = xml_reflection_core.on_error
     text = robot(joint('<origin xyz="1 0 0"/><origin xyz="2 0 0"/>')
-                 + '<constraint name="pin"/><lab_extension/>').replace('<robot ', '<robot x="1" ')
+                 + '<constraint name="pin"/><loop_joint name="ball"/><lab_extension/>'
+                 ).replace('<robot ', '<robot x="1" ')
     tree = read_urdf(text)
     assert tree.parser_messages == (
         'Scalar element defined multiple times: origin',
@@ -139,8 +140,9 @@ def test_the_parsers_notes_are_kept_not_printed_and_its_hook_is_restored(
         'Unknown tag "lab_extension" in /robot[@name=\'r\']')
     # as urdfdom, the first of two origins
     assert tree.joints['j'].origin_translation == (1.0, 0.0, 0.0)
-    # the <constraint> is left to loops.description, in the tree the parser read
+    # the <constraint> and the <loop_joint> are left to loops, in the tree the parser read
     assert [element.get('name') for element in tree.element.iter('constraint')] == ['pin']
+    assert [element.get('name') for element in tree.element.iter('loop_joint')] == ['ball']
     RobotTransforms(read_urdf(text))
     assert xml_reflection_core.on_error is before
     assert capfd.readouterr().err == ''

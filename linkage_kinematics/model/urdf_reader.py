@@ -15,8 +15,8 @@ line naming the element and what is wrong.
 Each joint comes with urdfdom's defaults filled in (origin 0, axis (1, 0, 0), mimic multiplier 1
 and offset 0), its origin's rotation also as urdfdom keeps it (a quaternion) and its axis made
 unit as KDL makes it. The parsed XML tree is kept for the elements urdf_parser_py does not read
-(the ``<constraint>`` elements ``loops.description`` reads). Pure: urdf_parser_py and lxml, no
-ROS graph.
+(the ``<constraint>`` and ``<loop_joint>`` elements that close loops, read in ``loops``). Pure:
+urdf_parser_py and lxml, no ROS graph.
 """
 
 from __future__ import annotations
@@ -118,14 +118,15 @@ def quaternion_from_rpy(roll: float, pitch: float, yaw: float) -> Quaternion:
 
 # urdf_parser_py reports what it does not know through the module-level function
 # xml_reflection.core.on_error, which by default writes each message to stderr; Reflection's
-# set_from_xml looks the name up in that module at call time. A <constraint> (the cut joint of a
-# closed loop, which loops.description reads) is not known to it, so every lab's good URDF with
-# loops would print 'Unknown tag "constraint" in /robot[...]'. The parse below swaps the function
-# for one that drops exactly that message (a <constraint> directly under <robot>, whose path is
-# /robot[@name='…']) and keeps every other one, a <constraint> misplaced inside a <joint>
-# included, for the caller; then it restores the function. The lock keeps two threads' parses
-# from restoring each other's function.
-_CONSTRAINT_COMPLAINT = re.compile(r'Unknown tag "constraint" in /robot(\[@name=\'[^/]*\'\])?')
+# set_from_xml looks the name up in that module at call time. A <constraint> or a <loop_joint>
+# (the cut joint of a closed loop in urdfdom PR #264's and Isaac Sim's words, which loops reads)
+# is not known to it, so every lab's good URDF with loops would print 'Unknown tag "constraint"
+# in /robot[...]'. The parse below swaps the function for one that drops exactly that message
+# (either element directly under <robot>, whose path is /robot[@name='…']) and keeps every other
+# one, a <constraint> misplaced inside a <joint> included, for the caller; then it restores the
+# function. The lock keeps two threads' parses from restoring each other's function.
+_CLOSURE_ELEMENT_COMPLAINT = re.compile(
+    r'Unknown tag "(constraint|loop_joint)" in /robot(\[@name=\'[^/]*\'\])?')
 _PARSER_HOOK = threading.Lock()
 
 
@@ -134,7 +135,7 @@ def _parser_messages() -> Iterator[list[str]]:
     messages: list[str] = []
 
     def keep(message: str) -> None:
-        if not _CONSTRAINT_COMPLAINT.fullmatch(message):
+        if not _CLOSURE_ELEMENT_COMPLAINT.fullmatch(message):
             messages.append(message)
 
     with _PARSER_HOOK:
