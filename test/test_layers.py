@@ -19,8 +19,8 @@ import sys
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / 'linkage_kinematics'
-LAYERS = ('kinematics', 'model', 'run', 'bag', 'ros', 'cli')
-PURE_LAYERS = ('kinematics', 'model', 'run')
+LAYERS = ('kinematics', 'model', 'loops', 'run', 'bag', 'ros', 'cli')
+PURE_LAYERS = ('kinematics', 'model', 'loops', 'run')
 # What a pure module must not load, directly or through what it imports.
 NOT_PURE = ('rclpy', 'rosidl_parser', 'rosidl_runtime_py', 'mcap', 'mcap_ros2',
             'ament_index_python', 'builtin_interfaces', 'sensor_msgs', 'std_msgs')
