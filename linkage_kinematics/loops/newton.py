@@ -1,0 +1,585 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+One closure group closed per sample: its known joints in, every other joint of its loops out.
+
+``GroupSolver`` takes any set of known coordinates the structure found determining (the
+measured actuators now; output joints in issue 30's direction). Per sample:
+
+1. **Start** from the last solution, moved to first order by the known joints' change
+   (q_U += S·Δq_K, S = −A⁻¹·J_K at the last solution; a turn's change taken the short way).
+2. **Positions.** Newton on the square system A·Δq_U = −r: the rows of J_U chosen at the
+   assembled pose as independent (pivoted Gram–Schmidt: a planar loop welded in 3D keeps 3 of
+   its 6 rows), plus one row per idle freedom, N_refᵀ·(q_U − q_U,ref) = 0 (exact, linear,
+   path-independent: an idle joint cannot drift over any number of samples). Steps longer than
+   ``TRUST`` (rad, or L-scaled m) are shortened. It stops when the step is at rounding level
+   (‖Δq‖ ≤ 4 ulp of max(‖q‖, 1)) or stops shrinking below 1e-6 (the noise floor), then checks
+   the residual of every row at that iterate against the rounding of the loop's forward
+   kinematics. Closed forms replace Newton where the structure found one (``GroupKind``); a
+   rod reduced to a distance (structure.reducible_rods) gets its angles in closed form.
+3. **Refusals**, each by name with its own reason (``Refusal``), never NaN: no convergence or
+   residual left (no assembly reaches the known values); the sign of det A changed since the
+   last sample (the assembly's orientation: the answer would jump to another assembly); the
+   conditioning κ (1-norm, rows and columns dimensionless) such that the answer would lose
+   ``ACCURACY``: positions carry κ·ε of the inputs' rounding, velocities and accelerations κ²·ε
+   (their Jacobian is taken at positions off by κ·ε), so samples with κ²·ε > 1e-3 are refused.
+4. **Velocities** from the same Jacobian: q̇_U = −A⁻¹·J_K·q̇_K; accelerations on request with
+   the Jacobian's rate: q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇).
+
+``singular_distance`` estimates how far the known joints are from a singular configuration: at
+a fold (the generic singular configuration: a dead point) det A vanishes as the square root of
+the distance δ, so δ ≈ det A / (2‖∇ det A‖) = 1 / (2‖∇ log|det A|‖), with ∂log|det A|/∂q_K,i =
+tr(A⁻¹·∂A/∂q_K,i) from J̇ along the motion that q_K,i drives. It is exact to first order at a
+fold and half the true distance where det A crosses zero linearly. Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+import enum
+import math
+import sys
+
+from linkage_kinematics.loops.assembly import Assembly
+from linkage_kinematics.loops.closed_forms import (
+    circle_intersection,
+    crank_to_sphere,
+    OutOfReach,
+    slide_to_sphere,
+    turn_to,
+    universal_angles,
+    universal_branch,
+)
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
+from linkage_kinematics.loops.linear import condition, inverse, solve
+from linkage_kinematics.loops.spatial import (
+    apply,
+    apply_transposed,
+    cross,
+    dot,
+    norm,
+    subtract,
+    turn_vector,
+)
+from linkage_kinematics.loops.structure import (
+    ClosureGroup,
+    five_bar_cycle,
+    five_bar_pair,
+    GroupKind,
+    GroupStructure,
+    RANK_TOLERANCE,
+    reducible_rods,
+    scaled_jacobian,
+)
+from linkage_kinematics.loops.tree import KinematicTree, MotionKind
+import numpy as np
+
+EPSILON = sys.float_info.epsilon
+ACCURACY = 1e-3
+CONDITION_LIMIT = math.sqrt(ACCURACY / EPSILON)
+ITERATIONS = 12
+TRUST = 0.5
+# The residual of a closed loop is the rounding of its forward kinematics: this many ε per
+# step of the loop, times the group's size for length rows.
+RESIDUAL_ROUNDING = 64.0
+
+
+class Refusal(enum.Enum):
+    """Why a sample is refused."""
+
+    UNREACHABLE = 'no assembly reaches the known joints'
+    ASSEMBLY_CHANGE = 'the answer would jump to another assembly'
+    SINGULAR = 'too near a singular configuration'
+
+
+class SampleRefused(ValueError):
+    """A sample a group cannot be closed at; ``reason`` says why, the message in full."""
+
+    def __init__(self, group: str, reason: Refusal, detail: str) -> None:
+        super().__init__(f'group {group}: {reason.value} ({detail})')
+        self.group = group
+        self.reason = reason
+
+
+class PlanError(ValueError):
+    """A group that cannot be solved per sample from its assembled pose; the message says why."""
+
+
+@dataclass
+class GroupState:
+    """A solved sample: ``solved`` joints' positions and velocities, κ and Newton's iterations."""
+
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    conditioning: float
+    iterations: int
+
+
+def independent_rows(matrix: np.ndarray) -> list[int]:
+    """Return rows of ``matrix`` spanning its row space, largest first (pivoted Gram–Schmidt)."""
+    remaining = matrix.astype(float).copy()
+    norms = np.linalg.norm(remaining, axis=1)
+    largest = float(np.max(norms, initial=0.0))
+    chosen: list[int] = []
+    while remaining.shape[0]:
+        lengths = np.linalg.norm(remaining, axis=1)
+        pick = int(np.argmax(lengths))
+        if lengths[pick] <= RANK_TOLERANCE * largest or lengths[pick] == 0.0:
+            break
+        chosen.append(pick)
+        direction = remaining[pick] / lengths[pick]
+        remaining = remaining - np.outer(remaining @ direction, direction)
+        remaining[pick] = 0.0
+    return sorted(chosen)
+
+
+class _System:
+    """The square system of one set of equations: its rows, idle rows and scales."""
+
+    def __init__(self, tree: KinematicTree, equations: LoopEquations, unknown: Sequence[int],
+                 structure: GroupStructure, values: Sequence[float]) -> None:
+        size = structure.size
+        self.columns = [equations.coordinates.index(i) for i in unknown]
+        jacobian = scaled_jacobian(equations, tree, values, size)
+        self.rows = independent_rows(jacobian[:, self.columns]) if self.columns else []
+        self.column_scale = [size if tree.coordinates[i].kind is MotionKind.SLIDE else 1.0
+                             for i in unknown]
+        self.row_scale = [1.0 / size if equations.row_kinds[row] is RowKind.LENGTH else 1.0
+                          for row in self.rows] + [1.0] * len(structure.idle)
+        solved = list(structure.solved)
+        names = [tree.coordinates[i].name for i in unknown]
+        # N_refᵀ·(y − y_ref) in the dimensionless y = q / column scale
+        self.idle = [[idle.direction[solved.index(name)] / scale
+                      for name, scale in zip(names, self.column_scale)]
+                     for idle in structure.idle]
+        self.reference = [values[column] for column in self.columns]
+        if len(self.rows) + len(self.idle) != len(self.columns):
+            raise PlanError(f'group {structure.name}: {len(self.rows)} independent rows and '
+                            f'{len(self.idle)} idle freedoms for {len(self.columns)} unknowns')
+
+    def matrix(self, jacobian: Sequence[Sequence[float]]) -> list[list[float]]:
+        """Return A: the chosen rows' unknown columns, then the idle rows."""
+        columns = self.columns
+        return [[jacobian[row][c] for c in columns] for row in self.rows] + self.idle
+
+    def right_side(self, residual: Sequence[float], values: Sequence[float]) -> list[float]:
+        """Return the chosen rows' residual, then the idle rows'."""
+        rhs = [residual[row] for row in self.rows]
+        for coefficients in self.idle:
+            rhs.append(math.fsum(k * (values[c] - ref) for k, c, ref in
+                                 zip(coefficients, self.columns, self.reference)))
+        return rhs
+
+    def conditioning(self, matrix: Sequence[Sequence[float]],
+                     inverse_matrix: Sequence[Sequence[float]]) -> float:
+        """Return κ₁ of A with rows and columns made dimensionless."""
+        return condition(matrix, inverse_matrix, self.row_scale, self.column_scale)
+
+
+class _Rods:
+    """The rods reduced to distances: their angles in closed form, continued from the last."""
+
+    def __init__(self, equations: LoopEquations, group: ClosureGroup, rods: dict) -> None:
+        names = [closure.name for closure in group.closures]
+        self.equations = equations
+        # (closure place, rod, outputs: the rod's coordinates' places in group.unknown)
+        self.rods = [(names.index(name), rod, [list(group.unknown).index(c)
+                                               for c in rod.coordinates])
+                     for name, rod in rods.items()]
+        self.coordinates = {c for rod in rods.values() for c in rod.coordinates}
+        self.branches: list[int] = []
+        self.angles: list[list[float]] = []
+
+    def reset(self, evaluation: Evaluation, values: Sequence[float]) -> None:
+        """Take each rod's branch and angles at an assembled pose (all the tree's values)."""
+        self.branches = [universal_branch(rod, self.target(place, evaluation),
+                                          values[rod.coordinates[1]])
+                         for place, rod, _ in self.rods]
+        self.angles = [[values[c] for c in rod.coordinates] for _, rod, _ in self.rods]
+
+    def target(self, place: int, evaluation: Evaluation) -> tuple[float, float, float]:
+        """Return the ball relative to the rod's centre, in the socket frame."""
+        socket = self.equations.frame(place, 1, evaluation)
+        return apply_transposed(socket.rotation, subtract(
+            self.equations.point(place, 0, evaluation),
+            self.equations.point(place, 1, evaluation)))
+
+    def solve(self, evaluation: Evaluation, rates: Sequence[float],
+              refuse) -> list[tuple[list[float], tuple[float, float], float]]:
+        """Return per rod its angles (continued), their rates and the rates' conditioning."""
+        results = []
+        for (place, rod, _), branch, last in zip(self.rods, self.branches, self.angles):
+            try:
+                angles = universal_angles(rod, self.target(place, evaluation), branch)
+            except OutOfReach as error:
+                raise refuse(Refusal.UNREACHABLE, f'rod of {rod.closure}: {error}') from None
+            angles = [angle if abs(angle - previous) <= math.pi else angle - 2.0 * math.pi
+                      * round((angle - previous) / (2.0 * math.pi))
+                      for angle, previous in zip(angles, last)]
+            socket = self.equations.frame(place, 1, evaluation).rotation
+            # the joint's axes in the base frame: the first fixed on the socket, the second
+            # turned with the first
+            first, second = rod.axes
+            axis1 = apply(socket, apply(rod.origins[0], first))
+            axis2 = apply(socket, apply(rod.origins[0], turn_vector(
+                first, angles[0], apply(rod.origins[1], second))))
+            d = subtract(self.equations.point(place, 0, evaluation),
+                         self.equations.point(place, 1, evaluation))
+            d_rate = self.equations.relative_velocity(place, evaluation, rates)
+            # ω₁θ̇₁ × d + ω₂θ̇₂ × d = ḋ: three consistent equations, solved by their normal
+            # equations; κ of [c₁ c₂] is the square root of its Gram matrix's
+            c1, c2 = cross(axis1, d), cross(axis2, d)
+            g11, g12, g22 = dot(c1, c1), dot(c1, c2), dot(c2, c2)
+            det = g11 * g22 - g12 * g12
+            if not det > 0.0:
+                raise refuse(Refusal.SINGULAR, f"rod of {rod.closure} along its joint's axis")
+            r1, r2 = dot(c1, d_rate), dot(c2, d_rate)
+            trace = g11 + g22
+            spread = math.sqrt(max(trace * trace - 4.0 * det, 0.0))
+            results.append((angles, ((g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det),
+                            math.sqrt((trace + spread) / max(trace - spread, 1e-300))))
+        return results
+
+
+class _LegPositions:
+    """One crank–rod–ball leg's inverse: the crank's value in closed form (closed_forms)."""
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, equations: LoopEquations,
+                 rod) -> None:
+        loop = tree.loop(group.closures[0])
+        crank = next(step for step in loop.paths[rod.side] if step not in rod.steps
+                     and tree.steps[step].coordinate not in group.known)
+        self.equations = equations
+        self.step = crank
+        self.column = equations.coordinates.index(tree.steps[crank].coordinate)
+        self.multiplier = tree.steps[crank].multiplier
+        self.turn = tree.steps[crank].kind is MotionKind.TURN
+        self.length = rod.length
+        self.branch = 1
+
+    def move(self, values: list[float], branch: int) -> None:
+        """Set the crank's value in ``values`` to the solution on ``branch``."""
+        evaluation = self.equations.evaluate(values)
+        axis, origin = self.equations.step_axis(self.step, evaluation)
+        ball = self.equations.point(0, 0, evaluation)
+        center = self.equations.point(0, 1, evaluation)
+        if self.turn:
+            change = crank_to_sphere(origin, axis, center, ball, self.length, branch)
+        else:
+            change = slide_to_sphere(center, axis, ball, self.length, branch)
+        values[self.column] += change / self.multiplier
+
+    def reset(self, values: Sequence[float]) -> None:
+        """Take the branch the assembled ``values`` lie on."""
+        def moved(branch: int) -> float:
+            trial = list(values)
+            self.move(trial, branch)
+            return abs(trial[self.column] - values[self.column])
+        self.branch = min((1, -1), key=moved)
+
+    def __call__(self, values: list[float], refuse) -> tuple[int, Evaluation, list]:
+        try:
+            self.move(values, self.branch)
+        except OutOfReach as error:
+            raise refuse(Refusal.UNREACHABLE, str(error)) from None
+        evaluation = self.equations.evaluate(values)
+        return 0, evaluation, self.equations.jacobian(evaluation)
+
+
+class _FiveBarPositions:
+    """
+    A planar five-bar with two adjacent pins known, placed pin by pin.
+
+    The two pins next to the known pair are placed by the known joints alone, the fifth (the
+    apex) where circles about them meet, and each unknown joint then turns its next pin onto
+    its place (closed_forms).
+    """
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup,
+                 equations: LoopEquations, values: Sequence[float]) -> None:
+        self.equations = equations
+        self.cycle = five_bar_cycle(tree, group.closures[0])
+        first = five_bar_pair(tree, group, values)
+        # the pins next to the known pair, and the apex opposite it
+        self.ends = (self.cycle[(first - 1) % 5], self.cycle[(first + 2) % 5])
+        self.apex = self.cycle[(first + 3) % 5]
+        loop = tree.loop(group.closures[0])
+        self.paths = loop.paths
+        # the closure's pin as a neighbour: taken on the side whose joints are all known
+        self.known_side = 0 if all(tree.steps[step].coordinate in group.known
+                                   for step in loop.paths[0]) else 1
+        self.unknown = [(step, equations.coordinates.index(tree.steps[step].coordinate),
+                         tree.steps[step].multiplier) for path in loop.paths for step in path
+                        if tree.steps[step].coordinate not in group.known]
+        evaluation = equations.evaluate(values)
+        # the first step below the base turns about the plane's normal, fixed in the base
+        self.normal = evaluation.frames[0][2][0]
+        apex = self.pin(self.apex, evaluation, None)
+        self.radii = tuple(norm(subtract(apex, self.pin(end, evaluation, self.known_side)))
+                           for end in self.ends)
+        self.branch = 1
+
+    def pin(self, step: int | None, evaluation: Evaluation, side: int | None) -> tuple:
+        """Return a pin's position: a joint's origin, or the closure's point on ``side``."""
+        if step is None:
+            return self.equations.point(0, 0 if side is None else side, evaluation)
+        return self.equations.step_axis(step, evaluation)[1]
+
+    def apex_position(self, evaluation: Evaluation, branch: int) -> tuple:
+        """Return the apex pin's position on ``branch``."""
+        p, q = (self.pin(end, evaluation, self.known_side) for end in self.ends)
+        return circle_intersection(p, q, self.radii[0], self.radii[1], self.normal, branch)
+
+    def reset(self, values: Sequence[float]) -> None:
+        """Take the branch the assembled ``values`` lie on."""
+        evaluation = self.equations.evaluate(values)
+        apex = self.pin(self.apex, evaluation, None)
+        self.branch = min((1, -1), key=lambda branch: norm(subtract(
+            self.apex_position(evaluation, branch), apex)))
+
+    def __call__(self, values: list[float], refuse) -> tuple[int, Evaluation, list]:
+        evaluation = self.equations.evaluate(values)
+        try:
+            places = {self.apex: self.apex_position(evaluation, self.branch)}
+        except OutOfReach as error:
+            raise refuse(Refusal.UNREACHABLE, str(error)) from None
+        for pin in self.cycle:  # the known pins and the two next to them
+            if pin != self.apex:
+                places[pin] = self.pin(pin, evaluation, self.known_side)
+        for step, column, multiplier in self.unknown:
+            evaluation = self.equations.evaluate(values)
+            path = next(path for path in self.paths if step in path)
+            below = path.index(step) + 1
+            following = path[below] if below < len(path) else None
+            side = self.paths.index(path)
+            axis, origin = self.equations.step_axis(step, evaluation)
+            values[column] += turn_to(axis, origin, self.pin(following, evaluation, side),
+                                      places[following]) / multiplier
+        evaluation = self.equations.evaluate(values)
+        return 0, evaluation, self.equations.jacobian(evaluation)
+
+
+class GroupSolver:
+    """
+    Closes one group per sample from its known joints (module docstring).
+
+    ``known`` and ``solved`` name the coordinates given and returned, in the tree's order;
+    ``solve`` takes and returns values in those orders. Built from the group's structure and an
+    assembled pose (its known joints at the first sample's values, or the checker's); ``kind``
+    is how positions are solved (structure.classify).
+    """
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 assembly: Assembly, kind: GroupKind = GroupKind.NEWTON) -> None:
+        self.name = group.name
+        self.kind = kind
+        self.known = structure.known
+        self.solved = structure.solved
+        values = assembly.values
+        rods = (reducible_rods(tree, group, structure)
+                if kind in (GroupKind.NEWTON, GroupKind.LEG_INVERSE) else {})
+        self.equations = LoopEquations(tree, group.closures, rods)
+        self.full = LoopEquations(tree, group.closures)
+        self._rods = _Rods(self.equations, group, rods)
+        local = [values[i] for i in self.equations.coordinates]
+        self._system = _System(tree, self.equations, [i for i in group.unknown if i not in
+                                                      self._rods.coordinates], structure, local)
+        self._full_system = _System(tree, self.full, group.unknown, structure,
+                                    [values[i] for i in self.full.coordinates])
+        self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
+        self._known_set = frozenset(self._known_columns)
+        self._unknown_set = frozenset(self._system.columns)
+        self._known_turns = [tree.coordinates[i].kind is MotionKind.TURN for i in group.known]
+        self._outputs = [self.equations.coordinates.index(i) if i not in self._rods.coordinates
+                         else None for i in group.unknown]
+        self._full_places = [self.full.coordinates.index(i) for i in group.unknown]
+        self._full_known = [self.full.coordinates.index(i) for i in group.known]
+        steps = max(len(path) for closure in group.closures for path in tree.loop(closure).paths)
+        self._bounds = [RESIDUAL_ROUNDING * EPSILON * (steps + 1)
+                        * (structure.size if row is RowKind.LENGTH else 1.0)
+                        for row in self.equations.row_kinds]
+        if kind is GroupKind.LEG_INVERSE:
+            self._closed_form = _LegPositions(tree, group, self.equations,
+                                              next(iter(rods.values())))
+        elif kind is GroupKind.FIVE_BAR:
+            self._closed_form = _FiveBarPositions(tree, group, self.equations, local)
+        else:
+            self._closed_form = None
+        self.reset(values)
+
+    def reset(self, values: Sequence[float]) -> None:
+        """Start again at an assembled pose (``values`` over all the tree's coordinates)."""
+        local = [float(values[i]) for i in self.equations.coordinates]
+        evaluation = self.equations.evaluate(local)
+        matrix = self._system.matrix(self.equations.jacobian(evaluation))
+        found = inverse(matrix) if matrix else ([], 1.0)
+        if found is None or found[1] == 0.0:
+            raise PlanError(f'group {self.name}: the assembled pose is a singular configuration')
+        self._sign = 1.0 if found[1] > 0.0 else -1.0
+        self._values = local
+        self._sensitivity: list[list[float]] = []
+        self._rods.reset(evaluation, values)
+        if self._closed_form is not None:
+            self._closed_form.reset(local)
+        self._last: tuple[list[float], list[float], list[float]] | None = None
+
+    @property
+    def orientation(self) -> int:
+        """Return the sign of det A at the last solution (±1), which names the assembly."""
+        return int(self._sign)
+
+    def solve(self, positions: Sequence[float], velocities: Sequence[float]) -> GroupState:
+        """
+        Return the ``solved`` joints' positions and velocities for the ``known`` joints'.
+
+        SampleRefused (with its ``Refusal``) leaves the state as it was.
+        """
+        values = list(self._values)
+        changes = []
+        for column, value, turn in zip(self._known_columns, positions, self._known_turns):
+            change = value - values[column]
+            changes.append(math.remainder(change, 2.0 * math.pi) if turn else change)
+            values[column] = value
+        for row, column in zip(self._sensitivity, self._system.columns):
+            values[column] += sum([s * c for s, c in zip(row, changes)])
+        if self._closed_form is not None:
+            iterations, evaluation, jacobian = self._closed_form(values, self._refuse)
+        else:
+            iterations, evaluation, jacobian = self._newton(values)
+        return self._finish(values, evaluation, jacobian, velocities, iterations)
+
+    def _refuse(self, reason: Refusal, detail: str) -> SampleRefused:
+        return SampleRefused(self.name, reason, detail)
+
+    def _newton(self, values: list[float]) -> tuple[int, Evaluation, list]:
+        system, equations = self._system, self.equations
+        scales, columns = system.column_scale, system.columns
+        last = math.inf
+        # the known joints' frames are posed once per sample, the unknowns' at each iteration
+        evaluation = equations.evaluate(values)
+        for iteration in range(1, ITERATIONS + 1):
+            if iteration > 1:
+                evaluation = equations.evaluate(values, evaluation, self._unknown_set)
+            jacobian = equations.jacobian(evaluation, self._unknown_set)
+            step = solve(system.matrix(jacobian), system.right_side(evaluation.residual, values))
+            if step is None or not all(map(math.isfinite, step)):
+                raise self._refuse(Refusal.UNREACHABLE, 'the Newton matrix became singular')
+            length = max(abs(x) / s for x, s in zip(step, scales)) if step else 0.0
+            factor = TRUST / length if length > TRUST else 1.0
+            size = 1.0
+            for column, x, s in zip(columns, step, scales):
+                values[column] -= factor * x
+                size = max(size, abs(values[column]) / s)
+            if length <= 4.0 * EPSILON * size or (iteration > 1 and 0.5 * last < length < 1e-6):
+                for row, known_row in zip(jacobian, equations.jacobian(evaluation,
+                                                                       self._known_set)):
+                    for column in self._known_columns:
+                        row[column] = known_row[column]
+                return iteration, evaluation, jacobian
+            last = length
+        raise self._refuse(Refusal.UNREACHABLE, f'Newton did not converge in {ITERATIONS} '
+                           f'steps, residual {max(map(abs, evaluation.residual)):.3g}')
+
+    def _finish(self, values: list[float], evaluation: Evaluation, jacobian: list,
+                velocities: Sequence[float], iterations: int) -> GroupState:
+        for place, (residual, bound) in enumerate(zip(evaluation.residual, self._bounds)):
+            if not abs(residual) <= bound:
+                name = next(name for name, start, count in self.equations.closure_rows
+                            if start <= place < start + count)
+                raise self._refuse(Refusal.UNREACHABLE,
+                                   f'closure {name} stays open by {abs(residual):.3g}')
+        system = self._system
+        matrix = system.matrix(jacobian)
+        found = inverse(matrix) if matrix else ([], self._sign)
+        if found is None:
+            raise self._refuse(Refusal.SINGULAR, 'the Newton matrix is singular')
+        inverse_matrix, det = found
+        conditioning = system.conditioning(matrix, inverse_matrix) if matrix else 1.0
+        known = self._known_columns
+        # S = −A⁻¹·[J_K (chosen rows); 0 (idle rows)]
+        blocks = [[jacobian[row][c] for row in system.rows] for c in known]
+        sensitivity = [[-sum([a * b for a, b in zip(line, block)]) for block in blocks]
+                       for line in inverse_matrix]
+        rates = [0.0] * len(values)
+        for column, rate in zip(known, velocities):
+            rates[column] = rate
+        for line, column in zip(sensitivity, system.columns):
+            rates[column] = math.fsum([s * v for s, v in zip(line, velocities)])
+        rods = self._rods.solve(evaluation, rates, self._refuse)
+        conditioning = max([conditioning] + [rod[2] for rod in rods])
+        if not conditioning <= CONDITION_LIMIT:
+            raise self._refuse(Refusal.SINGULAR, f'conditioning {conditioning:.3g} above '
+                               f'{CONDITION_LIMIT:.3g}')
+        if (det > 0.0) != (self._sign > 0.0):
+            raise self._refuse(Refusal.ASSEMBLY_CHANGE, 'the sign of det A changed')
+        positions = [values[c] if c is not None else 0.0 for c in self._outputs]
+        speeds = [rates[c] if c is not None else 0.0 for c in self._outputs]
+        for (angles, angle_rates, _), (_, _, outputs) in zip(rods, self._rods.rods):
+            for output, angle, rate in zip(outputs, angles, angle_rates):
+                positions[output], speeds[output] = angle, rate
+        self._rods.angles = [rod[0] for rod in rods]
+        self._values, self._sensitivity = values, sensitivity
+        self._last = (positions, speeds, [values[c] for c in known])
+        return GroupState(tuple(positions), tuple(speeds), conditioning, iterations)
+
+    def _full_state(self, known_velocities: Sequence[float]) -> tuple[list[float], list[float]]:
+        """Return the last solution's values and rates over the unreduced equations."""
+        if self._last is None:
+            raise PlanError(f'group {self.name}: no sample solved yet')
+        positions, speeds, known = self._last
+        values = [0.0] * len(self.full.coordinates)
+        rates = [0.0] * len(self.full.coordinates)
+        for place, position, speed in zip(self._full_places, positions, speeds):
+            values[place], rates[place] = position, speed
+        for place, position, speed in zip(self._full_known, known, known_velocities):
+            values[place], rates[place] = position, speed
+        return values, rates
+
+    def accelerations(self, known_velocities: Sequence[float],
+                      known_accelerations: Sequence[float]) -> tuple[float, ...]:
+        """
+        Return the ``solved`` joints' accelerations at the last solution.
+
+        q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇), for the known joints' velocities (as last solved) and
+        accelerations.
+        """
+        values, rates = self._full_state(known_velocities)
+        evaluation = self.full.evaluate(values)
+        jacobian = np.array(self.full.jacobian(evaluation))
+        bias = np.array(self.full.jacobian_rate(evaluation, rates)) @ np.array(rates)
+        system = self._full_system
+        rhs = jacobian[system.rows][:, self._full_known] @ np.array(known_accelerations, float)
+        rhs = np.concatenate([rhs + bias[system.rows], np.zeros(len(system.idle))])
+        result = -np.linalg.solve(np.array(system.matrix(jacobian.tolist())), rhs)
+        return tuple(float(x) for x in result)
+
+    def singular_distance(self, known_velocities: Sequence[float]) -> float:
+        """
+        Return the estimated distance to the nearest singular configuration.
+
+        From the last solution, in the known joints (rad or m, Euclidean): 1/(2‖∇ log|det A|‖)
+        (module docstring).
+        """
+        values, _ = self._full_state(known_velocities)
+        evaluation = self.full.evaluate(values)
+        jacobian = self.full.jacobian(evaluation)
+        system = self._full_system
+        matrix = np.array(system.matrix(jacobian))
+        inverse_matrix = np.linalg.inv(matrix)
+        known_block = np.array(jacobian)[system.rows][:, self._full_known]
+        known_block = np.vstack([known_block, np.zeros((len(system.idle), len(self._full_known)))])
+        sensitivity = -inverse_matrix @ known_block
+        gradient = []
+        for k in range(len(self._full_known)):
+            rates = [0.0] * len(values)
+            rates[self._full_known[k]] = 1.0
+            for place, column in enumerate(system.columns):
+                rates[column] = float(sensitivity[place, k])
+            rate = np.array(self.full.jacobian_rate(evaluation, rates))
+            change = np.vstack([rate[system.rows][:, system.columns],
+                                np.zeros((len(system.idle), len(system.columns)))])
+            gradient.append(float(np.trace(inverse_matrix @ change)))
+        length = math.sqrt(math.fsum(g * g for g in gradient))
+        return math.inf if length == 0.0 else 1.0 / (2.0 * length)
