@@ -26,9 +26,10 @@ assembled pose. Pure: no ROS.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 import math
 
-from linkage_kinematics.loops.equations import Rod
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations, Rod
 from linkage_kinematics.loops.spatial import (
     add,
     apply,
@@ -41,6 +42,8 @@ from linkage_kinematics.loops.spatial import (
     turn_vector,
     Vector,
 )
+from linkage_kinematics.loops.structure import ClosureGroup, five_bar_cycle, five_bar_pair
+from linkage_kinematics.loops.tree import KinematicTree, MotionKind
 
 # How far beyond ±1 rounding may push the cosine of a reachable angle: a target farther out
 # than this is out of reach (the caller refuses the sample).
@@ -136,6 +139,8 @@ def circle_intersection(p: Vector, q: Vector, radius_p: float, radius_q: float,
     """
     pq = subtract(q, p)
     distance = norm(pq)
+    if distance == 0.0:  # concentric: the third pin could be anywhere on the circle
+        raise OutOfReach('the two circles have one centre')
     u = scale(1.0 / distance, pq)
     along = (radius_p * radius_p - radius_q * radius_q + distance * distance) / (2.0 * distance)
     # 4d²h² = ((r_p + r_q)² − d²)(d² − (r_p − r_q)²): Heron's factors, each exact to rounding
@@ -186,3 +191,117 @@ def three_spheres(centers: tuple[Vector, Vector, Vector], radii: tuple[float, fl
 
 def _wrap(angle: float) -> float:
     return math.remainder(angle, 2.0 * math.pi)
+
+
+class LegPositions:
+    """One crank–rod–ball leg's inverse: the crank's value in closed form (closed_forms)."""
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, equations: LoopEquations,
+                 rod) -> None:
+        loop = tree.loop(group.closures[0])
+        crank = next(step for step in loop.paths[rod.side] if step not in rod.steps
+                     and tree.steps[step].coordinate not in group.known)
+        self.equations = equations
+        self.step = crank
+        self.column = equations.coordinates.index(tree.steps[crank].coordinate)
+        self.multiplier = tree.steps[crank].multiplier
+        self.turn = tree.steps[crank].kind is MotionKind.TURN
+        self.length = rod.length
+        self.branch = 1
+
+    def move(self, values: list[float], branch: int) -> None:
+        """Set the crank's value in ``values`` to the solution on ``branch``."""
+        evaluation = self.equations.evaluate(values)
+        axis, origin = self.equations.step_axis(self.step, evaluation)
+        ball = self.equations.point(0, 0, evaluation)
+        center = self.equations.point(0, 1, evaluation)
+        if self.turn:
+            change = crank_to_sphere(origin, axis, center, ball, self.length, branch)
+        else:
+            change = slide_to_sphere(center, axis, ball, self.length, branch)
+        values[self.column] += change / self.multiplier
+
+    def reset(self, values: Sequence[float]) -> None:
+        """Take the branch the assembled ``values`` lie on."""
+        def moved(branch: int) -> float:
+            trial = list(values)
+            self.move(trial, branch)
+            return abs(trial[self.column] - values[self.column])
+        self.branch = min((1, -1), key=moved)
+
+    def __call__(self, values: list[float]) -> tuple[int, Evaluation, list]:
+        """Move ``values`` to the solution; return 0 iterations, its evaluation and Jacobian."""
+        self.move(values, self.branch)
+        evaluation = self.equations.evaluate(values)
+        return 0, evaluation, self.equations.jacobian(evaluation)
+
+
+class FiveBarPositions:
+    """
+    A planar five-bar with two adjacent pins known, placed pin by pin.
+
+    The two pins next to the known pair are placed by the known joints alone, the fifth (the
+    apex) where circles about them meet, and each unknown joint then turns its next pin onto
+    its place (closed_forms).
+    """
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup,
+                 equations: LoopEquations, values: Sequence[float]) -> None:
+        self.equations = equations
+        self.cycle = five_bar_cycle(tree, group.closures[0])
+        first = five_bar_pair(tree, group, values)
+        # the pins next to the known pair, and the apex opposite it
+        self.ends = (self.cycle[(first - 1) % 5], self.cycle[(first + 2) % 5])
+        self.apex = self.cycle[(first + 3) % 5]
+        loop = tree.loop(group.closures[0])
+        self.paths = loop.paths
+        # the closure's pin as a neighbour: taken on the side whose joints are all known
+        self.known_side = 0 if all(tree.steps[step].coordinate in group.known
+                                   for step in loop.paths[0]) else 1
+        self.unknown = [(step, equations.coordinates.index(tree.steps[step].coordinate),
+                         tree.steps[step].multiplier) for path in loop.paths for step in path
+                        if tree.steps[step].coordinate not in group.known]
+        evaluation = equations.evaluate(values)
+        # the first step below the base turns about the plane's normal, fixed in the base
+        self.normal = evaluation.frames[0][2][0]
+        apex = self.pin(self.apex, evaluation, None)
+        self.radii = tuple(norm(subtract(apex, self.pin(end, evaluation, self.known_side)))
+                           for end in self.ends)
+        self.branch = 1
+
+    def pin(self, step: int | None, evaluation: Evaluation, side: int | None) -> tuple:
+        """Return a pin's position: a joint's origin, or the closure's point on ``side``."""
+        if step is None:
+            return self.equations.point(0, 0 if side is None else side, evaluation)
+        return self.equations.step_axis(step, evaluation)[1]
+
+    def apex_position(self, evaluation: Evaluation, branch: int) -> tuple:
+        """Return the apex pin's position on ``branch``."""
+        p, q = (self.pin(end, evaluation, self.known_side) for end in self.ends)
+        return circle_intersection(p, q, self.radii[0], self.radii[1], self.normal, branch)
+
+    def reset(self, values: Sequence[float]) -> None:
+        """Take the branch the assembled ``values`` lie on."""
+        evaluation = self.equations.evaluate(values)
+        apex = self.pin(self.apex, evaluation, None)
+        self.branch = min((1, -1), key=lambda branch: norm(subtract(
+            self.apex_position(evaluation, branch), apex)))
+
+    def __call__(self, values: list[float]) -> tuple[int, Evaluation, list]:
+        """Move ``values`` to the solution; return 0 iterations, its evaluation and Jacobian."""
+        evaluation = self.equations.evaluate(values)
+        places = {self.apex: self.apex_position(evaluation, self.branch)}
+        for pin in self.cycle:  # the known pins and the two next to them
+            if pin != self.apex:
+                places[pin] = self.pin(pin, evaluation, self.known_side)
+        for step, column, multiplier in self.unknown:
+            evaluation = self.equations.evaluate(values)
+            path = next(path for path in self.paths if step in path)
+            below = path.index(step) + 1
+            following = path[below] if below < len(path) else None
+            side = self.paths.index(path)
+            axis, origin = self.equations.step_axis(step, evaluation)
+            values[column] += turn_to(axis, origin, self.pin(following, evaluation, side),
+                                      places[following]) / multiplier
+        evaluation = self.equations.evaluate(values)
+        return 0, evaluation, self.equations.jacobian(evaluation)

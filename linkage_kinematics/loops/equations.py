@@ -304,6 +304,21 @@ class LoopEquations:
                     velocity[2] += rate * z
         return (velocity[0], velocity[1], velocity[2])
 
+    def spin(self, closure: int, side: int, evaluation: Evaluation,
+             rates: Sequence[float]) -> Vector:
+        """Return the angular velocity of a closure side's moving frame in its base frame."""
+        side_record = self._closures[closure][2 + side]
+        axes = evaluation.frames[side_record[0]][2]
+        spin = [0.0, 0.0, 0.0]
+        for place, col, multiplier, turn in side_record[4]:
+            if turn:
+                rate = multiplier * rates[col]
+                x, y, z = axes[place]
+                spin[0] += rate * x
+                spin[1] += rate * y
+                spin[2] += rate * z
+        return (spin[0], spin[1], spin[2])
+
     def motion(self, evaluation: Evaluation, rates: Sequence[float]) -> Motion:
         """Return the frames' motion for coordinate ``rates`` (for ``point_rates``)."""
         return Motion(self._programs, evaluation.frames, evaluation.values, rates)

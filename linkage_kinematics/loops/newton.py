@@ -44,11 +44,9 @@ import sys
 
 from linkage_kinematics.loops.assembly import Assembly
 from linkage_kinematics.loops.closed_forms import (
-    circle_intersection,
-    crank_to_sphere,
+    FiveBarPositions,
+    LegPositions,
     OutOfReach,
-    slide_to_sphere,
-    turn_to,
     universal_angles,
     universal_branch,
 )
@@ -59,14 +57,11 @@ from linkage_kinematics.loops.spatial import (
     apply_transposed,
     cross,
     dot,
-    norm,
     subtract,
     turn_vector,
 )
 from linkage_kinematics.loops.structure import (
     ClosureGroup,
-    five_bar_cycle,
-    five_bar_pair,
     GroupKind,
     GroupStructure,
     RANK_TOLERANCE,
@@ -79,7 +74,7 @@ import numpy as np
 EPSILON = sys.float_info.epsilon
 ACCURACY = 1e-3
 CONDITION_LIMIT = math.sqrt(ACCURACY / EPSILON)
-ITERATIONS = 12
+ITERATIONS = 40
 TRUST = 0.5
 # The residual of a closed loop is the rounding of its forward kinematics: this many ε per
 # step of the loop, times the group's size for length rows.
@@ -172,10 +167,24 @@ class _System:
                                  zip(coefficients, self.columns, self.reference)))
         return rhs
 
+    def wrapped(self, tree: KinematicTree, equations: LoopEquations) -> list[int]:
+        """Return the unknown turns no idle freedom moves: whole turns of them are one pose."""
+        return [column for place, column in enumerate(self.columns)
+                if tree.coordinates[equations.coordinates[column]].kind is MotionKind.TURN
+                and not any(row[place] for row in self.idle)]
+
     def conditioning(self, matrix: Sequence[Sequence[float]],
                      inverse_matrix: Sequence[Sequence[float]]) -> float:
         """Return κ₁ of A with rows and columns made dimensionless."""
         return condition(matrix, inverse_matrix, self.row_scale, self.column_scale)
+
+
+def residual_bounds(tree: KinematicTree, group: ClosureGroup, equations: LoopEquations,
+                    size: float) -> list[float]:
+    """Return per row the rounding a closed loop's residual may carry (m or rad)."""
+    steps = max(len(path) for closure in group.closures for path in tree.loop(closure).paths)
+    return [RESIDUAL_ROUNDING * EPSILON * (steps + 1) * (size if row is RowKind.LENGTH else 1.0)
+            for row in equations.row_kinds]
 
 
 class _Rods:
@@ -227,7 +236,9 @@ class _Rods:
                 first, angles[0], apply(rod.origins[1], second))))
             d = subtract(self.equations.point(place, 0, evaluation),
                          self.equations.point(place, 1, evaluation))
-            d_rate = self.equations.relative_velocity(place, evaluation, rates)
+            # ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d: the rod turns with its socket too
+            d_rate = subtract(self.equations.relative_velocity(place, evaluation, rates),
+                              cross(self.equations.spin(place, 1, evaluation, rates), d))
             # ω₁θ̇₁ × d + ω₂θ̇₂ × d = ḋ: three consistent equations, solved by their normal
             # equations; κ of [c₁ c₂] is the square root of its Gram matrix's
             c1, c2 = cross(axis1, d), cross(axis2, d)
@@ -241,124 +252,6 @@ class _Rods:
             results.append((angles, ((g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det),
                             math.sqrt((trace + spread) / max(trace - spread, 1e-300))))
         return results
-
-
-class _LegPositions:
-    """One crank–rod–ball leg's inverse: the crank's value in closed form (closed_forms)."""
-
-    def __init__(self, tree: KinematicTree, group: ClosureGroup, equations: LoopEquations,
-                 rod) -> None:
-        loop = tree.loop(group.closures[0])
-        crank = next(step for step in loop.paths[rod.side] if step not in rod.steps
-                     and tree.steps[step].coordinate not in group.known)
-        self.equations = equations
-        self.step = crank
-        self.column = equations.coordinates.index(tree.steps[crank].coordinate)
-        self.multiplier = tree.steps[crank].multiplier
-        self.turn = tree.steps[crank].kind is MotionKind.TURN
-        self.length = rod.length
-        self.branch = 1
-
-    def move(self, values: list[float], branch: int) -> None:
-        """Set the crank's value in ``values`` to the solution on ``branch``."""
-        evaluation = self.equations.evaluate(values)
-        axis, origin = self.equations.step_axis(self.step, evaluation)
-        ball = self.equations.point(0, 0, evaluation)
-        center = self.equations.point(0, 1, evaluation)
-        if self.turn:
-            change = crank_to_sphere(origin, axis, center, ball, self.length, branch)
-        else:
-            change = slide_to_sphere(center, axis, ball, self.length, branch)
-        values[self.column] += change / self.multiplier
-
-    def reset(self, values: Sequence[float]) -> None:
-        """Take the branch the assembled ``values`` lie on."""
-        def moved(branch: int) -> float:
-            trial = list(values)
-            self.move(trial, branch)
-            return abs(trial[self.column] - values[self.column])
-        self.branch = min((1, -1), key=moved)
-
-    def __call__(self, values: list[float], refuse) -> tuple[int, Evaluation, list]:
-        try:
-            self.move(values, self.branch)
-        except OutOfReach as error:
-            raise refuse(Refusal.UNREACHABLE, str(error)) from None
-        evaluation = self.equations.evaluate(values)
-        return 0, evaluation, self.equations.jacobian(evaluation)
-
-
-class _FiveBarPositions:
-    """
-    A planar five-bar with two adjacent pins known, placed pin by pin.
-
-    The two pins next to the known pair are placed by the known joints alone, the fifth (the
-    apex) where circles about them meet, and each unknown joint then turns its next pin onto
-    its place (closed_forms).
-    """
-
-    def __init__(self, tree: KinematicTree, group: ClosureGroup,
-                 equations: LoopEquations, values: Sequence[float]) -> None:
-        self.equations = equations
-        self.cycle = five_bar_cycle(tree, group.closures[0])
-        first = five_bar_pair(tree, group, values)
-        # the pins next to the known pair, and the apex opposite it
-        self.ends = (self.cycle[(first - 1) % 5], self.cycle[(first + 2) % 5])
-        self.apex = self.cycle[(first + 3) % 5]
-        loop = tree.loop(group.closures[0])
-        self.paths = loop.paths
-        # the closure's pin as a neighbour: taken on the side whose joints are all known
-        self.known_side = 0 if all(tree.steps[step].coordinate in group.known
-                                   for step in loop.paths[0]) else 1
-        self.unknown = [(step, equations.coordinates.index(tree.steps[step].coordinate),
-                         tree.steps[step].multiplier) for path in loop.paths for step in path
-                        if tree.steps[step].coordinate not in group.known]
-        evaluation = equations.evaluate(values)
-        # the first step below the base turns about the plane's normal, fixed in the base
-        self.normal = evaluation.frames[0][2][0]
-        apex = self.pin(self.apex, evaluation, None)
-        self.radii = tuple(norm(subtract(apex, self.pin(end, evaluation, self.known_side)))
-                           for end in self.ends)
-        self.branch = 1
-
-    def pin(self, step: int | None, evaluation: Evaluation, side: int | None) -> tuple:
-        """Return a pin's position: a joint's origin, or the closure's point on ``side``."""
-        if step is None:
-            return self.equations.point(0, 0 if side is None else side, evaluation)
-        return self.equations.step_axis(step, evaluation)[1]
-
-    def apex_position(self, evaluation: Evaluation, branch: int) -> tuple:
-        """Return the apex pin's position on ``branch``."""
-        p, q = (self.pin(end, evaluation, self.known_side) for end in self.ends)
-        return circle_intersection(p, q, self.radii[0], self.radii[1], self.normal, branch)
-
-    def reset(self, values: Sequence[float]) -> None:
-        """Take the branch the assembled ``values`` lie on."""
-        evaluation = self.equations.evaluate(values)
-        apex = self.pin(self.apex, evaluation, None)
-        self.branch = min((1, -1), key=lambda branch: norm(subtract(
-            self.apex_position(evaluation, branch), apex)))
-
-    def __call__(self, values: list[float], refuse) -> tuple[int, Evaluation, list]:
-        evaluation = self.equations.evaluate(values)
-        try:
-            places = {self.apex: self.apex_position(evaluation, self.branch)}
-        except OutOfReach as error:
-            raise refuse(Refusal.UNREACHABLE, str(error)) from None
-        for pin in self.cycle:  # the known pins and the two next to them
-            if pin != self.apex:
-                places[pin] = self.pin(pin, evaluation, self.known_side)
-        for step, column, multiplier in self.unknown:
-            evaluation = self.equations.evaluate(values)
-            path = next(path for path in self.paths if step in path)
-            below = path.index(step) + 1
-            following = path[below] if below < len(path) else None
-            side = self.paths.index(path)
-            axis, origin = self.equations.step_axis(step, evaluation)
-            values[column] += turn_to(axis, origin, self.pin(following, evaluation, side),
-                                      places[following]) / multiplier
-        evaluation = self.equations.evaluate(values)
-        return 0, evaluation, self.equations.jacobian(evaluation)
 
 
 class GroupSolver:
@@ -391,20 +284,18 @@ class GroupSolver:
         self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
         self._known_set = frozenset(self._known_columns)
         self._unknown_set = frozenset(self._system.columns)
+        self._wrapped = self._system.wrapped(tree, self.equations)
         self._known_turns = [tree.coordinates[i].kind is MotionKind.TURN for i in group.known]
         self._outputs = [self.equations.coordinates.index(i) if i not in self._rods.coordinates
                          else None for i in group.unknown]
         self._full_places = [self.full.coordinates.index(i) for i in group.unknown]
         self._full_known = [self.full.coordinates.index(i) for i in group.known]
-        steps = max(len(path) for closure in group.closures for path in tree.loop(closure).paths)
-        self._bounds = [RESIDUAL_ROUNDING * EPSILON * (steps + 1)
-                        * (structure.size if row is RowKind.LENGTH else 1.0)
-                        for row in self.equations.row_kinds]
+        self._bounds = residual_bounds(tree, group, self.equations, structure.size)
         if kind is GroupKind.LEG_INVERSE:
-            self._closed_form = _LegPositions(tree, group, self.equations,
-                                              next(iter(rods.values())))
+            self._closed_form = LegPositions(tree, group, self.equations,
+                                             next(iter(rods.values())))
         elif kind is GroupKind.FIVE_BAR:
-            self._closed_form = _FiveBarPositions(tree, group, self.equations, local)
+            self._closed_form = FiveBarPositions(tree, group, self.equations, local)
         else:
             self._closed_form = None
         self.reset(values)
@@ -442,11 +333,22 @@ class GroupSolver:
             change = value - values[column]
             changes.append(math.remainder(change, 2.0 * math.pi) if turn else change)
             values[column] = value
-        for row, column in zip(self._sensitivity, self._system.columns):
-            values[column] += sum([s * c for s, c in zip(row, changes)])
         if self._closed_form is not None:
-            iterations, evaluation, jacobian = self._closed_form(values, self._refuse)
+            try:
+                iterations, evaluation, jacobian = self._closed_form(values)
+            except OutOfReach as error:
+                raise self._refuse(Refusal.UNREACHABLE, str(error)) from None
         else:
+            # the first-order prediction, no longer than TRUST: near a singular configuration
+            # its slope is steep, and a longer step would be no prediction
+            system = self._system
+            prediction = [sum([s * c for s, c in zip(row, changes)])
+                          for row in self._sensitivity]
+            length = max([abs(x) / s for x, s in zip(prediction, system.column_scale)],
+                         default=0.0)
+            factor = TRUST / length if length > TRUST else 1.0
+            for x, column in zip(prediction, system.columns):
+                values[column] += factor * x
             iterations, evaluation, jacobian = self._newton(values)
         return self._finish(values, evaluation, jacobian, velocities, iterations)
 
@@ -454,31 +356,48 @@ class GroupSolver:
         return SampleRefused(self.name, reason, detail)
 
     def _newton(self, values: list[float]) -> tuple[int, Evaluation, list]:
-        system, equations = self._system, self.equations
+        """
+        Move ``values`` to the closed pose by Newton; return its iterations and last iterate.
+
+        A step that leaves the residual larger (in units of its rounding) is halved; turns
+        outside the idle freedoms are kept within π of the last solution (the same pose, and
+        sines of small arguments).
+        """
+        system, equations, bounds = self._system, self.equations, self._bounds
         scales, columns = system.column_scale, system.columns
-        last = math.inf
+        last_length = last_norm = math.inf
+        before: list[float] | None = None
         # the known joints' frames are posed once per sample, the unknowns' at each iteration
         evaluation = equations.evaluate(values)
         for iteration in range(1, ITERATIONS + 1):
             if iteration > 1:
                 evaluation = equations.evaluate(values, evaluation, self._unknown_set)
+            norm = max([abs(r) / b for r, b in zip(evaluation.residual, bounds)])
+            if before is not None and norm > 1.0 and norm > last_norm:
+                for column in columns:
+                    values[column] = 0.5 * (before[column] + values[column])
+                continue
+            last_norm, before = norm, list(values)
             jacobian = equations.jacobian(evaluation, self._unknown_set)
             step = solve(system.matrix(jacobian), system.right_side(evaluation.residual, values))
             if step is None or not all(map(math.isfinite, step)):
                 raise self._refuse(Refusal.UNREACHABLE, 'the Newton matrix became singular')
-            length = max(abs(x) / s for x, s in zip(step, scales)) if step else 0.0
+            length = max([abs(x) / s for x, s in zip(step, scales)], default=0.0)
             factor = TRUST / length if length > TRUST else 1.0
             size = 1.0
             for column, x, s in zip(columns, step, scales):
                 values[column] -= factor * x
                 size = max(size, abs(values[column]) / s)
-            if length <= 4.0 * EPSILON * size or (iteration > 1 and 0.5 * last < length < 1e-6):
+            for column in self._wrapped:
+                last = self._values[column]
+                values[column] = last + math.remainder(values[column] - last, 2.0 * math.pi)
+            if length <= 4.0 * EPSILON * size or 0.5 * last_length < length < 1e-6:
                 for row, known_row in zip(jacobian, equations.jacobian(evaluation,
                                                                        self._known_set)):
                     for column in self._known_columns:
                         row[column] = known_row[column]
                 return iteration, evaluation, jacobian
-            last = length
+            last_length = length
         raise self._refuse(Refusal.UNREACHABLE, f'Newton did not converge in {ITERATIONS} '
                            f'steps, residual {max(map(abs, evaluation.residual)):.3g}')
 
