@@ -10,11 +10,12 @@ method that converges from far and then polished to rounding:
 
 1. Levenberg–Marquardt on the closure residual (``equations``: welds by the log map, which has
    no false zero at a half turn), rows and columns made dimensionless by the group's size L,
-   Marquardt's diagonal scaling and Nielsen's damping update. Its damped steps favour small
-   moves, so from the start it finds the closed pose it can reach with the least motion.
-2. If that does not close (a local minimum of the residual), restarts from the start with the
-   free turns shifted by seeded random angles (the same every run), and takes the closed pose
-   nearest the start.
+   Marquardt's diagonal scaling and Nielsen's damping update, first with the distance from the
+   start added, ‖r‖² + μ·‖q − q_start‖², μ decreasing to 0 (``ANCHORS``): this follows the
+   closed pose nearest the start rather than wherever the damped steps lead.
+2. Restarts from the start with the free turns shifted by seeded random angles (the same every
+   run): ``COMPARED`` of them always, more until one closes where the first attempt did not
+   (a local minimum of the residual); the closed pose nearest the start is taken.
 3. Gauss–Newton with minimum-norm steps (the pseudo-inverse at the rank tolerance of
    structure.py) until the step is at rounding level: the pose is then closed to rounding, and
    idle freedoms and redundant rows do not move it.
@@ -51,8 +52,13 @@ NEAR = 1e-8
 CLOSED = 1e-10
 LM_STEPS = 400
 RESTARTS = 24
+# restarts made even when the start closed, to compare the assemblies they find with it
+COMPARED = 6
 POLISH_STEPS = 30
 RESTART_SEED = 29
+# The weights μ of ‖q − q_start‖² the first attempt closes through (dimensionless, against the
+# residual scaled by the group's size), decreasing to 0.
+ANCHORS = (1.0, 1e-2, 1e-4, 1e-6, 1e-8, 0.0)
 
 
 class AssemblyError(ValueError):
@@ -123,12 +129,14 @@ def assemble(tree: KinematicTree, group: ClosureGroup, start: Sequence[float],
             for column, turn in zip(free, turns):
                 trial[column] += rng.uniform(-math.pi, math.pi) if turn else (
                     rng.uniform(-0.5, 0.5) * size)
-        values, steps = _close(tree, equations, trial, free, size)
+        values, steps = _close(tree, equations, trial, free, size,
+                               ANCHORS if attempt == 0 else (0.0,))
         iterations += steps
         if values is not None:
             found.append((attempt, _near(values, begin, free, turns)))
-            if attempt == 0:
-                break
+        # a few restarts always, then only until one closes: another assembly may be nearer
+        if found and attempt >= COMPARED:
+            break
     if not found:
         gaps = ', '.join(f'{gap.closure} {_gap_text(gap)}' for gap in
                          closure_gaps(equations, begin))
@@ -174,18 +182,56 @@ def _scaled(equations: LoopEquations, tree: KinematicTree, values: Sequence[floa
 
 
 def _close(tree: KinematicTree, equations: LoopEquations, values: list[float],
-           free: Sequence[int], size: float) -> tuple[list[float] | None, int]:
-    """Return the closed pose Levenberg–Marquardt and Gauss–Newton reach from ``values``."""
+           free: Sequence[int], size: float,
+           anchors: Sequence[float]) -> tuple[list[float] | None, int]:
+    """
+    Return the closed pose reached from ``values``, and how many steps it took.
+
+    Each anchor μ in turn: Levenberg–Marquardt on ‖r(q)‖² + μ·‖q − q_start‖² (dimensionless,
+    from where the previous μ ended); μ decreasing to 0 follows the closed pose nearest the
+    start. Then Gauss–Newton to rounding.
+    """
     column_scale = np.array([size if tree.coordinates[equations.coordinates[c]].kind
                              is MotionKind.SLIDE else 1.0 for c in free])
-    x = np.array(values, dtype=float)
-    residual, jacobian = _scaled(equations, tree, x, free, size)
+    start = np.array(values, dtype=float)
+    x = start.copy()
+    steps = 0
+    for anchor in anchors:
+        weight = math.sqrt(anchor)
+
+        def system(point: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            residual, jacobian = _scaled(equations, tree, point, free, size)
+            if weight == 0.0:
+                return residual, jacobian
+            offset = (point[free] - start[free]) / column_scale
+            return (np.concatenate([residual, weight * offset]),
+                    np.vstack([jacobian, weight * np.eye(len(free))]))
+
+        x, more = _levenberg_marquardt(system, x, free, column_scale, closing=anchor == 0.0)
+        steps += more
+        if x is None:
+            return None, steps
+    polished, more = _polish(tree, equations, x, free, size, column_scale)
+    return polished, steps + more
+
+
+def _levenberg_marquardt(system, x: np.ndarray, free: Sequence[int], column_scale: np.ndarray,
+                         closing: bool) -> tuple[np.ndarray | None, int]:
+    """
+    Return where Levenberg–Marquardt on ``system`` (residual and Jacobian of x) ends.
+
+    Marquardt's diagonal scaling, Nielsen's damping update; it ends when the step is at
+    rounding level or, ``closing``, when every residual row is below ``NEAR``.
+    """
+    residual, jacobian = system(x)
+    rows = residual.size - (0 if closing else len(free))
     cost = 0.5 * float(residual @ residual)
     normal = jacobian.T @ jacobian
     damping = 1e-3 * max(float(np.max(np.diag(normal), initial=0.0)), 1e-12)
     growth = 2.0
     steps = 0
-    while steps < LM_STEPS and np.max(np.abs(residual), initial=0.0) > NEAR:
+    while steps < LM_STEPS and not (
+            closing and np.max(np.abs(residual[:rows]), initial=0.0) <= NEAR):
         steps += 1
         gradient = jacobian.T @ residual
         diagonal = np.maximum(np.diag(normal), 1e-12 * max(float(np.max(np.diag(normal))), 1.0))
@@ -195,7 +241,7 @@ def _close(tree: KinematicTree, equations: LoopEquations, values: list[float],
             return None, steps
         trial = x.copy()
         trial[free] += step * column_scale
-        trial_residual, trial_jacobian = _scaled(equations, tree, trial, free, size)
+        trial_residual, trial_jacobian = system(trial)
         trial_cost = 0.5 * float(trial_residual @ trial_residual)
         predicted = -float(step @ gradient) - 0.5 * float(step @ normal @ step)
         ratio = (cost - trial_cost) / predicted if predicted > 0.0 else -1.0
@@ -207,10 +253,9 @@ def _close(tree: KinematicTree, equations: LoopEquations, values: list[float],
         else:
             damping *= growth
             growth *= 2.0
-        if np.max(np.abs(step)) <= EPSILON * (1.0 + float(np.max(np.abs(x[free])))):
+        if np.max(np.abs(step)) <= 4.0 * EPSILON * (1.0 + float(np.max(np.abs(x[free])))):
             break
-    polished, more = _polish(tree, equations, x, free, size, column_scale)
-    return polished, steps + more
+    return x, steps
 
 
 def _polish(tree: KinematicTree, equations: LoopEquations, x: np.ndarray, free: Sequence[int],
