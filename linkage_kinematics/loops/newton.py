@@ -330,6 +330,8 @@ class GroupSolver:
         values = list(self._values)
         changes = []
         for column, value, turn in zip(self._known_columns, positions, self._known_turns):
+            if not math.isfinite(value):
+                raise self._refuse(Refusal.UNREACHABLE, f'a known joint is {value!r}')
             change = value - values[column]
             changes.append(math.remainder(change, 2.0 * math.pi) if turn else change)
             values[column] = value
