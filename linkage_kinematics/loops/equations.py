@@ -287,54 +287,40 @@ class LoopEquations:
         """
         return evaluation.points[closure][side]
 
-    def relative_velocity(self, closure: int, evaluation: Evaluation,
-                          rates: Sequence[float]) -> Vector:
-        """Return how fast a closure's side-0 ``point`` moves away from its side-1 point."""
+    def relative_motion(self, closure: int, evaluation: Evaluation,
+                        rates: Sequence[float]) -> tuple[Vector, Vector]:
+        """
+        Return how fast a closure's side-0 point moves from its side-1 point, and how fast.
+
+        The second: how fast side 1's moving frame turns (both in the base frame), for
+        coordinate ``rates``; a rod's socket's spin.
+        """
         record = self._closures[closure]
-        velocity = [0.0, 0.0, 0.0]
+        vx = vy = vz = sx = sy = sz = 0.0
         for side, point, sign in ((record[2], evaluation.points[closure][0], 1.0),
                                   (record[3], evaluation.points[closure][1], -1.0)):
-            frames = evaluation.frames[side[0]]
+            px, py, pz = point
+            _, _, axes, origins = evaluation.frames[side[0]]
             for place, col, multiplier, turn in side[4]:
                 rate = sign * multiplier * rates[col]
-                if rate != 0.0:
-                    x, y, z = _screw(frames, place, turn, point)
-                    velocity[0] += rate * x
-                    velocity[1] += rate * y
-                    velocity[2] += rate * z
-        return (velocity[0], velocity[1], velocity[2])
+                if rate == 0.0:
+                    continue
+                wx, wy, wz = axes[place]
+                if not turn:
+                    vx, vy, vz = vx + rate * wx, vy + rate * wy, vz + rate * wz
+                    continue
+                ox, oy, oz = origins[place]
+                rx, ry, rz = px - ox, py - oy, pz - oz
+                vx += rate * (wy * rz - wz * ry)
+                vy += rate * (wz * rx - wx * rz)
+                vz += rate * (wx * ry - wy * rx)
+                if sign < 0.0:
+                    sx, sy, sz = sx - rate * wx, sy - rate * wy, sz - rate * wz
+        return (vx, vy, vz), (sx, sy, sz)
 
-    def spin(self, closure: int, side: int, evaluation: Evaluation,
-             rates: Sequence[float]) -> Vector:
-        """Return the angular velocity of a closure side's moving frame in its base frame."""
-        side_record = self._closures[closure][2 + side]
-        axes = evaluation.frames[side_record[0]][2]
-        spin = [0.0, 0.0, 0.0]
-        for place, col, multiplier, turn in side_record[4]:
-            if turn:
-                rate = multiplier * rates[col]
-                x, y, z = axes[place]
-                spin[0] += rate * x
-                spin[1] += rate * y
-                spin[2] += rate * z
-        return (spin[0], spin[1], spin[2])
-
-    def motion(self, evaluation: Evaluation, rates: Sequence[float]) -> Motion:
-        """Return the frames' motion for coordinate ``rates`` (for ``point_rates``)."""
-        return Motion(self._programs, evaluation.frames, evaluation.values, rates)
-
-    def point_rates(self, closure: int, evaluation: Evaluation,
-                    motion: Motion) -> tuple[Vector, Vector]:
-        """Return the velocities of a closure's two ``point``s in a ``motion``."""
-        record = self._closures[closure]
-        return _point_rate(record[2], evaluation, motion), _point_rate(record[3], evaluation,
-                                                                       motion)
-
-    def frame(self, closure: int, side: int, evaluation: Evaluation) -> Pose:
-        """Return the moving frame a closure side is fixed on (for a rod, its socket)."""
-        program, slot = self._closures[closure][2 + side][:2]
-        rotations, positions = evaluation.frames[program][:2]
-        return Pose(rotations[slot], positions[slot])
+    def socket(self, closure: int) -> tuple[int, int]:
+        """Return the program and slot of a closure's side-1 moving frame (a rod's socket)."""
+        return self._closures[closure][3][0], self._closures[closure][3][1]
 
     def step_axis(self, step: int, evaluation: Evaluation) -> tuple[Vector, Vector]:
         """Return a tree step's world axis and joint origin (its loop's base frame)."""

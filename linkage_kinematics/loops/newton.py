@@ -193,9 +193,11 @@ class _Rods:
     def __init__(self, equations: LoopEquations, group: ClosureGroup, rods: dict) -> None:
         names = [closure.name for closure in group.closures]
         self.equations = equations
-        # (closure place, rod, outputs: the rod's coordinates' places in group.unknown)
+        # (closure place, rod, outputs: the rod's coordinates' places in group.unknown, the
+        # first axis in the socket frame, the second in the frame the first turns)
         self.rods = [(names.index(name), rod, [list(group.unknown).index(c)
-                                               for c in rod.coordinates])
+                                               for c in rod.coordinates],
+                      apply(rod.origins[0], rod.axes[0]), apply(rod.origins[1], rod.axes[1]))
                      for name, rod in rods.items()]
         self.coordinates = {c for rod in rods.values() for c in rod.coordinates}
         self.branches: list[int] = []
@@ -203,42 +205,41 @@ class _Rods:
 
     def reset(self, evaluation: Evaluation, values: Sequence[float]) -> None:
         """Take each rod's branch and angles at an assembled pose (all the tree's values)."""
-        self.branches = [universal_branch(rod, self.target(place, evaluation),
+        self.branches = [universal_branch(rod, self.target(place, evaluation)[0],
                                           values[rod.coordinates[1]])
-                         for place, rod, _ in self.rods]
-        self.angles = [[values[c] for c in rod.coordinates] for _, rod, _ in self.rods]
+                         for place, rod, *_ in self.rods]
+        self.angles = [[values[c] for c in rod.coordinates] for _, rod, *_ in self.rods]
 
-    def target(self, place: int, evaluation: Evaluation) -> tuple[float, float, float]:
-        """Return the ball relative to the rod's centre, in the socket frame."""
-        socket = self.equations.frame(place, 1, evaluation)
-        return apply_transposed(socket.rotation, subtract(
-            self.equations.point(place, 0, evaluation),
-            self.equations.point(place, 1, evaluation)))
+    def target(self, place: int, evaluation: Evaluation) -> tuple:
+        """Return the ball relative to the rod's centre in the socket frame, d, the socket."""
+        program, slot = self.equations.socket(place)
+        socket = evaluation.frames[program][0][slot]
+        ball, center = evaluation.points[place]
+        d = (ball[0] - center[0], ball[1] - center[1], ball[2] - center[2])
+        return apply_transposed(socket, d), d, socket
 
     def solve(self, evaluation: Evaluation, rates: Sequence[float],
               refuse) -> list[tuple[list[float], tuple[float, float], float]]:
         """Return per rod its angles (continued), their rates and the rates' conditioning."""
         results = []
-        for (place, rod, _), branch, last in zip(self.rods, self.branches, self.angles):
+        for (place, rod, _, axis1_local, second), branch, last in zip(
+                self.rods, self.branches, self.angles):
+            target, d, socket = self.target(place, evaluation)
             try:
-                angles = universal_angles(rod, self.target(place, evaluation), branch)
+                angles = universal_angles(rod, target, branch)
             except OutOfReach as error:
                 raise refuse(Refusal.UNREACHABLE, f'rod of {rod.closure}: {error}') from None
             angles = [angle if abs(angle - previous) <= math.pi else angle - 2.0 * math.pi
                       * round((angle - previous) / (2.0 * math.pi))
                       for angle, previous in zip(angles, last)]
-            socket = self.equations.frame(place, 1, evaluation).rotation
             # the joint's axes in the base frame: the first fixed on the socket, the second
             # turned with the first
-            first, second = rod.axes
-            axis1 = apply(socket, apply(rod.origins[0], first))
-            axis2 = apply(socket, apply(rod.origins[0], turn_vector(
-                first, angles[0], apply(rod.origins[1], second))))
-            d = subtract(self.equations.point(place, 0, evaluation),
-                         self.equations.point(place, 1, evaluation))
+            axis1 = apply(socket, axis1_local)
+            axis2 = apply(socket, apply(rod.origins[0], turn_vector(rod.axes[0], angles[0],
+                                                                    second)))
             # ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d: the rod turns with its socket too
-            d_rate = subtract(self.equations.relative_velocity(place, evaluation, rates),
-                              cross(self.equations.spin(place, 1, evaluation, rates), d))
+            velocity, spin = self.equations.relative_motion(place, evaluation, rates)
+            d_rate = subtract(velocity, cross(spin, d))
             # ω₁θ̇₁ × d + ω₂θ̇₂ × d = ḋ: three consistent equations, solved by their normal
             # equations; κ of [c₁ c₂] is the square root of its Gram matrix's
             c1, c2 = cross(axis1, d), cross(axis2, d)
@@ -437,7 +438,7 @@ class GroupSolver:
             raise self._refuse(Refusal.ASSEMBLY_CHANGE, 'the sign of det A changed')
         positions = [values[c] if c is not None else 0.0 for c in self._outputs]
         speeds = [rates[c] if c is not None else 0.0 for c in self._outputs]
-        for (angles, angle_rates, _), (_, _, outputs) in zip(rods, self._rods.rods):
+        for (angles, angle_rates, _), (_, _, outputs, _, _) in zip(rods, self._rods.rods):
             for output, angle, rate in zip(outputs, angles, angle_rates):
                 positions[output], speeds[output] = angle, rate
         self._rods.angles = [rod[0] for rod in rods]
