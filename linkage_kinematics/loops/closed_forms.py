@@ -254,13 +254,23 @@ class FiveBarPositions:
         self.ends = (self.cycle[(first - 1) % 5], self.cycle[(first + 2) % 5])
         self.apex = self.cycle[(first + 3) % 5]
         loop = tree.loop(group.closures[0])
-        self.paths = loop.paths
         # the closure's pin as a neighbour: taken on the side whose joints are all known
         self.known_side = 0 if all(tree.steps[step].coordinate in group.known
                                    for step in loop.paths[0]) else 1
-        self.unknown = [(step, equations.coordinates.index(tree.steps[step].coordinate),
-                         tree.steps[step].multiplier) for path in loop.paths for step in path
-                        if tree.steps[step].coordinate not in group.known]
+        # the unknown joints down each path: its column, multiplier, side, the pin below it
+        # (the next joint's, or the closure's on that side) and the columns of the joints
+        # above it on its path
+        self.unknown = []
+        for side, path in enumerate(loop.paths):
+            for place, step in enumerate(path):
+                if tree.steps[step].coordinate in group.known:
+                    continue
+                self.unknown.append((
+                    step, equations.coordinates.index(tree.steps[step].coordinate),
+                    tree.steps[step].multiplier, side,
+                    path[place + 1] if place + 1 < len(path) else None,
+                    {equations.coordinates.index(tree.steps[above].coordinate)
+                     for above in path[:place]}))
         evaluation = equations.evaluate(values)
         # the first step below the base turns about the plane's normal, fixed in the base
         self.normal = evaluation.frames[0][2][0]
@@ -294,14 +304,13 @@ class FiveBarPositions:
         for pin in self.cycle:  # the known pins and the two next to them
             if pin != self.apex:
                 places[pin] = self.pin(pin, evaluation, self.known_side)
-        for step, column, multiplier in self.unknown:
-            evaluation = self.equations.evaluate(values)
-            path = next(path for path in self.paths if step in path)
-            below = path.index(step) + 1
-            following = path[below] if below < len(path) else None
-            side = self.paths.index(path)
+        turned: set[int] = set()
+        for step, column, multiplier, side, following, above in self.unknown:
+            if turned & above:  # a joint above this one has turned: pose it again
+                evaluation = self.equations.evaluate(values, evaluation, turned)
             axis, origin = self.equations.step_axis(step, evaluation)
             values[column] += turn_to(axis, origin, self.pin(following, evaluation, side),
                                       places[following]) / multiplier
-        evaluation = self.equations.evaluate(values)
+            turned.add(column)
+        evaluation = self.equations.evaluate(values, evaluation, turned)
         return 0, evaluation, self.equations.jacobian(evaluation)

@@ -14,7 +14,7 @@ measured actuators now; output joints in issue 30's direction). Per sample:
    its 6 rows), plus one row per idle freedom, N_refᵀ·(q_U − q_U,ref) = 0 (exact, linear,
    path-independent: an idle joint cannot drift over any number of samples). Steps longer than
    ``TRUST`` (rad, or L-scaled m) are shortened. It stops when the step is at rounding level
-   (‖Δq‖ ≤ 4 ulp of max(‖q‖, 1)) or stops shrinking below 1e-6 (the noise floor), then checks
+   (‖Δq‖ ≤ 8 ulp of max(‖q‖, 1)) or stops shrinking below 1e-6 (the noise floor), then checks
    the residual of every row at that iterate against the rounding of the loop's forward
    kinematics. Closed forms replace Newton where the structure found one (``GroupKind``); a
    rod reduced to a distance (structure.reducible_rods) gets its angles in closed form.
@@ -75,6 +75,9 @@ EPSILON = sys.float_info.epsilon
 ACCURACY = 1e-3
 CONDITION_LIMIT = math.sqrt(ACCURACY / EPSILON)
 ITERATIONS = 40
+# A step at rounding level: the last step of a converged Newton is the rounding of the
+# residual mapped through A⁻¹, some 2–6 ulp of 1 rad for a well-conditioned loop.
+STEP_ROUNDING = 8.0
 TRUST = 0.5
 # The residual of a closed loop is the rounding of its forward kinematics: this many ε per
 # step of the loop, times the group's size for length rows.
@@ -394,7 +397,7 @@ class GroupSolver:
             for column in self._wrapped:
                 last = self._values[column]
                 values[column] = last + math.remainder(values[column] - last, 2.0 * math.pi)
-            if length <= 4.0 * EPSILON * size or 0.5 * last_length < length < 1e-6:
+            if length <= STEP_ROUNDING * EPSILON * size or 0.5 * last_length < length < 1e-6:
                 for row, known_row in zip(jacobian, equations.jacobian(evaluation,
                                                                        self._known_set)):
                     for column in self._known_columns:
