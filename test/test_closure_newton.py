@@ -19,7 +19,12 @@ import sys
 
 from closure_reference import Reference
 import closure_robots
-from linkage_kinematics.loops.newton import CONDITION_LIMIT, Refusal, SampleRefused
+from linkage_kinematics.loops.newton import (
+    CONDITION_LIMIT,
+    plan_group,
+    Refusal,
+    SampleRefused,
+)
 from linkage_kinematics.loops.structure import GroupKind
 from mpmath import mp, mpf
 import pytest
@@ -232,3 +237,23 @@ def test_accelerations_are_the_rate_of_the_references_velocities(case):
         exact = [(velocities[0][n] - velocities[1][n]) / (2 * h) for n in unknown]
     size = max(abs(float(x)) for x in exact)
     assert max(abs(float(x) - y) for x, y in zip(exact, result)) <= 1e-12 * size
+
+
+def test_plan_group_builds_the_solver_at_the_first_sample_or_says_why_not():
+    mechanism = closure_robots.ankle()
+    tree = closure_robots.KinematicTree(closure_robots.read_urdf(mechanism.urdf))
+    (group,) = closure_robots.closure_groups(tree, mechanism.closures, mechanism.measured)
+    start = [0.0] * len(tree.names)
+    start[tree.index['motor_left']], start[tree.index['motor_right']] = 0.2, -0.1
+    planned = plan_group(tree, group, start)
+    assert planned.problem is None and planned.kind is GroupKind.NEWTON
+    assert [planned.assembly.values[tree.index[n]] for n in ('motor_left', 'motor_right')] == [
+        0.2, -0.1]
+    state = planned.solver.solve([0.2, -0.1], [0.0, 0.0])
+    assert state.positions == pytest.approx(
+        [planned.assembly.values[tree.index[n]] for n in planned.structure.solved], abs=1e-15)
+    five_bar = closure_robots.five_bar()
+    tree = closure_robots.KinematicTree(closure_robots.read_urdf(five_bar.urdf))
+    (group,) = closure_robots.closure_groups(tree, five_bar.closures, ['j1'])
+    refused = plan_group(tree, group, [0.0] * 4, hold_known=False)
+    assert refused.solver is None and 'under-determined' in refused.problem

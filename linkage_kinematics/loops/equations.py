@@ -29,7 +29,7 @@ Plain floats throughout (``spatial``): this is the per-sample path. Pure: no ROS
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 import enum
 import math
@@ -488,7 +488,7 @@ def _rate_rows(record: tuple, evaluation: Evaluation, motion: Motion,
     p_a, p_b = _side_point(a, evaluation), _side_point(b, evaluation)
     v_a, v_b = _point_rate(a, evaluation, motion), _point_rate(b, evaluation, motion)
 
-    def screw_rates(side: tuple, point: Vector, velocity: Vector):
+    def screw_rates(side: tuple, point: Vector, velocity: Vector) -> Iterator[tuple]:
         frames = evaluation.frames[side[0]]
         for place, col, multiplier, turn in side[4]:
             w, o = frames[2][place], frames[3][place]

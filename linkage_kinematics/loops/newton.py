@@ -27,6 +27,9 @@ measured actuators now; output joints in issue 30's direction). Per sample:
 4. **Velocities** from the same Jacobian: q̇_U = −A⁻¹·J_K·q̇_K; accelerations on request with
    the Jacobian's rate: q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇).
 
+``plan_group`` assembles, analyses and classifies a group and builds its solver (or says in
+one line why not): the one call the node and the checker make per group.
+
 ``singular_distance`` estimates how far the known joints are from a singular configuration: at
 a fold (the generic singular configuration: a dead point) det A vanishes as the square root of
 the distance δ, so δ ≈ det A / (2‖∇ det A‖) = 1 / (2‖∇ log|det A|‖), with ∂log|det A|/∂q_K,i =
@@ -36,13 +39,13 @@ fold and half the true distance where det A crosses zero linearly. Pure: no ROS.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 import enum
 import math
 import sys
 
-from linkage_kinematics.loops.assembly import Assembly
+from linkage_kinematics.loops.assembly import assemble, Assembly
 from linkage_kinematics.loops.closed_forms import (
     FiveBarPositions,
     LegPositions,
@@ -61,6 +64,8 @@ from linkage_kinematics.loops.spatial import (
     turn_vector,
 )
 from linkage_kinematics.loops.structure import (
+    analyse,
+    classify,
     ClosureGroup,
     GroupKind,
     GroupStructure,
@@ -222,7 +227,8 @@ class _Rods:
         return apply_transposed(socket, d), d, socket
 
     def solve(self, evaluation: Evaluation, rates: Sequence[float],
-              refuse) -> list[tuple[list[float], tuple[float, float], float]]:
+              refuse: Callable[[Refusal, str], SampleRefused]
+              ) -> list[tuple[list[float], tuple[float, float], float]]:
         """Return per rod its angles (continued), their rates and the rates' conditioning."""
         results = []
         for (place, rod, _, axis1_local, second), branch, last in zip(
@@ -508,3 +514,41 @@ class GroupSolver:
             gradient.append(float(np.trace(inverse_matrix @ change)))
         length = math.sqrt(math.fsum(g * g for g in gradient))
         return math.inf if length == 0.0 else 1.0 / (2.0 * length)
+
+
+@dataclass(frozen=True)
+class PlannedGroup:
+    """
+    A group planned at a start: its assembly, structure and solver, or why it is refused.
+
+    ``solver`` is None exactly when ``structure.problem`` says why (under- or over-determined)
+    or ``problem`` does (a singular assembled pose).
+    """
+
+    assembly: Assembly
+    structure: GroupStructure
+    kind: GroupKind
+    solver: GroupSolver | None
+    problem: str | None
+
+
+def plan_group(tree: KinematicTree, group: ClosureGroup, start: Sequence[float],
+               seed: Mapping[str, float] | None = None, hold_known: bool = True) -> PlannedGroup:
+    """
+    Return a group assembled nearest ``start`` (all the tree's coordinates), analysed, solved.
+
+    ``hold_known``: the known joints stay at the start's values (the node, at its first
+    sample); False assembles the whole group freely (the checker, at the zero pose). ``seed``:
+    start values of some unknown joints (assembly.assemble). Raises AssemblyError (one line)
+    where no closed pose is found.
+    """
+    assembly = assemble(tree, group, start, None if hold_known else (), seed)
+    structure = analyse(tree, group, assembly.values)
+    kind = classify(tree, group, structure, assembly.values)
+    if structure.problem is not None:
+        return PlannedGroup(assembly, structure, kind, None, structure.problem)
+    try:
+        solver = GroupSolver(tree, group, structure, assembly, kind)
+    except PlanError as error:
+        return PlannedGroup(assembly, structure, kind, None, str(error))
+    return PlannedGroup(assembly, structure, kind, solver, None)

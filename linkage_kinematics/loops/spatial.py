@@ -98,26 +98,32 @@ def apply_transposed(a: Rotation, v: Vector) -> Vector:
 
 
 def add(a: Vector, b: Vector) -> Vector:
+    """Return a + b."""
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
 def subtract(a: Vector, b: Vector) -> Vector:
+    """Return a − b."""
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
 def scale(factor: float, a: Vector) -> Vector:
+    """Return factor·a."""
     return (factor * a[0], factor * a[1], factor * a[2])
 
 
 def dot(a: Vector, b: Vector) -> float:
+    """Return a·b."""
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def cross(a: Vector, b: Vector) -> Vector:
+    """Return a × b."""
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
 def norm(a: Vector) -> float:
+    """Return |a|."""
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
