@@ -76,7 +76,7 @@ def singular_rows(kind: GroupKind) -> list[tuple]:
             continue
         position, velocity = errors(planned, [s, -s], [1.0, -1.0], state)
         kappa = state.conditioning
-        estimate = planned.solver.singular_distance([1.0, -1.0])
+        estimate = planned.solver.derivatives.singular_distance([1.0, -1.0])
         rows.append((decade, (kappa, position, velocity, position / (kappa * EPSILON),
                               velocity / (kappa * kappa * EPSILON),
                               estimate / (math.sqrt(2.0) * 10.0 ** -decade)), None))

@@ -140,7 +140,7 @@ def test_near_a_singular_configuration_the_error_is_the_float_floor_until_refuse
         assert velocity_error <= 1e-14 + 4.0 * floor * state.conditioning
         # a fold: det A vanishes as the square root of the distance, which the estimate uses
         true_distance = math.sqrt(2.0) * 10.0 ** -decade
-        assert planned.solver.singular_distance([1.0, -1.0]) == pytest.approx(
+        assert planned.solver.derivatives.singular_distance([1.0, -1.0]) == pytest.approx(
             true_distance, rel=0.02)
 
 
@@ -214,7 +214,7 @@ def test_accelerations_are_the_rate_of_the_references_velocities(case):
         known, rates = known_at(case, step)
         state = planned.solver.solve(known, rates)
     accelerations = [0.7 * (k + 1) for k in range(len(known))]
-    result = planned.solver.accelerations(rates, accelerations)
+    result = planned.solver.derivatives.accelerations(rates, accelerations)
     mechanism = planned.mechanism
     structure = planned.structure
     reference = Reference(mechanism.urdf, planned.group.closures,
@@ -257,3 +257,16 @@ def test_plan_group_builds_the_solver_at_the_first_sample_or_says_why_not():
     (group,) = closure_robots.closure_groups(tree, five_bar.closures, ['j1'])
     refused = plan_group(tree, group, [0.0] * 4, hold_known=False)
     assert refused.solver is None and 'under-determined' in refused.problem
+
+
+def test_the_sensitivity_maps_known_velocities_to_solved_ones_and_efforts_back():
+    planned = closure_robots.plan(closure_robots.ankle(), ('ankle_pitch', 'ankle_roll'))
+    state = planned.solver.solve([0.2, -0.1], [0.7, -0.4])
+    sensitivity = planned.solver.derivatives.sensitivity()
+    assert [sum(s * v for s, v in zip(row, [0.7, -0.4])) for row in sensitivity] == \
+        pytest.approx(state.velocities, abs=1e-15)
+    # power balance: a motor torque τ_m does the work τ_m·ṁ = (Sᵀ·τ_m)·(pitch, roll rates)
+    torque = 3.0
+    efforts = [torque * row for row in sensitivity[0]]
+    assert efforts[0] * 0.7 + efforts[1] * -0.4 == pytest.approx(torque * state.velocities[0],
+                                                                 rel=1e-15)

@@ -193,7 +193,7 @@ def test_every_row_and_its_rate_follow_the_residual(kind):
 
 def test_a_welds_rows_and_rate_at_an_assembled_pose_moving_as_the_loop_allows():
     planned = closure_robots.plan(closure_robots.planar_weld())
-    equations = planned.solver.full
+    equations = planned.solver.derivatives.full
     state = planned.solver.solve([0.4], [1.3])
     values = [0.4] + list(state.positions)
     rates = [1.3] + list(state.velocities)

@@ -24,17 +24,19 @@ measured actuators now; output joints in issue 30's direction). Per sample:
    conditioning κ (1-norm, rows and columns dimensionless) such that the answer would lose
    ``ACCURACY``: positions carry κ·ε of the inputs' rounding, velocities and accelerations κ²·ε
    (their Jacobian is taken at positions off by κ·ε), so samples with κ²·ε > 1e-3 are refused.
-4. **Velocities** from the same Jacobian: q̇_U = −A⁻¹·J_K·q̇_K; accelerations on request with
-   the Jacobian's rate: q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇).
+4. **Velocities** from the same Jacobian: q̇_U = −A⁻¹·J_K·q̇_K. On request (``Derivatives``, on
+   the unreduced equations): the sensitivity ∂q_U/∂q_K, accelerations with the Jacobian's
+   rate, q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇), and the distance to a singular configuration.
 
 ``plan_group`` assembles, analyses and classifies a group and builds its solver (or says in
 one line why not): the one call the node and the checker make per group.
 
-``singular_distance`` estimates how far the known joints are from a singular configuration: at
-a fold (the generic singular configuration: a dead point) det A vanishes as the square root of
-the distance δ, so δ ≈ det A / (2‖∇ det A‖) = 1 / (2‖∇ log|det A|‖), with ∂log|det A|/∂q_K,i =
-tr(A⁻¹·∂A/∂q_K,i) from J̇ along the motion that q_K,i drives. It is exact to first order at a
-fold and half the true distance where det A crosses zero linearly. Pure: no ROS.
+``Derivatives.singular_distance`` estimates how far the known joints are from a singular
+configuration: at a fold (the generic singular configuration: a dead point) det A vanishes as
+the square root of the distance δ, so δ ≈ det A / (2‖∇ det A‖) = 1 / (2‖∇ log|det A|‖), with
+∂log|det A|/∂q_K,i = tr(A⁻¹·∂A/∂q_K,i) from J̇ along the motion that q_K,i drives. It is exact
+to first order at a fold and half the true distance where det A crosses zero linearly. Pure:
+no ROS.
 """
 
 from __future__ import annotations
@@ -284,13 +286,11 @@ class GroupSolver:
         rods = (reducible_rods(tree, group, structure)
                 if kind in (GroupKind.NEWTON, GroupKind.LEG_INVERSE) else {})
         self.equations = LoopEquations(tree, group.closures, rods)
-        self.full = LoopEquations(tree, group.closures)
         self._rods = _Rods(self.equations, group, rods)
         local = [values[i] for i in self.equations.coordinates]
         self._system = _System(tree, self.equations, [i for i in group.unknown if i not in
                                                       self._rods.coordinates], structure, local)
-        self._full_system = _System(tree, self.full, group.unknown, structure,
-                                    [values[i] for i in self.full.coordinates])
+        self.derivatives = Derivatives(tree, group, structure, values)
         self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
         self._known_set = frozenset(self._known_columns)
         self._unknown_set = frozenset(self._system.columns)
@@ -298,8 +298,6 @@ class GroupSolver:
         self._known_turns = [tree.coordinates[i].kind is MotionKind.TURN for i in group.known]
         self._outputs = [self.equations.coordinates.index(i) if i not in self._rods.coordinates
                          else None for i in group.unknown]
-        self._full_places = [self.full.coordinates.index(i) for i in group.unknown]
-        self._full_known = [self.full.coordinates.index(i) for i in group.known]
         self._bounds = residual_bounds(tree, group, self.equations, structure.size)
         if kind is GroupKind.LEG_INVERSE:
             self._closed_form = LegPositions(tree, group, self.equations,
@@ -324,7 +322,7 @@ class GroupSolver:
         self._rods.reset(evaluation, values)
         if self._closed_form is not None:
             self._closed_form.reset(local)
-        self._last: tuple[list[float], list[float], list[float]] | None = None
+        self.derivatives.last = None
 
     @property
     def orientation(self) -> int:
@@ -452,19 +450,39 @@ class GroupSolver:
                 positions[output], speeds[output] = angle, rate
         self._rods.angles = [rod[0] for rod in rods]
         self._values, self._sensitivity = values, sensitivity
-        self._last = (positions, speeds, [values[c] for c in known])
+        self.derivatives.last = (positions, speeds, [values[c] for c in known])
         return GroupState(tuple(positions), tuple(speeds), conditioning, iterations)
 
-    def _full_state(self, known_velocities: Sequence[float]) -> tuple[list[float], list[float]]:
+
+class Derivatives:
+    """
+    A group's unreduced equations at its solver's last solution: what issue 30 needs.
+
+    The sensitivity ∂(solved)/∂(known), the accelerations with J̇, and the distance to the
+    nearest singular configuration; in numpy (not per sample at 1 kHz). ``last`` is set by
+    the solver: (solved positions, solved velocities, known positions).
+    """
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 values: Sequence[float]) -> None:
+        self.name = group.name
+        self.full = LoopEquations(tree, group.closures)
+        self._system = _System(tree, self.full, group.unknown, structure,
+                               [values[i] for i in self.full.coordinates])
+        self._places = [self.full.coordinates.index(i) for i in group.unknown]
+        self._known = [self.full.coordinates.index(i) for i in group.known]
+        self.last: tuple[list[float], list[float], list[float]] | None = None
+
+    def _state(self, known_velocities: Sequence[float]) -> tuple[list[float], list[float]]:
         """Return the last solution's values and rates over the unreduced equations."""
-        if self._last is None:
+        if self.last is None:
             raise PlanError(f'group {self.name}: no sample solved yet')
-        positions, speeds, known = self._last
+        positions, speeds, known = self.last
         values = [0.0] * len(self.full.coordinates)
         rates = [0.0] * len(self.full.coordinates)
-        for place, position, speed in zip(self._full_places, positions, speeds):
+        for place, position, speed in zip(self._places, positions, speeds):
             values[place], rates[place] = position, speed
-        for place, position, speed in zip(self._full_known, known, known_velocities):
+        for place, position, speed in zip(self._known, known, known_velocities):
             values[place], rates[place] = position, speed
         return values, rates
 
@@ -476,15 +494,31 @@ class GroupSolver:
         q̈_U = −A⁻¹·(J_K·q̈_K + J̇·q̇), for the known joints' velocities (as last solved) and
         accelerations.
         """
-        values, rates = self._full_state(known_velocities)
+        values, rates = self._state(known_velocities)
         evaluation = self.full.evaluate(values)
         jacobian = np.array(self.full.jacobian(evaluation))
         bias = np.array(self.full.jacobian_rate(evaluation, rates)) @ np.array(rates)
-        system = self._full_system
-        rhs = jacobian[system.rows][:, self._full_known] @ np.array(known_accelerations, float)
+        system = self._system
+        rhs = jacobian[system.rows][:, self._known] @ np.array(known_accelerations, float)
         rhs = np.concatenate([rhs + bias[system.rows], np.zeros(len(system.idle))])
         result = -np.linalg.solve(np.array(system.matrix(jacobian.tolist())), rhs)
         return tuple(float(x) for x in result)
+
+    def sensitivity(self) -> list[list[float]]:
+        """
+        Return ∂(solved)/∂(known) at the last solution: −A⁻¹·[J_K; 0] over the whole group.
+
+        Rows in ``solved`` order, columns in ``known`` order. Velocities are this times the
+        known joints' velocities; efforts map back by its transpose (issue 30: τ_known =
+        Sᵀ·τ_solved for the solved actuators).
+        """
+        values, _ = self._state([0.0] * len(self._known))
+        jacobian = np.array(self.full.jacobian(self.full.evaluate(values)))
+        system = self._system
+        known_block = np.vstack([jacobian[system.rows][:, self._known],
+                                 np.zeros((len(system.idle), len(self._known)))])
+        sensitivity = -np.linalg.solve(np.array(system.matrix(jacobian.tolist())), known_block)
+        return sensitivity.tolist()
 
     def singular_distance(self, known_velocities: Sequence[float]) -> float:
         """
@@ -493,19 +527,19 @@ class GroupSolver:
         From the last solution, in the known joints (rad or m, Euclidean): 1/(2‖∇ log|det A|‖)
         (module docstring).
         """
-        values, _ = self._full_state(known_velocities)
+        values, _ = self._state(known_velocities)
         evaluation = self.full.evaluate(values)
         jacobian = self.full.jacobian(evaluation)
-        system = self._full_system
+        system = self._system
         matrix = np.array(system.matrix(jacobian))
         inverse_matrix = np.linalg.inv(matrix)
-        known_block = np.array(jacobian)[system.rows][:, self._full_known]
-        known_block = np.vstack([known_block, np.zeros((len(system.idle), len(self._full_known)))])
+        known_block = np.array(jacobian)[system.rows][:, self._known]
+        known_block = np.vstack([known_block, np.zeros((len(system.idle), len(self._known)))])
         sensitivity = -inverse_matrix @ known_block
         gradient = []
-        for k in range(len(self._full_known)):
+        for k in range(len(self._known)):
             rates = [0.0] * len(values)
-            rates[self._full_known[k]] = 1.0
+            rates[self._known[k]] = 1.0
             for place, column in enumerate(system.columns):
                 rates[column] = float(sensitivity[place, k])
             rate = np.array(self.full.jacobian_rate(evaluation, rates))
