@@ -5,8 +5,8 @@
 urdf/humanoid_ankle.urdf: the package's parallel ankle, closed from its two motors.
 
 The file is installed (setup.py's urdf/*.urdf), reads as a URDF, can be given to the node with
-``-p robot_description:="$(cat …)"`` (no comment holds a colon and a space, which rcl's YAML
-reading of -p values would take as a mapping), is drawn assembled with realistic dimensions,
+``-p robot_description:="$(cat …)"`` (no comment holds a colon: rcl reads -p values as YAML,
+where a colon and a space start a mapping), is drawn assembled with realistic dimensions,
 and every answer of the closure closes its loops by urchin's forward kinematics. Pitch and roll
 known, each leg's motor comes back by the leg's closed form, and forward again to the same
 pitch and roll.
@@ -39,7 +39,7 @@ def test_the_urdf_is_installed_readable_and_safe_to_pass_with_p():
     tree = read_urdf(text)
     assert tree.name == 'humanoid_ankle' and tree.parser_messages == ()
     comments = re.findall(r'<!--(.*?)-->', text, re.DOTALL)
-    assert len(comments) == 2 and not any(': ' in comment for comment in comments[1:])
+    assert len(comments) == 2 and not any(':' in comment for comment in comments)
     constraints = [(c.get('name'), c.get('type')) for c in tree.element.findall('constraint')]
     assert constraints == [('ball_left', 'spherical'), ('ball_right', 'spherical')]
 
