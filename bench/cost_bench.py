@@ -10,7 +10,8 @@ linkage_node at ``rate_hz`` with logging on (``end_behavior:=bounce``) and
 utime + stime from /proc/PID/stat over the same seconds, the node's with its bag writer's.
 Then the highest timer rate at which the node, logging, misses under 1 % of its ticks (from
 its own /diagnostics), with the default placement and with ``cpu_affinity:=0``, and timer
-jitter and latency to another process at 100 Hz, 1 kHz and those rates.
+jitter and latency to another process at 100 Hz, 1 kHz and those rates. Last, both side by side
+at each of a range of rates, for the plot of CPU against rate.
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ MINIMAL_PUBLISHER = pathlib.Path(__file__).resolve().parent / 'minimal_publisher
 CPU_SECONDS = 5.0  # the window CPU time is measured over, after STARTUP_S
 RATES = (1000.0, 2000.0, 3000.0, 4000.0, 5000.0, 7500.0, 10000.0)
 MISSED_LIMIT = 0.01
+# The timer rates of the CPU-against-rate plot: the node's default 100 Hz to twice a lab's 1 kHz.
+PLOT_RATES = (100.0, 250.0, 500.0, 1000.0, 2000.0)
 # The node's placements the rates are measured with: the operating system's, and the node on
 # CPU 0 with its bag writer on the others (the cpu_affinity parameter).
 PLACEMENTS = {'default': {}, 'cpu_affinity:=0': {'cpu_affinity': '0'}}
@@ -177,3 +180,46 @@ def run(quick: bool, ros_domain: int) -> str:
                         'latency p99', 'messages received'], rows),
     ]
     return '\n'.join(lines)
+
+
+def cpu_against_rate(quick: bool, ros_domain: int
+                     ) -> tuple[str, list[tuple[float, float, float]]]:
+    """
+    Return the table of both processes' CPU at each of ``PLOT_RATES``, and its figures.
+
+    Side by side as ``side_by_side`` runs them, on the default executor; the figures are
+    (rate, linkage_node's share, the minimal publisher's share) for the plot.
+    """
+    rates = (100.0, 1000.0) if quick else PLOT_RATES
+    figures = [(rate, *side_by_side(rate, 'single', ros_domain)) for rate in rates]
+    rows = [[f'{rate:g} Hz', f'{100.0 * node:.1f} %', f'{100.0 * minimal:.1f} %',
+             f'{node / minimal:.2f}×'] for rate, node, minimal in figures]
+    return ('\n'.join([
+        f'CPU against the timer rate, one core = 100 %, both side by side over {CPU_SECONDS:g} s '
+        "at each rate (logging on, the minimal publisher on rclpy's default executor):", '',
+        markdown_table(['timer rate', 'linkage_node', 'minimal publisher',
+                        'linkage_node ÷ minimal'], rows)]), figures)
+
+
+def plot_cpu_against_rate(figures: list[tuple[float, float, float]], path: str) -> None:
+    """Draw both processes' CPU (% of one core) against the timer rate, log-log."""
+    import matplotlib
+
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    rates = [rate for rate, _, _ in figures]
+    figure, axis = plt.subplots(figsize=(7, 4.5))
+    for index, (label, marker, colour) in enumerate((
+            ('linkage_node (logging on, with its bag writer)', 'o', 'tab:green'),
+            ('minimal hand-written rclpy publisher', 's', 'tab:blue')), start=1):
+        axis.loglog(rates, [100.0 * row[index] for row in figures], marker=marker,
+                    color=colour, label=label)
+    axis.set_xlabel('timer rate (Hz)')
+    axis.set_ylabel('CPU (% of one core)')
+    axis.set_title('Cost against rate, side by side at each rate (lower is better)')
+    axis.grid(True, which='both', alpha=0.3)
+    axis.legend(fontsize=9)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)

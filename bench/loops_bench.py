@@ -31,11 +31,12 @@ import math
 import re
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr, JointStateDecoder
-from linkage_kinematics.model.loops import find_loops
+from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
+from linkage_kinematics.loops.plan import find_loops, read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.ros.loop_source import TreePositions
 from linkage_kinematics.ros.messages import JointStateEncoder, RobotStateTransforms
-from linkage_kinematics.run.robot_loops import LoopSample, read_loops, RobotLoopsFollower
+from linkage_kinematics.shared.cdr import encode_cdr, JointStateDecoder
 from loop_robots import excavator, four_bar_knee, ROBOTS
 from loops_per_call import ReferenceFollower
 import measured_bench
@@ -105,7 +106,7 @@ def run(quick: bool, ros_domain: int) -> str:
         figures = measured_bench.follow_side_by_side(
             node, seconds, ros_domain + 4, joints,
             {f'{robot}.yaml': yaml.safe_dump(parameters)},
-            frozenset(find_loops(urdf).plan(list(measured)).passive))
+            frozenset(find_loops(read_urdf(urdf)).plan(list(measured)).passive))
         # the encoder's messages also carry the relay's crank and an unrelated joint
         lines += ['', f'**{robot}** ({len(measured)} measured of the {len(joints) + 2} joints '
                       'in each message)', '', measured_bench.report(figures)]
@@ -169,14 +170,15 @@ def path_workloads(measured: tuple[str, ...], urdf: str, inputs: list[Message]
 
     Each follow workload restarts its follower first, so that every run follows the same motion.
     """
-    follower = RobotLoopsFollower(read_loops(urdf), measured, {}, math.pi / 2)
+    description = read_urdf(urdf)
+    follower = RobotLoopsFollower(read_loops(description), measured, {}, math.pi / 2)
     reference = ReferenceFollower(follower)
     received = [input_bytes(message) for message in inputs]
     decoder = JointStateDecoder()
     now = [follower.follow(*message) for message in inputs]
     before = [reference.follow(*message) for message in inputs]
     encoder = JointStateEncoder(now[0].names)
-    transforms = RobotStateTransforms(urdf, '')
+    transforms = RobotStateTransforms(description, '')
     tree = TreePositions(transforms.driven_joints, follower.loop_joints, {})
     heard: dict[str, float] = {}
 

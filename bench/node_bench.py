@@ -179,13 +179,13 @@ def _tick_parts(logging_node: Any, quiet_node: Any, bare_publisher: Any,
     publishers = logging_node.outputs._publishers
     clock = logging_node.get_clock()
     elapsed = [i * 1e-3 for i in range(count)]
-    samples = [sample_at_time(config, t % config.segment_duration) for t in elapsed]
+    samples = [sample_at_time(config, t % config.motion.segment_duration) for t in elapsed]
     state = solve_sample(config, samples[0])
     stamp = clock.now()
     names = list(DEFAULT_JOINT_NAMES.values())
     positions, velocities = tree_values(state, Driver.CRANK)
     joint_state_encoder = messages.JointStateEncoder(names)
-    state_encoder = messages.LinkageStateEncoder(config.linkage, config.frame_id)
+    state_encoder = messages.LinkageStateEncoder(config.geometry.linkage, config.outputs.frame_id)
     joint_state_data = joint_state_encoder.encode(stamp.nanoseconds, positions, velocities)
     trajectory_data = state_encoder.encode(state, stamp.nanoseconds, 0.0)
     # the node's own JointState, as a subscriber's rclpy decodes it
@@ -198,7 +198,7 @@ def _tick_parts(logging_node: Any, quiet_node: Any, bare_publisher: Any,
 
     def solve_only() -> int:
         for sample in samples:
-            solve(config.linkage, sample.alpha, config.drive, config.branch)
+            solve(config.geometry.linkage, sample.alpha, config.motion.drive, config.motion.branch)
         return count
 
     def encode() -> int:
@@ -251,7 +251,7 @@ def _logged_messages(logging_node: Any) -> list[tuple[str, str, bytes]]:
     from linkage_kinematics.ros import messages
 
     config, outputs = logging_node.config, logging_node.outputs
-    state = solve(config.linkage, 0.3, config.drive, config.branch)
+    state = solve(config.geometry.linkage, 0.3, config.motion.drive, config.motion.branch)
     positions, velocities = tree_values(state, Driver.CRANK)
     names = list(DEFAULT_JOINT_NAMES.values())
     stamp_ns = logging_node.get_clock().now().nanoseconds
@@ -261,7 +261,7 @@ def _logged_messages(logging_node: Any) -> list[tuple[str, str, bytes]]:
          messages.JointStateEncoder(names).encode(stamp_ns, positions, velocities)),
         ('/tf', 'tf2_msgs/msg/TFMessage', transforms),
         ('/linkage/state', 'trajectory_msgs/msg/JointTrajectory',
-         messages.LinkageStateEncoder(config.linkage, config.frame_id).encode(
+         messages.LinkageStateEncoder(config.geometry.linkage, config.outputs.frame_id).encode(
              state, stamp_ns, 0.0)),
     ]
 

@@ -21,7 +21,6 @@ from collections.abc import Callable, Mapping, Sequence
 import math
 import random
 
-from linkage_kinematics.bag.cdr import FixedShapeEncoder
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.model.robot_transforms import (
     quaternion_product,
@@ -30,7 +29,9 @@ from linkage_kinematics.model.robot_transforms import (
     Transform,
 )
 from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfTree
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import FixedShapeEncoder
 from timing import format_seconds, interleaved_medians, markdown_table, paired_ratio
 
 STAMP_NS = 1_790_000_000_123_456_789
@@ -43,8 +44,8 @@ PAIR_STATES = 100
 class GenericTF:
     """The per-state /tf of the package before the prepared path, as it was written."""
 
-    def __init__(self, urdf: str, frame_prefix: str, names: Sequence[str]) -> None:
-        self._robot = RobotTransforms(urdf, frame_prefix)
+    def __init__(self, tree: UrdfTree, frame_prefix: str, names: Sequence[str]) -> None:
+        self._robot = RobotTransforms(tree, frame_prefix)
         moving = self.moving_transforms(dict.fromkeys(names, 0.0))
         self._frames = [(transform.parent_frame, transform.child_frame) for transform in moving]
         template = messages.tf_message(
@@ -144,12 +145,13 @@ def run(quick: bool, repetitions: int) -> str:
                          urdf_text(preset('paper').geometry)),
                         (f'a {CHAIN_JOINTS}-joint chain (every 5th prismatic, every 7th a '
                          'mimic)', chain_urdf(CHAIN_JOINTS))):
-        robot = RobotTransforms(urdf)
+        tree = read_urdf(urdf)
+        robot = RobotTransforms(tree)
         names = [name for name, joint in robot.joints.items() if joint.mimic is None]
         samples = [dict(zip(names, (generator.uniform(-math.pi, math.pi) for _ in names)))
                    for _ in range(states)]
-        prepared = messages.RobotStateTransforms(urdf, 'robot_1/')
-        generic = GenericTF(urdf, 'robot_1/', names)
+        prepared = messages.RobotStateTransforms(tree, 'robot_1/')
+        generic = GenericTF(tree, 'robot_1/', names)
         identical = all(prepared.message(positions, STAMP_NS + index)
                         == generic.message(positions, STAMP_NS + index)
                         for index, positions in enumerate(samples))

@@ -50,8 +50,8 @@ def _rpy_matrix(rpy: Triple) -> np.ndarray:
     """
     Return the rotation of URDF roll–pitch–yaw: Rz(yaw)·Ry(pitch)·Rx(roll).
 
-    Written here, not taken from ``loop_urdf``: the robots the tests check the package on are
-    not placed by the package's own code.
+    Written here, not taken from ``loops.description``: the robots the tests check the package on
+    are not placed by the package's own code.
     """
     roll, pitch, yaw = rpy
     cr, sr = math.cos(roll), math.sin(roll)

@@ -30,14 +30,13 @@ from linkage_kinematics.kinematics.planar_loop import (
     UnreachableError,
 )
 from linkage_kinematics.kinematics.solver import solve, unwrap_near
-from linkage_kinematics.model.loops import LoopSampleError
-from linkage_kinematics.run.measured import joint_velocity
-from linkage_kinematics.run.robot_loops import (
+from linkage_kinematics.loops.follower import (
     LoopDrop,
-    LoopRejection,
     LoopSample,
     RobotLoopsFollower,
 )
+from linkage_kinematics.loops.intake import DropReason, joint_velocity
+from linkage_kinematics.loops.solver import LoopSampleError
 
 
 def solve_loop(loop: PlanarLoop, known: int, value: float, rate: float,
@@ -139,23 +138,23 @@ class ReferenceFollower:
         missing = [name for name in measured
                    if name not in index or index[name] >= len(positions)]
         if missing:
-            return LoopDrop(LoopRejection.NO_JOINT, (), f'no position of {missing}')
+            return LoopDrop(DropReason.NO_JOINT, (), f'no position of {missing}')
         values = {name: positions[index[name]] for name in measured}
         given = {name: velocities[index[name]] for name in measured
                  if index[name] < len(velocities)}
         bad = [name for name in measured if not math.isfinite(values[name])
                or not math.isfinite(given.get(name, 0.0))]
         if bad:
-            return LoopDrop(LoopRejection.NON_FINITE, (), f'{bad} not finite')
+            return LoopDrop(DropReason.NON_FINITE, (), f'{bad} not finite')
         if self.last_stamp_ns is not None and stamp_ns <= self.last_stamp_ns:
-            return LoopDrop(LoopRejection.STAMP_NOT_NEWER, (), 'stamp not newer')
+            return LoopDrop(DropReason.STAMP_NOT_NEWER, (), 'stamp not newer')
         for name in self.revolute & self.last.keys():
             last = self.last[name]
             values[name] += round((last - values[name]) / TWO_PI) * TWO_PI
         jumps = [name for name in self.revolute & self.last.keys()
                  if abs(values[name] - self.last[name]) > self.max_jump]
         if jumps:
-            return LoopDrop(LoopRejection.JUMP, (), f'{jumps} jumped')
+            return LoopDrop(DropReason.JUMP, (), f'{jumps} jumped')
         rates, estimates = {}, {}
         for name in measured:
             last = None if name not in self.last else (self.last_stamp_ns, self.last[name])
@@ -165,7 +164,7 @@ class ReferenceFollower:
             solved, solved_rates = self.solve({name: float(values[name]) for name in measured},
                                               {name: float(rates[name]) for name in measured})
         except LoopSampleError as error:
-            return LoopDrop(LoopRejection.UNREACHABLE,
+            return LoopDrop(DropReason.JOINTS_UNREACHABLE,
                             () if error.constraint is None else (error.constraint,), str(error))
         self.last_stamp_ns, self.last = stamp_ns, values
         joints = {**values, **solved}

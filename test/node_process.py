@@ -343,7 +343,7 @@ def expected_state_point(
     Return the positions.
 
     Velocities and accelerations /linkage/state carries for a library state, in its joint order
-    (README): α, β, γ, pins A and B, θ_BC = π − β, OA·α, BC·β.
+    (docs/parameters.md, Topics): α, β, γ, pins A and B, θ_BC = π − β, OA·α, BC·β.
     """
     crank, rocker = linkage.crank_length, linkage.rocker_length
     return (

@@ -29,13 +29,13 @@ from bag_files import (
 )
 from linkage_kinematics.bag import player
 from linkage_kinematics.bag import reader as bag_reader
-from linkage_kinematics.bag.cdr import encode_cdr, ros_type_name
 from linkage_kinematics.bag.metadata import package_version
 from linkage_kinematics.bag.writer import BagWriter
 from linkage_kinematics.cli.replay import main as replay_main
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.shared.cdr import encode_cdr, ros_type_name
 from mcap.reader import make_reader
 from mcap_ros2.reader import read_ros2_messages
 from node_process import (

@@ -60,7 +60,7 @@ def state_message(
     state: LinkageState, index: int, stamp_ns: int, elapsed_s: float, seven: bool = False
 ) -> dict:
     """
-    Build a /linkage/state JointTrajectory as the README's topic table defines it.
+    Build a /linkage/state JointTrajectory as docs/parameters.md (Topics) defines it.
 
     The geometry is the paper's; ``seven`` writes only the first seven coordinates, as bags logged
     before the rocker angle and the pin arcs were added hold.

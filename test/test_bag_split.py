@@ -21,7 +21,6 @@ import select
 import time
 
 from bag_files import only_bag
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.errors import BagError
 from linkage_kinematics.bag.metadata import (
@@ -30,7 +29,9 @@ from linkage_kinematics.bag.metadata import (
 )
 from linkage_kinematics.bag.reader import bag_files, iter_messages
 from linkage_kinematics.bag.recovery import recover_bag
-from linkage_kinematics.bag.writer import BagWriter, MIN_SPLIT_SIZE
+from linkage_kinematics.bag.writer import BagWriter
+from linkage_kinematics.shared.cdr import encode_cdr
+from linkage_kinematics.shared.rosbag2_split import MIN_SPLIT_SIZE
 from mcap_ros2.reader import read_ros2_messages
 from node_process import (
     NodeProcesses,

@@ -17,11 +17,11 @@ from pathlib import Path
 import tempfile
 from typing import Any
 
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition, type_description_hash
 from linkage_kinematics.model.robot_transforms import RobotTransforms, Transform
-from linkage_kinematics.model.urdf_reader import UrdfError
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import encode_cdr
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
 from node_process import NodeProcesses, PROCESS_TIMEOUT, REPOSITORY
@@ -149,7 +149,7 @@ def stamp_ns(stamp: Any) -> int:
 def test_transforms_chain_to_urchins_forward_kinematics(
     positions: dict[str, float], prefix: str
 ) -> None:
-    robot = RobotTransforms(EVERY_JOINT_URDF, prefix)
+    robot = RobotTransforms(read_urdf(EVERY_JOINT_URDF), prefix)
     fixed = robot.fixed_transforms()
     moving = moving_transforms(robot, positions)
     # kdl_parser makes floating joints fixed; the mimic follows arm_joint.
@@ -165,7 +165,7 @@ def test_transforms_chain_to_urchins_forward_kinematics(
 
 
 def test_only_joints_named_in_the_joint_state_move_and_a_named_mimic_keeps_its_value() -> None:
-    robot = RobotTransforms(EVERY_JOINT_URDF)
+    robot = RobotTransforms(read_urdf(EVERY_JOINT_URDF))
     moving = moving_transforms(robot, {'wheel_joint': 1.0, 'follower_joint': 0.5, 'other': 3.0})
     assert [t.child_frame for t in moving] == ['follower', 'wheel']
     with tempfile.TemporaryDirectory() as folder:
@@ -195,7 +195,7 @@ def test_only_joints_named_in_the_joint_state_move_and_a_named_mimic_keeps_its_v
 ])
 def test_a_bad_urdf_is_refused_naming_the_problem(text: str, problem: str) -> None:
     with pytest.raises(UrdfError) as raised:
-        RobotTransforms(text)
+        read_urdf(text)
     assert problem in str(raised.value)
     assert '\n' not in str(raised.value)
 
@@ -213,7 +213,7 @@ def test_shipped_tfmessage_is_rosbag2s_schema_and_type_hash() -> None:
 
 
 def test_tf_message_encoders_write_what_rosbags_serializes() -> None:
-    robot = RobotTransforms(EVERY_JOINT_URDF, 'p/')
+    robot = RobotTransforms(read_urdf(EVERY_JOINT_URDF), 'p/')
     positions = {'arm_joint': 0.4, 'slider_joint': 0.1, 'wheel_joint': 2.0}
     prepared = robot.moving(list(positions))
     stamp = 1_790_000_000_123_456_789
@@ -258,7 +258,7 @@ def test_every_joint_state_has_the_transforms_robot_state_publisher_gives_it(
             logged.setdefault(channel.topic, []).append((message.log_time, decoded))
     [(description_time, description)] = logged[f'{NAMESPACE}/robot_description']
     urdf = description.data
-    root = FRAME_PREFIX + RobotTransforms(urdf).root_link
+    root = FRAME_PREFIX + RobotTransforms(read_urdf(urdf)).root_link
     # /tf_static once, at the description's time; this URDF has no fixed joint.
     [(static_time, static)] = logged['/tf_static']
     assert static_time == description_time and static.transforms == []

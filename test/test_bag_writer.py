@@ -22,7 +22,6 @@ from geometry_msgs.msg import Point
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from linkage_kinematics.bag import reader as bag_reader
-from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
 from linkage_kinematics.bag.definitions import DEFINITION_SEPARATOR, message_definition
 from linkage_kinematics.bag.errors import BagExistsError
 from linkage_kinematics.bag.metadata import offered_qos_profiles_for, package_version, yaml_text
@@ -39,6 +38,7 @@ from linkage_kinematics.model.joints import (
     unwrap_positions,
 )
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder, ros_type_name
 from mcap.reader import make_reader
 from node_process import decode, expected_state_point, time_msg, TYPESTORE
 import numpy as np

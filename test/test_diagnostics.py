@@ -10,10 +10,12 @@ import re
 
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.solver import solve
+from linkage_kinematics.loops.intake import DropReason, FOUR_BAR_DROPS, LOOPS_DROPS
 from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import (
     key_values,
+    MeasuredHealth,
     RATE_WINDOW,
     RateMeter,
     STATUS_PERIOD,
@@ -101,7 +103,7 @@ def test_rate_is_measured_over_the_last_window() -> None:
 
 def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
     config = configuration(mode='fixed_step', alpha_step=math.radians(0.25))
-    state = solve(config.linkage, 0.3, DriveLaw(2.0))
+    state = solve(config.geometry.linkage, 0.3, DriveLaw(2.0))
     values = drive_law_values(config=config, run_state=RunState.RUNNING, state=state,
                               achieved_rate=231.26, missed_deadlines=3, log_file='bags/run',
                               log_size=101_588)
@@ -122,6 +124,32 @@ def test_fixed_step_reports_its_step_and_no_rate_hz() -> None:
 def test_residual_reads_in_scientific_notation() -> None:
     config = configuration()
     values = drive_law_values(config=config, run_state=RunState.RUNNING,
-                              state=solve(config.linkage, 0.7, DriveLaw(2.0)), achieved_rate=0.0)
+                              state=solve(config.geometry.linkage, 0.7, DriveLaw(2.0)),
+                              achieved_rate=0.0)
     residual = values['loop closure residual']
     assert re.fullmatch(r'\d\.\d\de[+-]\d\d', residual) and float(residual) < 1e-12
+
+
+def test_each_measured_modes_drop_reasons_keep_their_texts_and_order() -> None:
+    """Each mode's 'dropped <reason>' key values, as bags and readers have them, from one enum."""
+    assert [reason.value for reason in FOUR_BAR_DROPS] == [
+        'without the driver joint',
+        'with a NaN or infinite position or velocity',
+        'with a stamp not newer than the last one used',
+        'at a driver angle the loop cannot reach (or at a dead point)',
+        'jumping further than measured.max_jump',
+        'whose bytes are not a well-formed JointState']
+    assert [reason.value for reason in LOOPS_DROPS] == [
+        'before the robot description was closed',
+        'while the measured joints cannot close the loops',
+        'without every measured joint',
+        'with a NaN or infinite position or velocity',
+        'with a stamp not newer than the last one used',
+        'at joint values a loop cannot reach (or at a dead point)',
+        'jumping further than measured.max_jump',
+        'whose bytes are not a well-formed JointState']
+    assert set(FOUR_BAR_DROPS) | set(LOOPS_DROPS) == set(DropReason)
+    health = MeasuredHealth(0)
+    health.drop(DropReason.JUMP)
+    assert [key for key in health.sample_values(0) if key.startswith('dropped ')] == [
+        'dropped samples', *(f'dropped {reason.value}' for reason in FOUR_BAR_DROPS)]

@@ -14,6 +14,7 @@ from linkage_kinematics.kinematics.geometry import (
     GeometryError,
     preset,
     PRESETS,
+    Reachability,
     UnreachableError,
     wrap_angle,
 )
@@ -121,6 +122,41 @@ def test_change_points_are_not_dead_points() -> None:
     assert parallelogram.change_point_distance(1.5 + 2 * math.pi * 3) == pytest.approx(
         math.pi / 2 - 1.5, abs=1e-13)
     assert parallelogram.first_dead_point(0.0, 2 * math.pi * 1000) is None
+
+
+def test_a_loop_joints_reachability_names_the_joint() -> None:
+    """The same class holds a loop's known joint: an angle (rad) or a displacement (m)."""
+    revolute = Reachability(((-1.0, 2.0),), (-1.0, 2.0), (), joint=3)
+    assert revolute.describe() == '[-57.295780°, 114.591559°] (mod 360°)'
+    with pytest.raises(UnreachableError, match=r'^joint 3 at 143\.239448783° is not reachable: '
+                                               r'the loop closes only for \[-57\.295780°, '
+                                               r'114\.591559°\] \(mod 360°\)$'):
+        revolute.require(2.5)
+    assert revolute.contains(2.0 + 4 * math.pi) and not revolute.contains(math.inf)
+    assert Reachability(((-math.pi, math.pi),), (), (), joint=1).describe() == (
+        'all angles (full rotation)')
+
+
+def test_a_displacements_reachability_does_not_wrap() -> None:
+    slide = Reachability(((-0.5, -0.1), (0.1, 0.5)), (-0.5, -0.1, 0.1, 0.5), (), periodic=False,
+                         joint=2)
+    assert not slide.full_rotation
+    assert slide.describe() == '[-0.5 m, -0.1 m] and [0.1 m, 0.5 m]'
+    with pytest.raises(UnreachableError, match=r'^joint 2 at 0\.0 m is not reachable: the loop '
+                                               r'closes only for \[-0\.5 m, -0\.1 m\] and '
+                                               r'\[0\.1 m, 0\.5 m\]$'):
+        slide.require(0.0)
+    assert slide.require(0.3) == (0.1, 0.5)
+    assert slide.interval_containing(0.3 + 2 * math.pi) is None
+    assert slide.contains(-0.5) and not slide.contains(0.0) and not slide.contains(math.nan)
+    assert slide.dead_point_distance(0.0) == pytest.approx(0.1, abs=1e-17)
+    assert slide.dead_point_distance(0.3 + 2 * math.pi) == pytest.approx(2 * math.pi - 0.2)
+    # the dead points ahead on the way, none behind it and none a turn later
+    assert slide.first_dead_point(0.0, 0.4) == pytest.approx(0.1, abs=1e-17)
+    assert slide.first_dead_point(0.2, -0.2) == pytest.approx(0.1, abs=1e-17)
+    assert slide.first_dead_point(0.2, 0.5) == pytest.approx(0.5, abs=1e-17)
+    assert slide.first_dead_point(0.2, 0.4) is None
+    assert slide.first_dead_point(0.2, 0.4 + 2 * math.pi) == pytest.approx(0.5, abs=1e-17)
 
 
 def test_first_dead_point_on_the_way() -> None:

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-``bag.cdr.JointStateDecoder`` reads a JointState's bytes as rclpy and rosbags do.
+``shared.cdr.JointStateDecoder`` reads a JointState's bytes as rclpy and rosbags do.
 
 Many random messages (empty and unequal name/position/velocity/effort lengths, non-ASCII names,
 NaN and ±inf, frame_ids of every length mod 8 so that each sequence starts at another alignment,
@@ -20,7 +20,7 @@ import struct
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr, JointStateDecoder
+from linkage_kinematics.shared.cdr import encode_cdr, JointStateDecoder
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message

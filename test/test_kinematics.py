@@ -241,7 +241,7 @@ def test_seed_tables_1_and_2(alpha_degrees: float) -> None:
 
 
 def test_seed_values_at_alpha_zero_to_more_digits() -> None:
-    """Return the README's exact figures: ω_BC = −20/3, ω̇_AB = −57.78, ω̇_BC = 192.59 at α = 0."""
+    """The seed's figures at α = 0, more digits: ω_BC = −20/3, ω̇_AB = −57.78, ω̇_BC = 192.59."""
     state = solve(PRESETS['paper'].geometry, 0.0, CONSTANT)
     assert state.omega_bc == pytest.approx(-20.0 / 3.0, rel=1e-12)
     assert round(state.omega_dot_ab, 2) == -57.78

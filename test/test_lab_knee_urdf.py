@@ -2,11 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-urdf/lab_knee.urdf, the README's worked example: the lab knee closed from its ``<constraint>``.
+urdf/lab_knee.urdf, docs/following_loops.md's worked example: the knee closed by ``<constraint>``.
 
 The URDF is config/measured_lab.yaml's knee drawn assembled at the zero pose; the loop solver
 must give the passive joints the reference gives, with no direction or offset written by hand,
-and the README must show what ``linkage-check-loops`` prints for it.
+and the document must show what ``linkage-check-loops`` prints for it.
 """
 
 from __future__ import annotations
@@ -20,12 +20,15 @@ import xml.etree.ElementTree as ElementTree
 from linkage_kinematics.cli import check_loops
 from linkage_kinematics.kinematics.geometry import preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
-from linkage_kinematics.model.loops import find_loops, LoopSolver
+from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.solver import LoopSolver
+from linkage_kinematics.model.urdf_reader import read_urdf
 import pytest
 from reference import reference_state
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 URDF = REPOSITORY / 'urdf' / 'lab_knee.urdf'
+DOCUMENT = REPOSITORY / 'docs' / 'following_loops.md'
 # The motor's zero of config/measured_lab.yaml: knee_motor = −α + 0.4.
 ALPHA_AT_ZERO = 0.4
 COMMAND = 'linkage-check-loops urdf/lab_knee.urdf --measured knee_motor'
@@ -57,7 +60,7 @@ def foot_end(text: str, positions: dict[str, float]) -> tuple[float, float]:
 
 def test_the_loop_solver_completes_the_knee_as_the_reference_does() -> None:
     text = URDF.read_text(encoding='utf-8')
-    solver = LoopSolver(find_loops(text).plan(['knee_motor']))
+    solver = LoopSolver(find_loops(read_urdf(text)).plan(['knee_motor']))
     link_zero, output_zero = reference_passive(ALPHA_AT_ZERO)
     # a whole turn of the motor in small steps, as an encoder reports it (wrapped at ±π)
     for index in range(-180, 181):
@@ -73,14 +76,15 @@ def test_the_loop_solver_completes_the_knee_as_the_reference_does() -> None:
         assert math.dist(end, (1.0, 0.0)) < 1e-12
 
 
-def test_the_readme_sample_and_printout_are_what_the_package_gives() -> None:
-    readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
-    solver = LoopSolver(find_loops(URDF.read_text(encoding='utf-8')).plan(['knee_motor']))
+def test_the_documented_sample_and_printout_are_what_the_package_gives() -> None:
+    document = DOCUMENT.read_text(encoding='utf-8')
+    solver = LoopSolver(
+        find_loops(read_urdf(URDF.read_text(encoding='utf-8'))).plan(['knee_motor']))
     positions, _ = solver.solve({'knee_motor': -0.1}, {'knee_motor': 1.0})
-    assert f"`knee_link` = {positions['knee_link']:.4f} rad".replace('-', '−') in readme
-    assert f"{positions['knee_output']:.4f} rad".replace('-', '−') in readme
+    assert f"`knee_link` = {positions['knee_link']:.4f} rad".replace('-', '−') in document
+    assert f"{positions['knee_output']:.4f} rad".replace('-', '−') in document
     printed = io.StringIO()
     with contextlib.redirect_stdout(printed):
         assert check_loops.main([str(URDF), '--measured', 'knee_motor']) == 0
-    shown = readme.split(f'$ ./dev run {COMMAND}\n', 1)[1].split('```', 1)[0]
+    shown = document.split(f'$ ./dev run {COMMAND}\n', 1)[1].split('```', 1)[0]
     assert shown == printed.getvalue()

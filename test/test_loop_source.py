@@ -12,15 +12,17 @@ from __future__ import annotations
 
 from typing import Any
 
+from linkage_kinematics.loops.intake import Estimate
 from linkage_kinematics.ros.loop_source import ClosedRobot, RobotLoopsSubscription, TreePositions
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
-from linkage_kinematics.run.measured import Estimate
 from loop_robots import ROBOTS
+import pytest
 from rclpy.serialization import serialize_message
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from test_sources import configuration, FakeHost, FakeLogger, START_NS
+from urdf_parser_py import urdf as urdf_parser
 
 KNEE = ROBOTS['four_bar_knee'].urdf()
 # the parallelogram's coupler joint also mimics the crank
@@ -116,7 +118,7 @@ def test_reset_starts_afresh_and_stale_data_is_an_error() -> None:
     send(host, START_NS + 2 * PERIOD_NS, 0.25)
     assert 'first sample' in node_status(host, source).values['estimated']
     assert source.stale is False
-    host.clock_ns += round(2e9 * host.config.measured_timeout)
+    host.clock_ns += round(2e9 * host.config.measured.timeout)
     (freshness,) = host.timers
     freshness.callback()
     assert source.stale
@@ -208,3 +210,15 @@ def test_tree_positions_are_the_mapping_robot_state_publisher_would_get() -> Non
             joints.get(name, expected_heard.get(name, 0.0)) for name in tree_joints]
     assert heard == expected_heard == {'wrist': 0.5, 'hip': 0.2, 'other': 9.5, 'ankle': -0.4}
     assert tree.positions == [0.2, 0.25, 0.45, -0.4, 0.5]
+
+
+def test_a_description_is_parsed_once_for_its_loops_and_its_tf(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    parses = []
+    parse = urdf_parser.Robot.from_xml
+    monkeypatch.setattr(urdf_parser.Robot, 'from_xml',
+                        lambda *arguments: parses.append(arguments) or parse(*arguments))
+    robot = ClosedRobot(KNEE, LoopsHost(robot_description=KNEE).config)
+    assert robot.follower.loops.robot_name == 'four_bar_knee'
+    assert robot.tree_joints == ('knee_front', 'knee_rear', 'knee_shank')
+    assert len(parses) == 1

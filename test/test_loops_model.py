@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-model.loops: a URDF's <constraint> loops read, checked, ordered and solved.
+A URDF's <constraint> loops read, checked, ordered and solved (loops: description to solver).
 
 The test robots (test/loop_robots.py) are drawn with derived, non-aligned frames; their
 solutions are checked against test/loop_reference.py (mpmath Newton on all constraints at once,
@@ -17,9 +17,11 @@ from linkage_kinematics.kinematics.continuation import continued_branch
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.kinematics.solver import CrankRates, solve
-from linkage_kinematics.model.loop_urdf import LoopError, read_robot
-from linkage_kinematics.model.loops import find_loops, LoopSampleError, LoopSolver
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 import loop_reference
 from loop_robots import DEPTH_1, ROBOTS
 import numpy as np
@@ -64,7 +66,7 @@ def four_bar(crank_axis: str = '0 0 1', coupler_axis: str = '0 0 1', rocker_axis
 
 def refusal(urdf: str) -> str:
     """Return the one problem ``find_loops`` finds in ``urdf``."""
-    loops = find_loops(urdf)
+    loops = find_loops(read_urdf(urdf))
     assert not loops.loops
     assert len(loops.problems) == 1
     return loops.problems[0]
@@ -75,14 +77,14 @@ def refusal(urdf: str) -> str:
 def test_good_urdfs_are_read_without_a_word_on_stderr(capfd: pytest.CaptureFixture[str]) -> None:
     """urdf_parser_py's complaint about <constraint> is dropped; its other notes are kept."""
     for robot in ROBOTS.values():
-        assert find_loops(robot.urdf()).parser_messages == ()
-    noted = find_loops(four_bar(extra='\n  <lab_extension/>'))
+        assert find_loops(read_urdf(robot.urdf())).parser_messages == ()
+    noted = find_loops(read_urdf(four_bar(extra='\n  <lab_extension/>')))
     assert capfd.readouterr().err == ''
     assert len(noted.parser_messages) == 1
     assert noted.parser_messages[0].startswith('Unknown tag "lab_extension" in /robot')
     # only a <constraint> directly under <robot> is expected: one inside a <joint> is noted
     misplaced = four_bar().replace('<origin xyz="0 1 0"/>', '<origin xyz="0 1 0"/><constraint/>')
-    assert find_loops(misplaced).parser_messages == (
+    assert find_loops(read_urdf(misplaced)).parser_messages == (
         'Unknown tag "constraint" in '
         "/robot[@name='test_four_bar']/joint[@name='coupler_joint']",)
 
@@ -93,14 +95,14 @@ def test_the_parser_alone_would_complain_and_its_hook_is_restored(
     before = xml_reflection_core.on_error
     urdf_parser.URDF.from_xml_string(four_bar().encode())
     assert capfd.readouterr().err.startswith('Unknown tag "constraint" in /robot')
-    find_loops(four_bar())
+    find_loops(read_urdf(four_bar()))
     assert xml_reflection_core.on_error is before
     assert capfd.readouterr().err == ''
 
 
 def test_loops_found_in_each_test_robot() -> None:
     for name, robot in ROBOTS.items():
-        loops = find_loops(robot.urdf())
+        loops = find_loops(read_urdf(robot.urdf()))
         assert loops.problems == (), name
         assert {loop.constraint: frozenset(loop.names) for loop in loops.loops} == robot.loops
         for loop in loops.loops:
@@ -126,7 +128,7 @@ def test_joint_kinds_and_signs_follow_the_axes_and_the_path() -> None:
         'follower_pin': {'coupler_joint': -1, 'crank_joint': 1, 'follower_joint': 1},
     }
     for name in ('four_bar_knee', 'slider_crank', 'balancer', 'parallelogram'):
-        for loop in find_loops(ROBOTS[name].urdf()).loops:
+        for loop in find_loops(read_urdf(ROBOTS[name].urdf())).loops:
             assert {joint.name: joint.sign for joint in loop.joints} == expected[loop.constraint]
             assert loop.planar.kinds[0] is JointKind.REVOLUTE
             for joint in loop.joints:
@@ -141,27 +143,27 @@ def _lengths(constraint_points: list[tuple[float, float]]) -> list[float]:
 
 def test_dimensions_match_the_construction() -> None:
     """The knee's and the parallelogram's links, the slider's line: loop_robots' numbers."""
-    knee = find_loops(ROBOTS['four_bar_knee'].urdf()).loops[0]
+    knee = find_loops(read_urdf(ROBOTS['four_bar_knee'].urdf())).loops[0]
     # pin (shank's rear pivot) → knee_rear → knee_front → knee_shank, depth dropped
     expected = _lengths([(-0.022, -0.060), (-0.018, -0.008), (0.020, 0.000), (0.028, -0.055)])
     assert [math.hypot(*link) for link in knee.planar.links] == pytest.approx(expected, abs=1e-15)
     assert np.allclose(knee.normal, (0.0, 0.0, 1.0), rtol=0.0, atol=1e-15)
-    parallelogram = find_loops(ROBOTS['parallelogram'].urdf()).loops[0]
+    parallelogram = find_loops(read_urdf(ROBOTS['parallelogram'].urdf())).loops[0]
     assert [math.hypot(*link) for link in parallelogram.planar.links] == pytest.approx(
         [math.hypot(0.12, 0.01), 0.08, math.hypot(0.12, 0.01), 0.08], abs=1e-15)
-    slider = find_loops(ROBOTS['slider_crank'].urdf()).loops[0]
+    slider = find_loops(read_urdf(ROBOTS['slider_crank'].urdf())).loops[0]
     assert np.allclose(slider.slide_world, (math.cos(-0.15), math.sin(-0.15), 0.0), atol=1e-15)
     # pin → coupler_joint → crank_joint: links[1] is the crank
     assert math.hypot(*slider.planar.links[1]) == pytest.approx(0.05, abs=1e-15)
-    excavator = find_loops(ROBOTS['excavator'].urdf())
+    excavator = find_loops(read_urdf(ROBOTS['excavator'].urdf()))
     for loop in excavator.loops:
         assert abs(abs(loop.normal[1]) - 1.0) < 1e-15, loop.constraint
 
 
 def test_depth_offsets_are_dropped() -> None:
     """The knee's links sit at depths DEPTH_1 apart; the loop is the same without them."""
-    flat = find_loops(ROBOTS['four_bar_knee'].urdf().replace(repr(DEPTH_1), '0.0'))
-    deep = find_loops(ROBOTS['four_bar_knee'].urdf()).loops[0]
+    flat = find_loops(read_urdf(ROBOTS['four_bar_knee'].urdf().replace(repr(DEPTH_1), '0.0')))
+    deep = find_loops(read_urdf(ROBOTS['four_bar_knee'].urdf())).loops[0]
     assert np.allclose(flat.loops[0].planar.links, deep.planar.links, rtol=0.0, atol=1e-15)
 
 
@@ -200,7 +202,7 @@ def test_fixed_joints_on_the_path_are_rigid() -> None:
     <origin xyz="0 0.5 0.25" rpy="0 0 0.3"/></joint>""").replace(
         '<child link="rocker_end"/><child_origin xyz="0 1.5 0"/>',
         f'<child link="rocker_end"/><child_origin xyz="{pin}" rpy="0 0 -0.3"/>')
-    loops = find_loops(split)
+    loops = find_loops(read_urdf(split))
     assert loops.problems == ()
     assert loops.loops[0].names == ('coupler_joint', 'crank_joint', 'rocker_joint')
     assert loops.loops[0].closure_residual < 1e-15
@@ -220,8 +222,9 @@ def test_non_parallel_axes_are_refused() -> None:
         four_bar(rocker_axis=tilt))
     assert 'its child_axis is not parallel' in refusal(four_bar(child_axis='1 0 0'))
     # opposite senses are parallel, and a tilt far below 1e-9 rad is rounding
-    assert find_loops(four_bar(rocker_axis='0 0 -1', child_axis='0 0 -1')).problems == ()
-    assert find_loops(four_bar(rocker_axis=f'0 {math.sin(1e-12)!r} 1')).problems == ()
+    for axes in ({'rocker_axis': '0 0 -1', 'child_axis': '0 0 -1'},
+                 {'rocker_axis': f'0 {math.sin(1e-12)!r} 1'}):
+        assert find_loops(read_urdf(four_bar(**axes))).problems == ()
 
 
 def test_prismatic_joints_must_slide_in_the_plane_and_be_alone() -> None:
@@ -232,18 +235,18 @@ def test_prismatic_joints_must_slide_in_the_plane_and_be_alone() -> None:
                  crank_axis='1 0 0'))
 
 
-def test_urdfs_that_are_no_tree_are_refused() -> None:
-    with pytest.raises(LoopError, match='the URDF is not XML'):
-        read_robot('<robot name="x"><link name="a"></robot>')
-    with pytest.raises(LoopError, match=r"the URDF has 2 root links \['base', 'spare'\]"):
-        read_robot(four_bar(extra='\n  <link name="spare"/>'))
+def test_urdfs_that_are_no_tree_are_refused_before_their_loops_are_read() -> None:
+    with pytest.raises(UrdfError, match='the URDF is not XML'):
+        read_urdf('<robot name="x"><link name="a"></robot>')
+    with pytest.raises(UrdfError, match=r"the URDF has 2 root links \['base', 'spare'\]"):
+        read_urdf(four_bar(extra='\n  <link name="spare"/>'))
 
 
 # --- ordering ------------------------------------------------------------------------------------
 
 def test_the_excavator_loops_are_ordered_from_the_cylinders() -> None:
     robot = ROBOTS['excavator']
-    loops = find_loops(robot.urdf())
+    loops = find_loops(read_urdf(robot.urdf()))
     plan = loops.plan(robot.measured_joints)
     order = [planned.loop.constraint for planned in plan.loops]
     assert order.index('bucket_cylinder_pin') < order.index('bucket_pin')
@@ -260,7 +263,7 @@ def test_the_excavator_loops_are_ordered_from_the_cylinders() -> None:
 def test_the_bucket_measured_at_its_pivot_reverses_the_order() -> None:
     """Measuring bucket_joint instead of its cylinder: the four-bar first, then the cylinder."""
     robot = ROBOTS['excavator']
-    loops = find_loops(robot.urdf())
+    loops = find_loops(read_urdf(robot.urdf()))
     forward = LoopSolver(loops.plan(robot.measured_joints))
     reverse_measured = ('boom_cylinder', 'stick_cylinder', 'bucket_joint')
     plan = loops.plan(reverse_measured)
@@ -278,7 +281,7 @@ def test_the_bucket_measured_at_its_pivot_reverses_the_order() -> None:
 
 
 def test_loops_without_or_with_too_many_known_joints_are_refused() -> None:
-    loops = find_loops(ROBOTS['excavator'].urdf())
+    loops = find_loops(read_urdf(ROBOTS['excavator'].urdf()))
     with pytest.raises(LoopError) as missing:
         loops.plan(('boom_cylinder', 'stick_cylinder'))
     assert str(missing.value).split('\n') == [
@@ -294,7 +297,7 @@ def test_loops_without_or_with_too_many_known_joints_are_refused() -> None:
 
 
 def test_branch_overrides_are_checked() -> None:
-    loops = find_loops(four_bar())
+    loops = find_loops(read_urdf(four_bar()))
     with pytest.raises(LoopError, match="branch given for 'pins'"):
         loops.plan(('crank_joint',), {'pins': 1})
     with pytest.raises(LoopError, match="constraint 'pin': branch 0 is not -1 or 1"):
@@ -305,11 +308,12 @@ def test_a_passive_loop_joint_with_a_mimic_is_warned_about() -> None:
     urdf = ROBOTS['parallelogram'].urdf().replace(
         '<axis xyz="0.0 0.0 -1.0"/>',
         '<axis xyz="0.0 0.0 -1.0"/><mimic joint="crank_joint" multiplier="-1.0"/>', 1)
-    plan = find_loops(urdf).plan(('crank_joint',))
+    plan = find_loops(read_urdf(urdf)).plan(('crank_joint',))
     assert plan.warnings == (
         "joint 'coupler_joint' (constraint 'follower_pin') is solved by its loop but also mimics "
         "'crank_joint': robot_state_publisher would pose it from two sources",)
-    assert find_loops(ROBOTS['parallelogram'].urdf()).plan(('crank_joint',)).warnings == ()
+    parallelogram = find_loops(read_urdf(ROBOTS['parallelogram'].urdf()))
+    assert parallelogram.plan(('crank_joint',)).warnings == ()
 
 
 # --- solving -------------------------------------------------------------------------------------
@@ -326,7 +330,7 @@ def _sweep(robot_name: str) -> list[dict[str, float]]:
 def test_solving_along_a_sweep_matches_the_reference(robot_name: str) -> None:
     robot = ROBOTS[robot_name]
     urdf = robot.urdf()
-    solver = LoopSolver(find_loops(urdf).plan(robot.measured_joints))
+    solver = LoopSolver(find_loops(read_urdf(urdf)).plan(robot.measured_joints))
     rates = {name: 0.3 + 0.2 * index for index, name in enumerate(robot.measured_joints)}
     guess: dict[str, float] = {}
     for measured in _sweep(robot_name):
@@ -344,7 +348,7 @@ def test_solving_along_a_sweep_matches_the_reference(robot_name: str) -> None:
 
 def test_a_refused_sample_leaves_the_solver_as_it_was() -> None:
     """The rocker reaches −31.4°…58.6° on this assembly: 86° is out of reach."""
-    solver = LoopSolver(find_loops(four_bar()).plan(('rocker_joint',)))
+    solver = LoopSolver(find_loops(read_urdf(four_bar())).plan(('rocker_joint',)))
     before = solver.solve({'rocker_joint': 0.2}, {'rocker_joint': 1.0})
     with pytest.raises(LoopSampleError, match=r"constraint 'pin' at rocker_joint = 1\.5: .*not "
                                               'reachable'):
@@ -368,7 +372,7 @@ def test_continuous_joints_stay_continuous_and_the_branch_holds_through_change_p
                     rocker_type='continuous').replace(
         '<parent_origin xyz="2 0.5 0"/>', '<parent_origin xyz="2 0 0"/>').replace(
         '<child_origin xyz="0 1.5 0"/>', '<child_origin xyz="0 1 0"/>')
-    solver = LoopSolver(find_loops(urdf).plan(('crank_joint',)))
+    solver = LoopSolver(find_loops(read_urdf(urdf)).plan(('crank_joint',)))
     # steps of 3°, landing exactly on the change points at 90° and 270° (all four pins in line)
     for step in range(1, 241):
         crank = math.radians(3.0 * step)
@@ -390,8 +394,8 @@ def test_a_wrapping_encoder_keeps_the_branch_where_a_turn_has_one_change_point()
     start = -1.5
     # the zero pose's branch from which the solver reaches +1 at the first sample
     zero_branch = int(continued_branch(kite, start, 1, 0.0))
-    solver = LoopSolver(find_loops(urdf_text(kite)).plan(('crank_joint',),
-                                                         {'pivot_c': zero_branch}))
+    solver = LoopSolver(find_loops(read_urdf(urdf_text(kite))).plan(
+        ('crank_joint',), {'pivot_c': zero_branch}))
     for step in range(240):
         alpha = start + math.radians(3.0 * step)
         wrapped = math.remainder(alpha, 2.0 * math.pi)
@@ -408,7 +412,7 @@ def test_a_wrapping_encoder_keeps_the_branch_where_a_turn_has_one_change_point()
 
 def test_the_branch_override_picks_the_other_assembly() -> None:
     urdf = four_bar()
-    loops = find_loops(urdf)
+    loops = find_loops(read_urdf(urdf))
     default = LoopSolver(loops.plan(('crank_joint',))).solve({'crank_joint': 0.0},
                                                              {'crank_joint': 0.0})[0]
     assert default == pytest.approx({'coupler_joint': 0.0, 'rocker_joint': 0.0}, abs=1e-12)

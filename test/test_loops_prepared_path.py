@@ -19,17 +19,18 @@ import math
 from typing import Any
 
 from builtin_interfaces.msg import Time
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.kinematics.geometry import TWO_PI
 from linkage_kinematics.kinematics.planar_loop import JointKind
-from linkage_kinematics.ros.messages import JointStateEncoder
-from linkage_kinematics.run.robot_loops import (
+from linkage_kinematics.loops.follower import (
     LoopDrop,
-    LoopRejection,
     LoopSample,
-    read_loops,
     RobotLoopsFollower,
 )
+from linkage_kinematics.loops.intake import DropReason
+from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf
+from linkage_kinematics.ros.messages import JointStateEncoder
+from linkage_kinematics.shared.cdr import encode_cdr
 from loop_robots import ROBOTS
 from loops_per_call import ReferenceFollower
 import pytest
@@ -85,8 +86,8 @@ def sweep(name: str, revolute: bool) -> list[tuple[int, list[str], list[float], 
 @pytest.mark.parametrize('name', sorted(ROBOTS))
 def test_the_prepared_path_gives_the_per_call_paths_bits(name: str) -> None:
     """Every sample, drop and estimate of the sweep equals the reference's, float bits too."""
-    follower = RobotLoopsFollower(read_loops(ROBOTS[name].urdf()), ROBOTS[name].measured_joints,
-                                  {}, math.pi / 2)
+    follower = RobotLoopsFollower(read_loops(read_urdf(ROBOTS[name].urdf())),
+                                  ROBOTS[name].measured_joints, {}, math.pi / 2)
     reference = ReferenceFollower(follower)
     revolute = follower.plan.loops[0].known.kind is JointKind.REVOLUTE
     reasons = set()
@@ -106,16 +107,16 @@ def test_the_prepared_path_gives_the_per_call_paths_bits(name: str) -> None:
         assert isinstance(got, LoopSample)
         assert bits(vars(got)) == bits(vars(expected))
     # the sweep reached every refusal it means to (a reference that never refuses proves less)
-    assert reasons == {LoopRejection.NON_FINITE, LoopRejection.STAMP_NOT_NEWER,
-                       LoopRejection.JUMP if revolute else LoopRejection.UNREACHABLE}
+    assert reasons == {DropReason.NON_FINITE, DropReason.STAMP_NOT_NEWER,
+                       DropReason.JUMP if revolute else DropReason.JOINTS_UNREACHABLE}
 
 
 @pytest.mark.parametrize('name', sorted(ROBOTS))
 @pytest.mark.parametrize('stamp_ns', [0, 1_700_000_000_123_456_789, -1_500_000_001])
 def test_the_output_encoder_writes_encode_cdrs_bytes(name: str, stamp_ns: int) -> None:
     """The prepared joint_states bytes equal encode_cdr of the message built field by field."""
-    follower = RobotLoopsFollower(read_loops(ROBOTS[name].urdf()), ROBOTS[name].measured_joints,
-                                  {}, math.pi / 2)
+    follower = RobotLoopsFollower(read_loops(read_urdf(ROBOTS[name].urdf())),
+                                  ROBOTS[name].measured_joints, {}, math.pi / 2)
     encoder = None
     for stamp, names, positions, velocities in sweep(name, False)[:SAMPLES:37]:
         sample = follower.follow(stamp, names, positions, velocities)

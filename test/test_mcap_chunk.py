@@ -21,7 +21,6 @@ import re
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from linkage_kinematics.bag import writer as writer_module
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.mcap_chunk import (
     message_record,
@@ -31,6 +30,7 @@ from linkage_kinematics.bag.mcap_chunk import (
 )
 from linkage_kinematics.bag.metadata import offered_qos_profiles_for
 from linkage_kinematics.bag.writer import BagWriter
+from linkage_kinematics.shared.cdr import encode_cdr
 from mcap._chunk_builder import ChunkBuilder
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer

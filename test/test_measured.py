@@ -27,10 +27,11 @@ import xml.etree.ElementTree as ElementTree
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from linkage_kinematics.kinematics.geometry import FourBar, preset, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates
+from linkage_kinematics.loops.intake import DropReason, FOUR_BAR_DROPS
 from linkage_kinematics.model.joints import Driver, JointStream, Link, TREE_ORDER
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.run.configuration import build_configuration, SourceKind
-from linkage_kinematics.run.measured import MeasuredFollower, Rejection
+from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
 from node_process import (
     Listener,
@@ -435,11 +436,12 @@ def test_bad_samples_are_dropped_counted_and_named_and_nothing_is_nan(context, n
     assert_stamps_are_the_inputs(run, samples, ('coupler_joint', 'rocker_joint'))
     warnings = ' '.join(status.message for status in statuses()
                         if status.level == DiagnosticStatus.WARN)
-    for rejection in Rejection:
+    for rejection in FOUR_BAR_DROPS:
         assert rejection.value in warnings
     values = {item.key: item.value for item in statuses()[-1].values}
-    expected = {Rejection.NON_FINITE: 2, Rejection.NO_DRIVER: 1, Rejection.STAMP_NOT_NEWER: 2,
-                Rejection.UNREACHABLE: 1, Rejection.JUMP: 1, Rejection.MALFORMED: 1}
+    expected = {DropReason.NON_FINITE: 2, DropReason.NO_DRIVER: 1,
+                DropReason.STAMP_NOT_NEWER: 2, DropReason.DRIVER_UNREACHABLE: 1,
+                DropReason.JUMP: 1, DropReason.MALFORMED: 1}
     for rejection, count in expected.items():
         assert values[f'dropped {rejection.value}'] == str(count)
     assert values['dropped samples'] == '8'
@@ -460,9 +462,10 @@ def test_the_lab_parameters_file_is_the_mapping_tested_here_and_a_valid_configur
     assert {name: values[name] for name in LAB_JOINTS} == LAB_JOINTS
     defaults = {spec.name: spec.default for spec in parameter_specs(values['preset'])}
     config = build_configuration({**defaults, **values})
-    assert (config.source, config.driver, config.publish_robot_description) == (
+    joints = config.joints
+    assert (joints.source, joints.driver, joints.publish_robot_description) == (
         SourceKind.MEASURED, Driver.CRANK, False)
-    # The README's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
+    # docs/following_loops.md's worked example: at α = 0.5 rad the encoder reads −0.1 rad.
     state = MeasuredFollower(config).follow(1, ['knee_motor'], [-0.1], [1.0]).state
     assert state.alpha == pytest.approx(0.5, abs=1e-15)
     assert math.remainder(state.gamma - state.alpha - 0.2, TWO_PI) == pytest.approx(
@@ -484,17 +487,17 @@ def test_the_nodes_urdf_closes_the_loop_at_the_published_values_for_each_driver(
     defaults = {spec.name: spec.default for spec in parameter_specs('grashof_crank_rocker')}
     config = build_configuration({**defaults, **mapping, 'source': 'measured',
                                   'driver': driver.value})
-    linkage = config.linkage
-    urdf = urdf_text(linkage, config.frame_id, config.joints, driver)
+    linkage = config.geometry.linkage
+    urdf = urdf_text(linkage, config.outputs.frame_id, config.joints.lab, driver)
     order = TREE_ORDER[driver]
-    names = config.joints.names(order)
+    names = config.joints.lab.names(order)
     assert {joint.get('name') for joint in ElementTree.fromstring(urdf).iter('joint')} == set(
         names)
-    stream = JointStream(config.joints, driver, include_driver=False)
+    stream = JointStream(config.joints.lab, driver, include_driver=False)
     assert stream.names == names[1:]
-    driver_mapping = config.joints[Link(driver.value)]
+    driver_mapping = config.joints.lab[Link(driver.value)]
     follower = MeasuredFollower(config)
-    interval = config.driven_linkage.reachability.intervals[0]
+    interval = config.geometry.driven_linkage.reachability.intervals[0]
     low, high = interval
     span = high - low if high - low < TWO_PI else TWO_PI
     end = (linkage.rocker_length, (linkage.ground_x, linkage.ground_y)) if (

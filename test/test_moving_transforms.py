@@ -20,7 +20,6 @@ import math
 import random
 import struct
 
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.model.joints import Driver, JointMap, JointMapping
 from linkage_kinematics.model.robot_transforms import (
@@ -30,7 +29,9 @@ from linkage_kinematics.model.robot_transforms import (
     Transform,
 )
 from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.ros import messages
+from linkage_kinematics.shared.cdr import encode_cdr
 import pytest
 from test_bag_transforms import EVERY_JOINT_URDF, moving_transforms
 
@@ -147,8 +148,9 @@ def random_positions(robot: RobotTransforms, names: list[str],
 
 def check_against_reference(urdf: str, names: list[str], seed: int) -> int:
     """Check every sample's transforms and /tf bytes; return how many transforms were checked."""
-    robot = RobotTransforms(urdf, 'robot_1/')
-    tf = messages.RobotStateTransforms(urdf, 'robot_1/')
+    tree = read_urdf(urdf)
+    robot = RobotTransforms(tree, 'robot_1/')
+    tf = messages.RobotStateTransforms(tree, 'robot_1/')
     checked = 0
     for positions in random_positions(robot, names, random.Random(seed)):
         expected = reference_transforms(robot, positions)
@@ -168,7 +170,7 @@ def test_node_urdf_transforms_and_bytes_are_the_generic_ones(
     driver: Driver, joints: JointMap
 ) -> None:
     urdf = urdf_text(preset('paper').geometry, 'linkage_base', joints, driver)
-    names = list(RobotTransforms(urdf).joints)
+    names = list(RobotTransforms(read_urdf(urdf)).joints)
     assert len(names) == 3
     assert check_against_reference(urdf, names, seed=7) == 3 * SAMPLES
 
@@ -190,8 +192,9 @@ def test_varied_urdf_transforms_and_bytes_are_the_generic_ones(
 
 
 def test_new_names_prepare_new_transforms() -> None:
-    tf = messages.RobotStateTransforms(MIMIC_URDF, '')
-    robot = RobotTransforms(MIMIC_URDF)
+    tree = read_urdf(MIMIC_URDF)
+    tf = messages.RobotStateTransforms(tree, '')
+    robot = RobotTransforms(tree)
     for positions in ({'slide': 0.3, 'drive': 1.0}, {'c_late': -0.5, 'drive': 2.0},
                       {'slide': 0.3, 'drive': 1.0, 'unknown': 5.0}, {'slide': 0.1}):
         assert tf.message(positions, STAMP_NS) == encode_cdr(
@@ -201,8 +204,9 @@ def test_new_names_prepare_new_transforms() -> None:
 @pytest.mark.parametrize('urdf', [EVERY_JOINT_URDF, MIMIC_URDF])
 def test_the_whole_trees_tf_is_the_generic_one(urdf: str) -> None:
     """``tree_message`` of every driven joint's position in order: the reference's bytes."""
-    tf = messages.RobotStateTransforms(urdf, 'robot_1/')
-    robot = RobotTransforms(urdf, 'robot_1/')
+    tree = read_urdf(urdf)
+    tf = messages.RobotStateTransforms(tree, 'robot_1/')
+    robot = RobotTransforms(tree, 'robot_1/')
     names = list(tf.driven_joints)
     assert len(names) >= 2
     for positions in random_positions(robot, names, random.Random(5)):

@@ -359,32 +359,32 @@ def test_loop_over_whole_turns_keeps_counting_alpha():
     config = _configuration(
         preset='grashof_crank_rocker', rocker_length=crank_rocker.rocker_length,
         ground_x=crank_rocker.ground_x, alpha_end=2.0 * TWO_PI, end_behavior='loop', k=0.1)
-    assert config.whole_turns
-    duration = config.segment_duration
+    assert config.motion.whole_turns
+    duration = config.motion.segment_duration
     sample = sample_at_time(config, 2.25 * duration)
     assert sample.turn_offset == 2.0 * 2.0 * TWO_PI
-    assert sample.alpha == config.drive.alpha_at(0.0, 2.25 * duration - 2.0 * duration)
+    assert sample.alpha == config.motion.drive.alpha_at(0.0, 2.25 * duration - 2.0 * duration)
     state = solve_sample(config, sample)
     assert state.alpha == sample.alpha + 4.0 * TWO_PI
-    assert state.omega == config.drive.angular_velocity(sample.alpha)
+    assert state.omega == config.motion.drive.angular_velocity(sample.alpha)
 
-    steps = sample_at_step(config, config.step_count + 3)
-    assert steps.alpha == 3 * config.alpha_step
+    steps = sample_at_step(config, config.motion.step_count + 3)
+    assert steps.alpha == 3 * config.motion.alpha_step
     assert steps.turn_offset == 2.0 * TWO_PI
 
 
 def test_loop_over_part_of_a_turn_restarts_at_alpha_start():
     config = _configuration(end_behavior='loop')
-    assert not config.whole_turns
-    sample = sample_at_time(config, config.segment_duration * 1.5)
+    assert not config.motion.whole_turns
+    sample = sample_at_time(config, config.motion.segment_duration * 1.5)
     assert sample.alpha == pytest.approx(math.pi / 4.0, abs=1e-15)
     assert sample.turn_offset == 0.0
-    assert sample_at_step(config, config.step_count + 1).alpha == 0.0
+    assert sample_at_step(config, config.motion.step_count + 1).alpha == 0.0
 
 
 def test_bounce_plays_the_pass_backwards_with_negated_rates():
     config = _configuration(end_behavior='bounce', k=0.3)
-    duration = config.segment_duration
+    duration = config.motion.segment_duration
     forward = sample_at_time(config, 0.25 * duration)
     backward = sample_at_time(config, 1.75 * duration)
     assert not forward.is_reversed and backward.is_reversed
@@ -396,9 +396,9 @@ def test_bounce_plays_the_pass_backwards_with_negated_rates():
     assert back.omega_dot == pytest.approx(ahead.omega_dot, rel=1e-15)
     assert back.acceleration_b_y == pytest.approx(ahead.acceleration_b_y, rel=1e-12)
     # Fixed steps: out to alpha_end, back towards alpha_start, out again.
-    end_index = config.step_count
+    end_index, alpha_step = config.motion.step_count, config.motion.alpha_step
     assert sample_at_step(config, end_index).alpha == math.pi / 2.0
-    assert sample_at_step(config, end_index + 1).alpha == (end_index - 1) * config.alpha_step
+    assert sample_at_step(config, end_index + 1).alpha == (end_index - 1) * alpha_step
     assert sample_at_step(config, end_index + 1).is_reversed
     assert sample_at_step(config, 2 * end_index).alpha == 0.0
 
@@ -407,17 +407,17 @@ def test_stop_ends_exactly_at_alpha_end_or_not_at_all_at_a_dead_point():
     config = _configuration(end_behavior='stop')
     final = sample_at_time(config, 10.0)
     assert final.final and final.alpha == math.pi / 2.0
-    assert final.motion_time == config.segment_duration
-    last = sample_at_step(config, config.step_count)
+    assert final.motion_time == config.motion.segment_duration
+    last = sample_at_step(config, config.motion.step_count)
     assert last.final and last.alpha == math.pi / 2.0
-    assert config.step_count == 180
+    assert config.motion.step_count == 180
     assert sample_at_step(config, 179).alpha == 179 * math.radians(0.5)
 
     blocked = _configuration(end_behavior='stop', omega0=-1.0, alpha_end=-0.5)
-    assert blocked.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
-    assert sample_at_time(blocked, blocked.segment_duration) is None
-    assert sample_at_step(blocked, blocked.step_count) is None
-    assert not sample_at_step(blocked, blocked.step_count - 1).final
+    assert blocked.motion.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
+    assert sample_at_time(blocked, blocked.motion.segment_duration) is None
+    assert sample_at_step(blocked, blocked.motion.step_count) is None
+    assert not sample_at_step(blocked, blocked.motion.step_count - 1).final
 
 
 # --- URDF -----------------------------------------------------------------------------------
@@ -479,5 +479,6 @@ def test_launch_configs_hold_the_seed_scenarios():
         text = (REPOSITORY / 'config' / f'seed_{name}.yaml').read_text()
         parameters = yaml.safe_load(text)['/**/linkage_node']['ros__parameters']
         config = _configuration(**parameters)
-        assert (config.drive, config.alpha_start, config.alpha_end, config.end_behavior) == (
+        motion = config.motion
+        assert (motion.drive, motion.alpha_start, motion.alpha_end, motion.end_behavior) == (
             DriveLaw(omega0, k), 0.0, math.pi / 2.0, 'stop')

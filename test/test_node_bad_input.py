@@ -109,22 +109,23 @@ ACCEPTED = {
 ACCEPTED_IN_CONTEXT = [{'ground_x': 0.0, 'ground_y': -1.3}, {'ground_x': 0, 'ground_y': -1.3}]
 # Where an accepted value shows in the configuration.
 CONFIGURED = {
-    'ground_x': lambda config: config.linkage.ground_x,
-    'ground_y': lambda config: config.linkage.ground_y,
-    'branch': lambda config: config.branch,
-    'omega0': lambda config: config.drive.omega0,
-    'k': lambda config: config.drive.k,
-    'alpha_start': lambda config: config.alpha_start,
-    'alpha_end': lambda config: config.alpha_end,
-    'diagnostics.min_transmission_angle': lambda config: config.min_transmission_angle,
-    'diagnostics.dead_point_warning': lambda config: config.dead_point_warning,
-    'cpu_affinity': lambda config: config.cpu_affinity,
+    'ground_x': lambda config: config.geometry.linkage.ground_x,
+    'ground_y': lambda config: config.geometry.linkage.ground_y,
+    'branch': lambda config: config.motion.branch,
+    'omega0': lambda config: config.motion.drive.omega0,
+    'k': lambda config: config.motion.drive.k,
+    'alpha_start': lambda config: config.motion.alpha_start,
+    'alpha_end': lambda config: config.motion.alpha_end,
+    'diagnostics.min_transmission_angle': lambda config: config.outputs.min_transmission_angle,
+    'diagnostics.dead_point_warning': lambda config: config.outputs.dead_point_warning,
+    'cpu_affinity': lambda config: config.logging.cpu_affinity,
     **{f'joints.{link}.{field}': (
-        lambda config, link=link, field=field: getattr(getattr(config.joints, link), field))
+        lambda config, link=link, field=field: getattr(getattr(config.joints.lab, link), field))
        for link in ('crank', 'coupler', 'rocker') for field in ('direction', 'offset')},
-    'measured.acceleration_time_constant': lambda config: config.acceleration_time_constant,
-    'log.max_bag_size': lambda config: config.log_max_bag_size,
-    'log.max_bag_duration': lambda config: config.log_max_bag_duration,
+    'measured.acceleration_time_constant':
+        lambda config: config.measured.acceleration_time_constant,
+    'log.max_bag_size': lambda config: config.logging.max_bag_size,
+    'log.max_bag_duration': lambda config: config.logging.max_bag_duration,
 }
 
 
@@ -180,7 +181,7 @@ def test_build_configuration_refuses_each_bad_value_naming_its_parameter(name, b
 @pytest.mark.parametrize('overrides', ACCEPTED_IN_CONTEXT)
 def test_values_valid_in_their_context_are_accepted(overrides):
     config = build_configuration(configuration_values(**overrides))
-    assert (config.linkage.ground_x, config.linkage.ground_y) == (0.0, -1.3)
+    assert (config.geometry.linkage.ground_x, config.geometry.linkage.ground_y) == (0.0, -1.3)
 
 
 # --- start-up: one node process per class of bad value -----------------------------------------
@@ -316,18 +317,18 @@ def _finite(message) -> bool:
 def test_passes_cut_short_by_a_dead_point_are_counted_as_meetings():
     bounce = build_configuration(configuration_values(
         omega0=-1.0, alpha_end=-0.1, end_behavior='bounce', **{'log.enabled': False}))
-    assert bounce.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
-    duration = bounce.segment_duration
+    assert bounce.motion.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
+    duration = bounce.motion.segment_duration
     samples = [sample_at_time(bounce, fraction * duration) for fraction in (0.5, 1.5, 2.5, 3.5)]
     assert [sample.pass_index for sample in samples] == [0, 1, 2, 3]
     assert [sample.is_reversed for sample in samples] == [False, True, False, True]
-    last_out = sample_at_step(bounce, bounce.step_count - 1)
-    first_back = sample_at_step(bounce, bounce.step_count)
+    last_out = sample_at_step(bounce, bounce.motion.step_count - 1)
+    first_back = sample_at_step(bounce, bounce.motion.step_count)
     assert (last_out.pass_index, first_back.pass_index) == (0, 1) and first_back.is_reversed
     # Bounce meets the dead point at the end of each forward pass only; loop at every pass end.
     assert met_dead_point(bounce, 0, 1) and met_dead_point(bounce, 1, 3)
     assert not met_dead_point(bounce, 1, 2) and not met_dead_point(bounce, 2, 2)
-    loop = replace(bounce, end_behavior='loop')
+    loop = replace(bounce, motion=replace(bounce.motion, end_behavior='loop'))
     assert sample_at_time(loop, 2.5 * duration).pass_index == 2
     assert met_dead_point(loop, 1, 2)
     clear = build_configuration(configuration_values(end_behavior='loop'))

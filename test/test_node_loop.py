@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The node's own URDF as a ``<constraint>`` loop, read by ``model.loops`` as a lab's would be.
+The node's own URDF as a ``<constraint>`` loop, read by ``loops.plan`` as a lab's would be.
 
 For each preset, each driver and each joint mapping: one four-bar loop without a problem, whose
 dimensions are the four-bar's; its constraint frames parallel at the zero pose and coinciding
@@ -12,11 +12,14 @@ the element is the only thing robot_state_publisher's reading of the text does n
 
 from __future__ import annotations
 
+from dataclasses import replace
 import math
 import re
 
 from linkage_kinematics.kinematics.geometry import FourBar, preset, PRESETS, TWO_PI
 from linkage_kinematics.kinematics.solver import CrankRates, DeadPointError, solve
+from linkage_kinematics.loops.intake import DropReason
+from linkage_kinematics.loops.plan import find_loops
 from linkage_kinematics.model.joints import (
     Driver,
     JointMap,
@@ -26,16 +29,17 @@ from linkage_kinematics.model.joints import (
     TREE_ORDER,
     tree_values,
 )
-from linkage_kinematics.model.loops import find_loops
 from linkage_kinematics.model.robot_transforms import RobotTransforms
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description, urdf_text
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
-from linkage_kinematics.run.measured import FollowedSample, MeasuredFollower, Rejection
+from linkage_kinematics.run.measured import FollowedSample, MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import loop_reference
 import numpy as np
 import pytest
 import urchin
+from urdf_parser_py import urdf as urdf_parser
 
 # The kite (a change-point linkage) is solved from its URDF, whose link vectors are rounded
 # components at the zero pose: within a few degrees of its change point the rates amplify that
@@ -72,7 +76,7 @@ def _lengths_in_loop_order(linkage: FourBar, driver: Driver) -> tuple[float, ...
 def test_the_nodes_urdf_has_one_four_bar_loop_of_the_linkages_dimensions(
         name: str, driver: Driver, mapping: str) -> None:
     urdf = _node_urdf(name, driver, mapping)
-    loops = find_loops(urdf)
+    loops = find_loops(read_urdf(urdf))
     assert (loops.problems, loops.parser_messages) == ((), ())
     (loop,) = loops.loops
     assert loop.constraint == ('pivot_c' if driver is Driver.CRANK else 'pivot_o')
@@ -123,8 +127,8 @@ def test_robot_state_publishers_reading_is_that_of_the_text_without_the_constrai
     without = urdf.replace(element, '')
     assert without.endswith('  </joint>\n</robot>\n')
     values = {name: 0.3 for name in LAB.names(TREE_ORDER[driver])}
-    with_constraint = RobotTransforms(urdf)
-    plain = RobotTransforms(without)
+    with_constraint = RobotTransforms(read_urdf(urdf))
+    plain = RobotTransforms(read_urdf(without))
     assert with_constraint.fixed_transforms() == plain.fixed_transforms()
     names = list(values)
     moving, plain_moving = with_constraint.moving(names), plain.moving(names)
@@ -157,7 +161,7 @@ def _config(geometry: str, driver: Driver, mapping: str, branch: int) -> RunConf
 
 def _sweep(config: RunConfiguration) -> list[float]:
     """Return driver angles (node convention) to and fro over its range, two turns if it turns."""
-    low, high = config.driven_linkage.reachability.intervals[0]
+    low, high = config.geometry.driven_linkage.reachability.intervals[0]
     if high - low >= TWO_PI:  # a full turn: two turns forwards, through any change points
         return [low + 2.0 * TWO_PI * index / 720 for index in range(721)]
     # close to both dead points (where the closed forms' own error grows as 1/√distance)
@@ -175,25 +179,25 @@ def test_the_followers_loop_joints_are_the_four_bar_mappings(
     """
     The follower's passive joints, solved by the node's loop, are the four-bar mapping's.
 
-    Solved through ``model.loops``, they are what ``JointStream`` gives of the closed-form
+    Solved through ``loops.solver``, they are what ``JointStream`` gives of the closed-form
     state, to 1e-12: over the driver's whole range (to 0.1 % of it from a dead point) on both
     branches, the driver's lab value wrapping at ±π; the velocities relative to their size
     (they grow without bound at the dead points).
     """
     config = _config(geometry, driver, mapping, branch)
-    driver_mapping = config.joints[Link(driver.value)]
+    driver_mapping = config.joints.lab[Link(driver.value)]
     follower = MeasuredFollower(config)
-    stream = JointStream(config.joints, driver, include_driver=True)
+    stream = JointStream(config.joints.lab, driver, include_driver=True)
     angles = _sweep(config)
     for index, angle in enumerate(angles):
         omega = 0.7 + 0.3 * math.cos(index)
         lab_angle = math.remainder(driver_mapping.to_lab(angle), TWO_PI)
         followed = follower.follow(index + 1, [driver_mapping.name], [lab_angle],
                                    [driver_mapping.direction * omega])
-        if followed is Rejection.UNREACHABLE:
+        if followed is DropReason.DRIVER_UNREACHABLE:
             # the kite's pin A on C: the closed form refuses it too (the motion is undetermined)
             with pytest.raises(DeadPointError, match='undetermined'):
-                solve(config.driven_linkage, angle, CrankRates(omega, 0.0), branch)
+                solve(config.geometry.driven_linkage, angle, CrankRates(omega, 0.0), branch)
             continue
         assert isinstance(followed, FollowedSample), (angle, followed)
         positions, velocities = stream.values(followed.state)
@@ -224,8 +228,8 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     """
     config = _config('grashof_crank_rocker', Driver.CRANK, 'lab', 1)
     follower = MeasuredFollower(config)
-    stream = JointStream(config.joints, Driver.CRANK, include_driver=True)
-    name = config.joints.crank.name
+    stream = JointStream(config.joints.lab, Driver.CRANK, include_driver=True)
+    name = config.joints.lab.crank.name
 
     def check(stamp: int, lab_angle: float) -> None:
         followed = follower.follow(stamp, [name], [lab_angle], [-1.0])
@@ -235,7 +239,7 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     for index in range(1, 80):  # a turn and a half of the crank, unwrapped by the stream
         check(index, math.remainder(0.4 - 0.12 * index, TWO_PI))
     smaller = build_configuration({**{spec.name: spec.default for spec in parameter_specs(
-        'grashof_crank_rocker')}, **{f'joints.{link}.{key}': getattr(config.joints[link], key)
+        'grashof_crank_rocker')}, **{f'joints.{link}.{key}': getattr(config.joints.lab[link], key)
                                      for link in TREE_ORDER[Driver.CRANK]
                                      for key in ('name', 'direction', 'offset')},
         'source': 'measured', 'crank_length': 0.25})
@@ -244,3 +248,31 @@ def test_a_new_geometry_is_a_new_loop_and_a_restart_keeps_the_joints_continuous(
     # the state is the new geometry's: the joints match it only if they come from its loop
     for index in range(80, 100):
         check(index, math.remainder(0.4 - 0.12 * index, TWO_PI))
+
+
+def test_the_nodes_description_is_parsed_once_for_its_loop_and_its_tf(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """
+    The measured mode's loop and the log's TF read one parse of the node's URDF text.
+
+    A follower, a second follower of the same joints, a new threshold and the outputs'
+    ``node_description`` (its tree gives /tf_static and /tf) parse the text once in all; a new
+    geometry is a new text, parsed once more.
+    """
+    parses = []
+    parse = urdf_parser.Robot.from_xml
+    monkeypatch.setattr(urdf_parser.Robot, 'from_xml',
+                        lambda *arguments: parses.append(arguments) or parse(*arguments))
+    node_description.cache_clear()
+    config = _config('grashof_crank_rocker', Driver.CRANK, 'lab', 1)
+    follower = MeasuredFollower(config)
+    MeasuredFollower(config)
+    follower.reconfigure(replace(config, measured=replace(config.measured, max_jump=0.5)))
+    parts = (config.geometry.linkage, config.outputs.frame_id, config.joints.lab,
+             config.joints.driver)
+    description = node_description(*parts)
+    assert description.text == urdf_text(*parts)
+    assert description.tree.joints.keys() == {'knee_motor', 'knee_link', 'knee_output'}
+    assert len(parses) == 1
+    MeasuredFollower(_config('kite', Driver.CRANK, 'lab', 1))
+    assert len(parses) == 2

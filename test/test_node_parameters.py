@@ -121,7 +121,7 @@ def test_the_descriptors_range_is_the_one_validated(spec):
     if spec.kind is Kind.REAL:
         (interval,) = descriptor.floating_point_range
         low, high = interval.from_value, interval.to_value
-        # The descriptor cannot show an open end: its description says it (README, Parameters).
+        # The descriptor cannot show an open end: its description says it (docs/parameters.md).
         open_low = 'greater than' in descriptor.description
         assert spec.interval.open_low == open_low
         bounds = (f'greater than {low:g} {spec.unit} and at most {high:g} {spec.unit}' if open_low
@@ -154,8 +154,8 @@ def test_an_integer_parameter_refuses_what_lies_between_its_off_value_and_its_ra
 SUPERSCRIPTS = str.maketrans('⁰¹²³⁴⁵⁶⁷⁸⁹', '0123456789')
 
 
-def readme_number(text: str) -> float:
-    """Return a bound as README writes it: 0, 10000, −10⁶, π/2, 2π."""
+def documented_number(text: str) -> float:
+    """Return a bound as docs/parameters.md writes it: 0, 10000, −10⁶, π/2, 2π."""
     sign, text = (-1.0, text[1:]) if text.startswith('−') else (1.0, text)
     power = re.fullmatch(r'10([⁰-⁹]+)', text)
     if power:
@@ -165,10 +165,10 @@ def readme_number(text: str) -> float:
     return sign * value
 
 
-def test_readme_states_each_real_parameters_range_as_validated():
-    """The README's Parameters table gives each real parameter's range as its spec has it."""
-    readme = (REPOSITORY / 'README.md').read_text(encoding='utf-8')
-    table = readme[readme.index('## Parameters'):readme.index('**Geometry.**')]
+def test_the_parameter_reference_states_each_real_parameters_range_as_validated():
+    """docs/parameters.md's table gives each real parameter's range as its spec has it."""
+    reference = (REPOSITORY / 'docs' / 'parameters.md').read_text(encoding='utf-8')
+    table = reference[reference.index('## Parameters'):reference.index('**Geometry.**')]
     stated = {}
     for row in table.splitlines():
         cells = row.split('|')
@@ -178,7 +178,8 @@ def test_readme_states_each_real_parameters_range_as_validated():
         for name in re.findall(r'`([^`]+)`', cells[1]):
             for link in Link:
                 stated[name.replace('<joint>', link.value)] = (
-                    readme_number(interval[2]), readme_number(interval[3]), interval[1] == '(')
+                    documented_number(interval[2]), documented_number(interval[3]),
+                    interval[1] == '(')
     reals = {spec.name: spec for spec in parameter_specs('') if spec.kind is Kind.REAL}
     assert set(reals) <= set(stated)
     for name, spec in reals.items():
@@ -203,28 +204,30 @@ def test_a_spec_without_what_its_kind_needs_is_refused():
 
 def test_defaults_are_the_seed_run_swinging_until_stopped():
     config = build_configuration(configuration_values())
-    assert config.linkage == PAPER
-    assert config.drive == DriveLaw(2.0, 0.0)
-    assert (config.alpha_start, config.alpha_end, config.end_behavior, config.mode) == (
+    assert config.geometry.linkage == PAPER
+    assert config.motion.drive == DriveLaw(2.0, 0.0)
+    motion = config.motion
+    assert (motion.alpha_start, motion.alpha_end, motion.end_behavior, motion.mode) == (
         0.0, math.pi / 2.0, 'bounce', 'real_time')
     assert config.autostart
-    assert config.blocked_at is None
-    assert config.segment_duration == math.pi / 4.0
+    assert config.motion.blocked_at is None
+    assert config.motion.segment_duration == math.pi / 4.0
     assert set(configuration_values()) == set(PARAMETER_NAMES)
 
 
 def test_explicit_geometry_overrides_the_preset_and_integers_are_accepted():
     config = build_configuration(configuration_values(crank_length=0.25, ground_x=1))
-    assert config.linkage == FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length, 1.0, 0.0)
+    assert config.geometry.linkage == FourBar(0.25, PAPER.coupler_length, PAPER.rocker_length,
+                                              1.0, 0.0)
     explicit = build_configuration(configuration_values(preset=''))
-    assert explicit.linkage == PAPER and explicit.preset == ''
+    assert explicit.geometry.linkage == PAPER and explicit.geometry.preset == ''
 
 
 def test_alpha_end_beyond_a_dead_point_runs_to_the_dead_point():
     config = build_configuration(configuration_values(omega0=-1.0, alpha_end=-1.0))
-    assert config.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
-    assert config.segment_end == config.blocked_at
-    assert config.segment_duration == DriveLaw(-1.0).time_to(0.0, config.blocked_at)
+    assert config.motion.blocked_at == pytest.approx(DEAD_POINT, abs=1e-15)
+    assert config.motion.segment_end == config.motion.blocked_at
+    assert config.motion.segment_duration == DriveLaw(-1.0).time_to(0.0, config.motion.blocked_at)
 
 
 # A lab's linkage whose crank can reach neither 0 nor 90° (only about 135°–315°): the drive
@@ -242,8 +245,9 @@ BEYOND_DEFAULTS = {'preset': '', 'crank_length': 0.3, 'coupler_length': 1.0,
 def test_measured_mode_does_not_check_the_drive_law(overrides):
     values = configuration_values(source='measured', **overrides)
     config = build_configuration(values)
-    assert config.source == 'measured'
-    assert (config.blocked_at, config.segment_duration, config.step_count) == (None, 0.0, 1)
+    assert config.joints.source == 'measured'
+    motion = config.motion
+    assert (motion.blocked_at, motion.segment_duration, motion.step_count) == (None, 0.0, 1)
     # The same values with the drive law are refused: the guard decides, not the values.
     with pytest.raises(ConfigurationError):
         build_configuration({**values, 'source': 'drive_law'})

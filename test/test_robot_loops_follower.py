@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-run.robot_loops and run.loop_diagnostics: a robot's loops followed message by message, no ROS.
+loops.follower and run.loop_diagnostics: a robot's loops followed message by message, no ROS.
 
 The follower's answers are checked against test/loop_reference.py (mpmath, sharing nothing with
 the package); its refusals, one by one, name the loops they concern; the statuses say so.
@@ -13,20 +13,21 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from linkage_kinematics.model.loop_urdf import LoopError
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.follower import (
+    LoopDrop,
+    LoopSample,
+    RobotLoopsFollower,
+)
+from linkage_kinematics.loops.intake import DropReason, Estimate
+from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
-from linkage_kinematics.run.measured import Estimate
+from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
-from linkage_kinematics.run.robot_loops import (
-    LoopDrop,
-    LoopRejection,
-    LoopSample,
-    read_loops,
-    RobotLoopsFollower,
-)
 import loop_reference
 from loop_robots import ROBOTS
 import pytest
@@ -40,7 +41,7 @@ CYLINDERS = list(ROBOTS['excavator'].measured_joints)
 
 def follower(urdf: str, measured: tuple[str, ...] = (), max_jump: float = math.pi / 2,
              branches: dict[str, int] | None = None) -> RobotLoopsFollower:
-    return RobotLoopsFollower(read_loops(urdf), measured, branches or {}, max_jump)
+    return RobotLoopsFollower(read_loops(read_urdf(urdf)), measured, branches or {}, max_jump)
 
 
 def test_the_knee_without_velocities_is_estimated_and_matches_the_reference() -> None:
@@ -81,14 +82,14 @@ def test_bad_samples_are_dropped_naming_their_loops_and_leave_the_motion_as_it_w
     good = excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], [0.1, 0.0, 0.0])
     assert isinstance(good, LoopSample)
     drops = [
-        (excavator.follow(2, CYLINDERS[:2], [0.0, 0.0], []), LoopRejection.NO_JOINT,
+        (excavator.follow(2, CYLINDERS[:2], [0.0, 0.0], []), DropReason.NO_JOINT,
          ('bucket_cylinder_pin',)),
-        (excavator.follow(2, CYLINDERS, [0.0, math.inf, 0.0], []), LoopRejection.NON_FINITE,
+        (excavator.follow(2, CYLINDERS, [0.0, math.inf, 0.0], []), DropReason.NON_FINITE,
          ('stick_cylinder_pin',)),
         (excavator.follow(2, CYLINDERS, [0.0, 0.0, 0.0], [math.nan, 0.0, 0.0]),
-         LoopRejection.NON_FINITE, ('boom_cylinder_pin',)),
-        (excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], []), LoopRejection.STAMP_NOT_NEWER, ()),
-        (excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []), LoopRejection.UNREACHABLE,
+         DropReason.NON_FINITE, ('boom_cylinder_pin',)),
+        (excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], []), DropReason.STAMP_NOT_NEWER, ()),
+        (excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []), DropReason.JOINTS_UNREACHABLE,
          ('boom_cylinder_pin',)),
     ]
     for drop, reason, constraints in drops:
@@ -104,7 +105,7 @@ def test_bad_samples_are_dropped_naming_their_loops_and_leave_the_motion_as_it_w
     knee = follower(KNEE, max_jump=0.5)
     knee.follow(1, ['knee_front'], [0.0], [])
     jump = knee.follow(2, ['knee_front'], [0.6], [])
-    assert (jump.reason, jump.constraints) == (LoopRejection.JUMP, ('knee_rear_pin',))
+    assert (jump.reason, jump.constraints) == (DropReason.JUMP, ('knee_rear_pin',))
 
 
 def test_measured_joints_come_from_the_first_message_and_own_output_is_ignored() -> None:
@@ -125,16 +126,25 @@ def test_measured_joints_come_from_the_first_message_and_own_output_is_ignored()
         follower(KNEE, ('nothing',))
 
 
+def test_a_joint_named_twice_counts_at_its_first_place_in_both_modes() -> None:
+    """As robot_state_publisher reads a joint state: its map keeps a name's first position."""
+    twice, once = follower(KNEE, ('knee_front',)), follower(KNEE, ('knee_front',))
+    sample = twice.follow(1, ['knee_front', 'knee_front'], [0.1, 0.3], [0.5, 0.7])
+    assert sample == once.follow(1, ['knee_front'], [0.1], [0.5])
+    crank = build_configuration({**{spec.name: spec.default for spec in parameter_specs('paper')},
+                                 'source': 'measured', 'log.enabled': False})
+    followed = MeasuredFollower(crank).follow(1, ['crank_joint', 'crank_joint'], [0.1, 0.3], [])
+    assert followed.joints == MeasuredFollower(crank).follow(1, ['crank_joint'], [0.1], []).joints
+
+
 def test_descriptions_that_cannot_be_closed_are_refused_in_one_line() -> None:
     broken = KNEE.replace('<constraint name="knee_rear_pin" type="revolute">',
                           '<constraint name="knee_rear_pin" type="prismatic">')
     with pytest.raises(LoopError, match='knee_rear_pin') as refusal:
-        read_loops(broken)
+        read_loops(read_urdf(broken))
     assert '\n' not in str(refusal.value)
     with pytest.raises(LoopError, match="robot 'plain' has no <constraint> loop to close"):
-        read_loops('<robot name="plain"><link name="a"/></robot>')
-    with pytest.raises(LoopError):
-        read_loops('not a robot')
+        read_loops(read_urdf('<robot name="plain"><link name="a"/></robot>'))
 
 
 def test_a_branch_override_picks_the_other_assembly() -> None:
@@ -159,8 +169,8 @@ def configuration(**overrides: Any) -> Any:
 def test_the_loop_parameters_are_validated_naming_them() -> None:
     config = configuration(**{'loops.branches': ['knee_rear_pin=-1', 'b=+1'],
                               'loops.measured_joints': ['knee_front']})
-    assert config.loop_branches == (('knee_rear_pin', -1), ('b', 1))
-    assert config.loop_measured_joints == ('knee_front',)
+    assert config.loops.branches == (('knee_rear_pin', -1), ('b', 1))
+    assert config.loops.measured_joints == ('knee_front',)
     for name, value, message in (
             ('loops.branches', ['pin=2'], "entry 'pin=2' is not CONSTRAINT=1 or CONSTRAINT=-1"),
             ('loops.branches', ['a=1', 'a=-1'], 'gives a constraint more than one branch'),
@@ -190,7 +200,8 @@ def test_the_statuses_say_what_each_loop_does_and_what_was_dropped() -> None:
     excavator = follower(EXCAVATOR, tuple(CYLINDERS))
     health = LoopsHealth(0)
     health.accept(0, excavator.follow(1, CYLINDERS, [0.0, 0.0, 0.0], [0.1, 0.2, 0.3]))
-    health.drop(excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], []))
+    drop = excavator.follow(2, CYLINDERS, [5.0, 0.0, 0.0], [])
+    health.drop(drop.reason, drop.constraints)
     node, *loops = statuses(health, excavator.plan)
     assert [status.task for status in loops] == [
         f'loop {planned.loop.constraint}' for planned in excavator.plan.loops]

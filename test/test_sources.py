@@ -18,13 +18,10 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import TreeValues
+from linkage_kinematics.ros.drive_law_source import DriveLawTimer
 from linkage_kinematics.ros.exit_codes import ExitCode
-from linkage_kinematics.ros.sources import (
-    DriveLawTimer,
-    MeasuredSubscription,
-    RunStatus,
-    SourceHost,
-)
+from linkage_kinematics.ros.measured_source import MeasuredSubscription
+from linkage_kinematics.ros.source import RunStatus, SourceHost
 from linkage_kinematics.run.configuration import build_configuration, RunConfiguration
 from linkage_kinematics.run.control import RunControl
 from linkage_kinematics.run.motion import dead_point_problem
@@ -167,7 +164,7 @@ def test_the_first_state_comes_after_its_scene_and_the_status_that_says_it_moves
                            ('state', 0.0, START_NS, 0.0)]
     host.clock_ns += PERIOD_NS
     timer.callback()
-    alpha = host.config.drive.alpha_at(0.0, 0.01)
+    alpha = host.config.motion.drive.alpha_at(0.0, 0.01)
     assert host.take() == [('state', pytest.approx(alpha, abs=1e-15), START_NS + PERIOD_NS,
                             pytest.approx(0.01, abs=1e-15))]
     assert not host.finished
@@ -177,14 +174,14 @@ def test_the_final_state_of_stop_ends_the_run_with_the_log_flushed_before_the_la
     host, source = hosted(end_behavior='stop')
     source.start()
     host.take()
-    duration = host.config.segment_duration
+    duration = host.config.motion.segment_duration
     host.clock_ns = START_NS + round(duration * 1e9) + 3 * PERIOD_NS
     host.timers[0].callback()
     stopped = 'reached alpha_end = 90.000000°; stopped'
     # The final state is stamped when the drive law reaches alpha_end, not at the late tick.
     assert host.take() == [
-        ('state', host.config.alpha_end, START_NS + round(duration * 1e9), duration),
-        ('log info', stopped), ('scene', host.config.alpha_end), ('flush log',),
+        ('state', host.config.motion.alpha_end, START_NS + round(duration * 1e9), duration),
+        ('log info', stopped), ('scene', host.config.motion.alpha_end), ('flush log',),
         ('status', stopped, None)]
     assert host.exit_code is ExitCode.OK
     host.clock_ns += PERIOD_NS
@@ -194,10 +191,10 @@ def test_the_final_state_of_stop_ends_the_run_with_the_log_flushed_before_the_la
 
 def test_a_dead_point_before_alpha_end_under_stop_fails_the_run():
     host, source = hosted(end_behavior='stop', alpha_end=4.0)
-    assert host.config.blocked_at == pytest.approx(3.1754688640491766)
+    assert host.config.motion.blocked_at == pytest.approx(3.1754688640491766)
     source.start()
     host.take()
-    host.clock_ns = START_NS + round((host.config.segment_duration + 0.5) * 1e9)
+    host.clock_ns = START_NS + round((host.config.motion.segment_duration + 0.5) * 1e9)
     host.timers[0].callback()
     problem = dead_point_problem(host.config)
     assert problem.endswith('it stops; the run cannot go on')

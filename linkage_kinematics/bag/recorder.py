@@ -21,14 +21,14 @@ from collections.abc import Sequence, Set
 from pathlib import Path
 from typing import Any
 
-from linkage_kinematics.bag.cdr import ros_type_name
 from linkage_kinematics.bag.definitions import message_definition
 from linkage_kinematics.bag.metadata import (
     offered_qos_profiles_for,
     TRANSIENT_LOCAL,
 )
 from linkage_kinematics.bag.writer_process import BagWriterProcess
-from linkage_kinematics.run.limits import NO_SPLIT
+from linkage_kinematics.shared.cdr import ros_type_name
+from linkage_kinematics.shared.rosbag2_split import NO_SPLIT
 
 # A topic to record: its resolved name, rclpy message class, QoS profile and whether its latest
 # message starts every file (None: if the QoS is transient local).

@@ -6,7 +6,7 @@ The layout of ``linkage/state``: which coordinate each joint name carries, both 
 
 A ``trajectory_msgs/JointTrajectory`` with one point whose ``positions``, ``velocities`` and
 ``accelerations`` are each coordinate of ``STATE_JOINT_NAMES`` and its first and second time
-derivatives (README, "Topics"): α, β, γ, A_x, A_y, B_x, B_y, then the rocker angle
+derivatives (docs/parameters.md, "Topics"): α, β, γ, A_x, A_y, B_x, B_y, then the rocker angle
 θ_BC = π − β (rates ω_BC, ω̇_BC) and the pins' arc coordinates OA·α (rate V_A = OA·ω) and
 BC·β (rate V_B = −BC·ω_BC), so that every quantity of the paper is one plain field.
 ``state_coordinates`` maps a state onto them (the node's encoder writes these),

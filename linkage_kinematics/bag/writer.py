@@ -54,7 +54,7 @@ from linkage_kinematics.bag.metadata import (
     TopicInfo,
 )
 from linkage_kinematics.bag.repeated import RepeatedTopics
-from linkage_kinematics.run.limits import MIN_SPLIT_SIZE, NO_SPLIT
+from linkage_kinematics.shared.rosbag2_split import MIN_SPLIT_SIZE, NO_SPLIT
 from mcap.data_stream import RecordBuilder
 from mcap.opcode import Opcode
 from mcap.records import (

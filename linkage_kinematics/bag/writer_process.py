@@ -43,8 +43,8 @@ from typing import Any, BinaryIO
 from linkage_kinematics.bag.errors import BagError, BagExistsError, LogFolderError
 from linkage_kinematics.bag.mcap_chunk import message_header
 from linkage_kinematics.bag.writer import BagWriter
-from linkage_kinematics.run.limits import NO_SPLIT
-from linkage_kinematics.run.placement import set_process_affinity
+from linkage_kinematics.shared.affinity import set_process_affinity
+from linkage_kinematics.shared.rosbag2_split import NO_SPLIT
 
 _FRAME = struct.Struct('<cI')
 START, TOPIC, MESSAGES, FLUSH = b'S', b'T', b'M', b'F'

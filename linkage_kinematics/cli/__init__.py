@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The command-line tools over the library: ``linkage-sweep``, ``linkage-demo``, ``linkage-replay``.
+The command-line tools over the library, one module each.
 
-``arguments`` holds the argument types they share.
+``sweep`` (``linkage-sweep``), ``demo`` (``linkage-demo``), ``replay`` (``linkage-replay``) and
+``check_loops`` (``linkage-check-loops``); ``arguments`` holds the argument types they share.
 """

@@ -23,9 +23,8 @@ import sys
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
-from linkage_kinematics.model.loop_geometry import Loop, LoopJoint
-from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.loops import (
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.plan import (
     find_loops,
     LoopPlan,
     mimic_warnings,
@@ -33,6 +32,8 @@ from linkage_kinematics.model.loops import (
     zero_pose_branch,
     zero_pose_warnings,
 )
+from linkage_kinematics.loops.planar import Loop, LoopJoint
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 
 PROGRAM = 'linkage-check-loops'
 EXIT_PROBLEMS = 1
@@ -160,8 +161,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_USAGE
     problems: list[str] = []
     try:
-        loops = find_loops(text)
-    except LoopError as error:
+        loops = find_loops(read_urdf(text))
+    except UrdfError as error:
         print(f'{PROGRAM}: {error}', file=sys.stderr)
         return EXIT_PROBLEMS
     problems += loops.problems

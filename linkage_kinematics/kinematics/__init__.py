@@ -6,10 +6,13 @@ The kinematics of the planar four-bar: a pure library, numpy only (no ROS).
 
 Its public names are imported from here (``from linkage_kinematics.kinematics import solve,
 FourBar``), as they were when this was one module. Modules, one concern each: ``geometry`` (the
-four-bar, its presets and where its crank can go), ``drive`` (the drive law ω = ω0 + k·α and its
-exact flow in time), ``solver`` (exact positions, rates and accelerations, and the refusals at
-dead points) over ``closed_form``, ``singular_points`` and ``continuation``, and ``inversion``
-(the four-bar driven by its rocker).
+four-bar, its presets, the factors of its loop closure and where its crank can go:
+``Reachability``, which a loop's known joint shares), ``drive`` (the drive law ω = ω0 + k·α and
+its exact flow in time), ``solver`` (exact positions, rates and accelerations, and the refusals
+at dead points) over ``closed_form``, ``singular_points`` and ``continuation``, ``inversion``
+(the four-bar driven by its rocker), ``planar_loop`` (a loop of four joints solved from one,
+a four-bar or, through ``prismatic_loop``, a loop with a slider) and ``decimal_arithmetic``
+(the 60-digit decimals the singular points are found in, once per loop).
 """
 
 from linkage_kinematics.kinematics.closed_form import (

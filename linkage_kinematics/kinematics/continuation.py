@@ -10,6 +10,8 @@ B never changes sides. A real mechanism driven through a change point continues 
 (analytic) branch, on which B crosses that line, so its side flips at every change point passed.
 With an odd number of change points per turn the smooth motion repeats only every two turns;
 ``turns`` lets a caller that keeps α within one pass (the node) get the branch of any later turn.
+The count of change points passed (``turns_past``) serves the slider loops too
+(``prismatic_loop``).
 """
 
 from __future__ import annotations
@@ -49,13 +51,13 @@ def continued_branch(
         return np.full(np.shape(alpha_to), branch) if isinstance(alpha_to, np.ndarray) else branch
     flips = abs(turns) * len(points)
     for point in points:
-        flips = flips + np.abs(_turns_past(alpha_to, point) - _turns_past(alpha_from, point))
+        flips = flips + np.abs(turns_past(alpha_to, point) - turns_past(alpha_from, point))
     if isinstance(alpha_to, np.ndarray):
         return np.where(flips % 2 == 0, branch, -branch)
     return branch if flips % 2 == 0 else -branch
 
 
-def _turns_past(alpha: FloatOrArray, point: tuple[float, float]) -> FloatOrArray:
+def turns_past(alpha: FloatOrArray, point: tuple[float, float]) -> FloatOrArray:
     """
     Return the largest k with point + 2π·k ≤ α.
 

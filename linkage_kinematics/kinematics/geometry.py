@@ -30,7 +30,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 from decimal import Decimal, localcontext
+from enum import Enum
 import math
+
+from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
 
 TWO_PI = 2.0 * math.pi
 # Cosine bounds k± (computed exactly from the float lengths) within this distance of ±1 are
@@ -82,91 +85,127 @@ def format_interval(interval: tuple[float, float]) -> str:
 @dataclass(frozen=True)
 class Reachability:
     """
-    Where the crank of a mechanism can go.
+    Where the coordinate that drives a loop can go: a four-bar's crank, or a loop's known joint.
 
-    ``intervals`` are the closed crank-angle intervals (rad) where the loop closes, each written
-    with its centre in (−π, π] and repeating every 2π. ``dead_points`` are the interval ends,
-    where coupler and rocker are collinear and the crank cannot drive further. ``change_points``
-    are crank angles inside an interval where both branches meet (Grashof equality linkages).
+    ``intervals`` are the closed intervals where the loop closes. An angle's (``periodic``: a
+    crank or a revolute joint, rad) are each written with its centre in (−π, π] and repeat every
+    2π; a displacement's (a prismatic joint, m) are plain. ``dead_points`` are the interval ends,
+    where the loop folds flat and the coordinate cannot drive further (none where an angle turns
+    fully). ``change_points`` lie inside an interval, where both assemblies meet (Grashof
+    equality linkages). ``joint`` is the loop joint that drives (``planar_loop``), None for a
+    four-bar's crank α; messages name it.
     """
 
     intervals: tuple[tuple[float, float], ...]
     dead_points: tuple[float, ...]
     change_points: tuple[float, ...]
+    periodic: bool = True
+    joint: int | None = None
 
     @property
     def full_rotation(self) -> bool:
-        """Return True when the crank can turn all the way round."""
-        return not self.dead_points
+        """Return True when the crank (or revolute joint) can turn all the way round."""
+        return self.periodic and not self.dead_points
 
-    def interval_containing(self, alpha: float) -> tuple[float, float] | None:
-        """Return the interval that holds ``alpha`` (modulo 2π), or None."""
+    def interval_containing(self, value: float) -> tuple[float, float] | None:
+        """Return the interval that holds ``value`` (modulo 2π for an angle), or None."""
         for low, high in self.intervals:
-            past_low = (alpha - low) % TWO_PI
-            if past_low <= high - low + ANGLE_TOLERANCE or past_low >= TWO_PI - ANGLE_TOLERANCE:
+            if self.periodic:
+                past_low = (value - low) % TWO_PI
+                if (past_low <= high - low + ANGLE_TOLERANCE
+                        or past_low >= TWO_PI - ANGLE_TOLERANCE):
+                    return (low, high)
+            elif low <= value <= high:
                 return (low, high)
         return None
 
-    def describe(self) -> str:
-        """Return the reachable set in degrees, for messages."""
-        if self.full_rotation:
-            return 'all crank angles (full rotation)'
-        return ' and '.join(format_interval(interval) for interval in self.intervals)
+    def contains(self, value: float) -> bool:
+        """Return True when the loop closes at ``value`` (modulo 2π for an angle)."""
+        return math.isfinite(value) and self.interval_containing(value) is not None
 
-    def require(self, alpha: float) -> tuple[float, float]:
+    def describe(self) -> str:
+        """Return the reachable set for messages: degrees for an angle, metres otherwise."""
+        if self.joint is None:
+            if self.full_rotation:
+                return 'all crank angles (full rotation)'
+            return ' and '.join(format_interval(interval) for interval in self.intervals)
+        if self.full_rotation:
+            return 'all angles (full rotation)'
+        if self.periodic:
+            return ' and '.join(
+                f'[{math.degrees(low):.6f}°, {math.degrees(high):.6f}°]'
+                for low, high in self.intervals) + ' (mod 360°)'
+        return ' and '.join(f'[{low:.9g} m, {high:.9g} m]' for low, high in self.intervals)
+
+    def unreachable(self, value: float) -> UnreachableError:
+        """Return the error for a ``value`` at which the loop does not close."""
+        if self.joint is None:
+            return UnreachableError(
+                f'crank angle α = {math.degrees(value):.6f}° is not reachable: the loop closes '
+                f'only for α in {self.describe()} (mod 360°)'
+            )
+        shown = f'{math.degrees(value):.9f}°' if self.periodic else f'{value!r} m'
+        return UnreachableError(
+            f'joint {self.joint} at {shown} is not reachable: the loop closes only for '
+            f'{self.describe()}'
+        )
+
+    def require(self, value: float) -> tuple[float, float]:
         """
-        Return the interval holding ``alpha``.
+        Return the interval holding ``value``.
 
         Raise UnreachableError naming the reachable set where none does.
         """
-        interval = self.interval_containing(alpha)
+        interval = self.interval_containing(value)
         if interval is None:
-            raise UnreachableError(
-                f'crank angle α = {math.degrees(alpha):.6f}° is not reachable: the loop closes '
-                f'only for α in {self.describe()} (mod 360°)'
-            )
+            raise self.unreachable(value)
         return interval
 
-    def dead_point_distance(self, alpha: float) -> float | None:
+    def dead_point_distance(self, value: float) -> float | None:
         """
-        Crank-angle distance (rad) from ``alpha`` to the nearest dead point (mod 2π).
+        Distance (rad or m) from ``value`` to the nearest dead point (mod 2π for an angle).
 
-        None when the crank turns fully (a linkage without dead points).
+        None where there is none (an angle that turns fully).
         """
-        return _nearest(self.dead_points, alpha)
+        return self._nearest(self.dead_points, value)
 
-    def change_point_distance(self, alpha: float) -> float | None:
+    def change_point_distance(self, value: float) -> float | None:
         """
-        Crank-angle distance (rad) from ``alpha`` to the nearest change point (mod 2π).
+        Distance (rad or m) from ``value`` to the nearest change point (mod 2π for an angle).
 
         Where the two assemblies meet and the motion continues smoothly; None if there is none.
         """
-        return _nearest(self.change_points, alpha)
+        return self._nearest(self.change_points, value)
 
-    def first_dead_point(self, alpha_from: float, alpha_to: float) -> float | None:
+    def first_dead_point(self, value_from: float, value_to: float) -> float | None:
         """
-        Return the first dead point the crank meets turning from ``alpha_from`` to ``alpha_to``.
+        Return the first dead point met on the way from ``value_from`` to ``value_to``.
 
-        ``alpha_to`` is included; the dead point is an unwrapped crank angle, None if the way is
-        clear.
+        ``value_to`` is included; for an angle the dead point is unwrapped (on the way's turn),
+        None if the way is clear.
 
-        Change points do not stop the crank (it continues through them on its smooth branch,
+        Change points do not stop the motion (it continues through them on its smooth branch,
         see ``kinematics.continued_branch``), so they are not counted here.
         """
-        direction = 1.0 if alpha_to > alpha_from else -1.0
-        travel = abs(alpha_to - alpha_from)
+        direction = 1.0 if value_to > value_from else -1.0
+        reach = abs(value_to - value_from) + (ANGLE_TOLERANCE if self.periodic else 0.0)
         nearest = None
         for point in self.dead_points:
-            distance = (direction * (point - alpha_from)) % TWO_PI
-            if distance <= travel + ANGLE_TOLERANCE and (nearest is None or distance < nearest):
+            distance = direction * (point - value_from)
+            if self.periodic:
+                distance %= TWO_PI
+            elif distance < 0.0:
+                continue  # behind the way
+            if distance <= reach and (nearest is None or distance < nearest):
                 nearest = distance
-        return None if nearest is None else alpha_from + direction * nearest
+        return None if nearest is None else value_from + direction * nearest
 
-
-def _nearest(points: tuple[float, ...], alpha: float) -> float | None:
-    if not points:
-        return None
-    return min(abs(wrap_angle(alpha - point)) for point in points)
+    def _nearest(self, points: tuple[float, ...], value: float) -> float | None:
+        if not points:
+            return None
+        if self.periodic:
+            return min(abs(wrap_angle(value - point)) for point in points)
+        return min(abs(value - point) for point in points)
 
 
 @dataclass(frozen=True)
@@ -240,71 +279,50 @@ class FourBar:
 # written as 4·OA·OC·sin²(½(α − a)), whose square root continues analytically through it.
 # A factor that stays away from zero is taken from d directly (the cheapest form).
 
-_PLAIN = 0
-_ROOTS = 1
-_TOUCH = 2
-# Digits of the one-time computation of the singular crank angles (decimal arithmetic).
-_DIGITS = 60
-_PI = Decimal('3.14159265358979323846264338327950288419716939937510582097494459230781640629')
+DoubleDouble = tuple[float, float]
 
 
-def _cos_sin(angle: Decimal) -> tuple[Decimal, Decimal]:
-    """Cos and sin of a decimal angle of a few radians, by their Taylor series."""
-    cosine = sine = Decimal(0)
-    term = Decimal(1)
-    tiny = Decimal(10) ** -(_DIGITS + 5)
-    order = 0
-    while abs(term) > tiny or order < 4:
-        if order % 4 == 0:
-            cosine += term
-        elif order % 4 == 1:
-            sine += term
-        elif order % 4 == 2:
-            cosine -= term
-        else:
-            sine -= term
-        order += 1
-        term = term * angle / order
-    return cosine, sine
+class FactorForm(Enum):
+    """How a factor of a loop's discriminant is evaluated (``Factor``)."""
 
-
-def _atan2(y: Decimal, x: Decimal) -> Decimal:
-    """atan2 in decimal: the float's value refined by Newton's method on x·sin θ − y·cos θ."""
-    if x == 0:
-        # exact, so that a pivot C straight above or below O puts α₀ on an exact float
-        return _PI / 2 if y > 0 else -_PI / 2
-    angle = Decimal(math.atan2(float(y), float(x)))
-    for _ in range(3):
-        cosine, sine = _cos_sin(angle)
-        angle += (y * cosine - x * sine) / (x * cosine + y * sine)
-    return angle
-
-
-def _split(value: Decimal) -> tuple[float, float]:
-    """Return the nearest float and the float nearest to what it leaves over (a double-double)."""
-    high = float(value)
-    return high, float(value - Decimal(high))
+    PLAIN = 'from the pin distance'
+    ROOTS = 'two roots'
+    TOUCH = 'touching zero'
 
 
 @dataclass(frozen=True)
-class LoopFactor:
+class Factor:
     """
-    One factor of Heron's product, and the form it is evaluated in (see the comment above).
+    One factor of a loop's discriminant, in the form that is exact near its zeros.
 
-    ``kind`` is ``_PLAIN`` (from d; ``length`` is AB + BC or |AB − BC|), ``_ROOTS`` (two dead
-    points ``first`` and ``second``, double-doubles) or ``_TOUCH`` (``gap`` + 4·OA·OC·sin²(½(α −
-    first)); ``gap`` = 0 at a change point).
+    The four-bar's two factors of Heron's product (see the comment above) and those of a loop
+    with a prismatic joint (``prismatic_loop``). With u(x, a) = sin(½(x − a)) for an angle
+    (``periodic``) or x − a for a displacement, each root a held as a double-double
+    (``singular_points`` evaluates them), the ``form`` is ``ROOTS``:
+    ``orientation``·``scale``·u(x, ``first``)·u(x, ``second``), two dead points; ``TOUCH``:
+    ``gap`` + ``scale``·u(x, ``first``)², a change point where ``gap`` = 0; or, for a four-bar's
+    factor far from zero everywhere, ``PLAIN``: taken from the pin distance d and ``length``. A
+    four-bar's ``length`` is AB + BC or |AB − BC| in every form.
     """
 
-    kind: int
-    length: float
-    first: tuple[float, float] = (0.0, 0.0)
-    second: tuple[float, float] = (0.0, 0.0)
+    form: FactorForm
+    scale: float
+    first: DoubleDouble = (0.0, 0.0)
+    second: DoubleDouble = (0.0, 0.0)
     gap: float = 0.0
+    orientation: float = 1.0
+    periodic: bool = True
+    length: float = 0.0
+
+    @property
+    def touching(self) -> bool:
+        """Return True for the TOUCH form: the factor touches zero or stays above it."""
+        return self.form is FactorForm.TOUCH
 
     @property
     def is_change(self) -> bool:
-        return self.kind == _TOUCH and self.gap == 0.0
+        """Return True where the factor touches zero: a change point."""
+        return self.form is FactorForm.TOUCH and self.gap == 0.0
 
 
 @dataclass(frozen=True)
@@ -319,8 +337,8 @@ class LoopClosure:
     use them.
     """
 
-    stretched: LoopFactor
-    folded: LoopFactor
+    stretched: Factor
+    folded: Factor
     scale: float
     ground: float
     squares: float
@@ -353,7 +371,7 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
     y_C), the dimensions the floats are roundings of where those are known (``from_exact``).
     """
     with localcontext() as context:
-        context.prec = _DIGITS
+        context.prec = DIGITS
         r, b, c, x_c, y_c = exact if exact is not None else (
             Decimal(linkage.crank_length), Decimal(linkage.coupler_length),
             Decimal(linkage.rocker_length), Decimal(linkage.ground_x),
@@ -369,7 +387,8 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
                     f'got OA = {crank} m, AB = {coupler} m, BC = {rocker} m'
                 )
             closure = LoopClosure(
-                LoopFactor(_PLAIN, coupler + rocker), LoopFactor(_PLAIN, abs(coupler - rocker)),
+                Factor(FactorForm.PLAIN, 0.0, orientation=-1.0, length=coupler + rocker),
+                Factor(FactorForm.PLAIN, 0.0, length=abs(coupler - rocker)),
                 0.0, 0.0, float(b * b - c * c), (0.0, 0.0), (0.0, 0.0), (), (), False,
             )
             return closure, Reachability(((-math.pi, math.pi),), (), ())
@@ -383,28 +402,33 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
                 f'[{float(abs(ground - r)):.6g}, {float(ground + r):.6g}] m but AB and BC reach '
                 f'only [{float(abs(b - c)):.6g}, {float(b + c):.6g}] m'
             )
-        direction = _PI / 2 + _atan2(y_c, x_c)
-        opposite = direction + _PI
+        direction = PI / 2 + atan2(y_c, x_c)
+        opposite = direction + PI
         scale = float(2 * product)
 
         def factor(cosine: Decimal, bound: int, touch_at: Decimal, length: Decimal
-                   ) -> LoopFactor:
+                   ) -> Factor:
             """
             Return the factor that vanishes where cos φ = ``cosine``.
 
-            Its extreme over a turn is at cos φ = ``bound``.
+            Its extreme over a turn is at cos φ = ``bound``. The factor is
+            ``bound``·2·OA·OC·(``cosine`` − cos φ), so ``bound`` is its orientation.
             """
+            orientation = float(bound)
             if abs(cosine - bound) <= TOUCH_TOLERANCE:
-                return LoopFactor(_TOUCH, float(length), _split(touch_at))
+                return Factor(FactorForm.TOUCH, scale, split(touch_at), orientation=orientation,
+                              length=float(length))
             gap = product * (cosine - bound) * bound  # the factor's least value over a turn
             if gap > 0:
                 # Far from zero everywhere, d's own rounding is small beside the factor.
                 plain = gap >= Decimal('0.25') * (ground + r) ** 2
-                return LoopFactor(_PLAIN if plain else _TOUCH, float(length), _split(touch_at),
-                                  gap=float(gap))
-            half_width = _atan2((1 - cosine * cosine).sqrt(), cosine)
-            return LoopFactor(_ROOTS, float(length), _split(direction - half_width),
-                              _split(direction + half_width))
+                return Factor(FactorForm.PLAIN if plain else FactorForm.TOUCH, scale,
+                              split(touch_at), gap=float(gap), orientation=orientation,
+                              length=float(length))
+            half_width = atan2((1 - cosine * cosine).sqrt(), cosine)
+            return Factor(FactorForm.ROOTS, scale, split(direction - half_width),
+                          split(direction + half_width), orientation=orientation,
+                          length=float(length))
 
         stretched = factor(lowest_cosine, -1, opposite, b + c)
         folded = factor(highest_cosine, 1, direction, abs(b - c))
@@ -413,12 +437,12 @@ def _loop_closure(linkage: FourBar, exact: tuple[Decimal, ...] | None = None
         passes_through_pivot = (folded.is_change
                                 and abs(b - c) <= Decimal(TOUCH_TOLERANCE) * (b + c))
     dead_points = tuple(
-        angle for part in (stretched, folded) if part.kind == _ROOTS
+        angle for part in (stretched, folded) if part.form is FactorForm.ROOTS
         for angle in (part.first, part.second)
     )
     change_points = tuple(part.first for part in (folded, stretched) if part.is_change)
     closure = LoopClosure(stretched, folded, scale, linkage.ground_length, float(b * b - c * c),
-                          _split(direction), _split(opposite), dead_points, change_points,
+                          split(direction), split(opposite), dead_points, change_points,
                           passes_through_pivot)
     return closure, _reachability(closure)
 
@@ -443,11 +467,11 @@ def from_exact(dimensions: tuple[Decimal, Decimal, Decimal, Decimal, Decimal]) -
 def _reachability(closure: LoopClosure) -> Reachability:
     """Crank intervals where both factors are ≥ 0, ending at the dead points (φ₋ ≤ |φ| ≤ φ₊)."""
     stretched, folded = closure.stretched, closure.folded
-    if stretched.kind != _ROOTS and folded.kind != _ROOTS:
+    if stretched.form is not FactorForm.ROOTS and folded.form is not FactorForm.ROOTS:
         ends = [(closure.direction[0] - math.pi, closure.direction[0] + math.pi)]
-    elif folded.kind != _ROOTS:
+    elif folded.form is not FactorForm.ROOTS:
         ends = [(stretched.first[0], stretched.second[0])]
-    elif stretched.kind != _ROOTS:
+    elif stretched.form is not FactorForm.ROOTS:
         ends = [(folded.second[0], folded.first[0] + TWO_PI)]
     else:
         ends = [(folded.second[0], stretched.second[0]), (stretched.first[0], folded.first[0])]

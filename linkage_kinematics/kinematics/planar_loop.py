@@ -24,7 +24,7 @@ A loop with one prismatic joint has its own closed forms (``prismatic_loop``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from decimal import Decimal, localcontext
 from enum import StrEnum
 from functools import lru_cache
@@ -32,21 +32,21 @@ import math
 import operator
 
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
+from linkage_kinematics.kinematics.decimal_arithmetic import DIGITS
 from linkage_kinematics.kinematics.geometry import (
-    _DIGITS,
     FourBar,
     from_exact,
     GeometryError,
+    Reachability,
     UnreachableError,
     wrap_angle,
 )
-from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
 from linkage_kinematics.kinematics.solver import DeadPointError, solve_at_rates
 
 __all__ = [
     'branch_of', 'continued_branch_of', 'driven_loop', 'DrivenLoop', 'joint_points', 'JointKind',
-    'known_joint_range', 'KnownJointRange', 'LoopState', 'PlanarLoop', 'solve_loop',
+    'known_joint_range', 'LoopState', 'PlanarLoop', 'solve_loop',
 ]
 
 # |slide| must be 1 to this relative tolerance (a unit vector written as floats).
@@ -170,7 +170,7 @@ def _four_bar(loop: PlanarLoop, known: int) -> FourBar:
     ground = loop.links[known - 1]
     try:
         with localcontext() as context:
-            context.prec = _DIGITS
+            context.prec = DIGITS
             crank_x, crank_y = Decimal(crank[0]), Decimal(crank[1])
             to_c_x, to_c_y = -Decimal(ground[0]), -Decimal(ground[1])
             length = _length(crank)
@@ -335,11 +335,10 @@ def continued_branch_of(loop: PlanarLoop, known: int, value_from: float, branch:
     return driven_loop(loop, known).continued_branch(value_from, branch, value_to)
 
 
-def known_joint_range(loop: PlanarLoop, known: int) -> KnownJointRange:
+def known_joint_range(loop: PlanarLoop, known: int) -> Reachability:
     """Return where joint ``known`` can go when it drives the loop, its dead and change points."""
     _check_known(loop, known)
     if loop.prismatic is not None:
         return _prismatic(loop, known).range
     reachability = _four_bar(loop, known).reachability
-    return KnownJointRange(known, True, reachability.intervals, reachability.dead_points,
-                           reachability.change_points)
+    return replace(reachability, joint=known)

@@ -41,33 +41,31 @@ the change point; the rates there come from forms with the vanishing factor divi
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from decimal import Decimal, localcontext
 from enum import Enum
 import math
 import operator
 
-from linkage_kinematics.kinematics.continuation import _turns_past, check_branch
+from linkage_kinematics.kinematics.continuation import check_branch, turns_past
+from linkage_kinematics.kinematics.decimal_arithmetic import atan2, DIGITS, PI, split
 from linkage_kinematics.kinematics.geometry import (
-    _atan2,
-    _DIGITS,
-    _PI,
-    _split,
+    Factor,
+    FactorForm,
     GeometryError,
+    Reachability,
     TOUCH_TOLERANCE,
     TWO_PI,
     wrap_angle,
 )
-from linkage_kinematics.kinematics.joint_range import KnownJointRange
 from linkage_kinematics.kinematics.singular_points import (
-    half_sine,
+    factor_unit,
+    factor_value,
     offset_from,
     PIVOT_PASSAGE,
     too_close,
 )
 from linkage_kinematics.kinematics.solver import DeadPointError
 
-DoubleDouble = tuple[float, float]
 Vector = tuple[float, float]
 
 
@@ -77,45 +75,6 @@ class KnownCase(Enum):
     SLIDE = 'the prismatic joint'
     NEXT = 'a revolute joint next to the prismatic one'
     OPPOSITE = 'the revolute joint opposite the prismatic one'
-
-
-@dataclass(frozen=True)
-class Factor:
-    """
-    One factor of a discriminant, in the form that is exact near its zeros.
-
-    Periodic (in an angle): ``orientation``·``scale``·sin(½(x − first))·sin(½(x − second)) with
-    two roots, or ``gap`` + ``scale``·sin²(½(x − first)) where it only touches zero (``touching``).
-    Not periodic (in δ): the same with the offsets x − first, x − second for the sines.
-    """
-
-    periodic: bool
-    touching: bool
-    orientation: float
-    scale: float
-    first: DoubleDouble
-    second: DoubleDouble = (0.0, 0.0)
-    gap: float = 0.0
-
-    @property
-    def is_change(self) -> bool:
-        """Return True where the factor touches zero: a change point."""
-        return self.touching and self.gap == 0.0
-
-    def unit(self, value: float, point: DoubleDouble) -> float:
-        """sin(½(x − point)) for an angle, x − point for a displacement: exact near the point."""
-        if self.periodic:
-            return half_sine(value, point, math.sin)
-        return offset_from(value, point)
-
-    def evaluate(self, value: float) -> tuple[float, float]:
-        """Return the factor at ``value`` and its nearest root's unit (inf if it has none)."""
-        first = self.unit(value, self.first)
-        if self.touching:
-            return self.gap + self.scale * first * first, math.inf
-        second = self.unit(value, self.second)
-        return (self.orientation * self.scale * first * second,
-                min(abs(first), abs(second)) * (1.0 if self.periodic else 0.5))
 
 
 def _sinusoid(constant: Decimal, amplitude: Decimal, phase: Decimal, sense: int,
@@ -129,14 +88,14 @@ def _sinusoid(constant: Decimal, amplitude: Decimal, phase: Decimal, sense: int,
     tolerance = Decimal(TOUCH_TOLERANCE)
     if constant - amplitude >= -tolerance * amplitude:
         gap = constant - amplitude
-        return Factor(True, True, 1.0, float(2 * amplitude), _split(centre),
+        return Factor(FactorForm.TOUCH, float(2 * amplitude), split(centre),
                       gap=float(gap) if gap > tolerance * amplitude else 0.0)
     if constant + amplitude <= tolerance * amplitude:
         raise GeometryError(f'the loop cannot close at any angle: {what}')
     ratio = constant / amplitude
-    half_width = _atan2((1 - ratio * ratio).sqrt(), ratio)
-    return Factor(True, False, 1.0, float(2 * amplitude), _split(centre - half_width),
-                  _split(centre + half_width))
+    half_width = atan2((1 - ratio * ratio).sqrt(), ratio)
+    return Factor(FactorForm.ROOTS, float(2 * amplitude), split(centre - half_width),
+                  split(centre + half_width))
 
 
 def _quadratic(centre: Decimal, radius_squared: Decimal, orientation: int, size: Decimal,
@@ -151,10 +110,10 @@ def _quadratic(centre: Decimal, radius_squared: Decimal, orientation: int, size:
         if orientation < 0:
             raise GeometryError(f'the loop cannot close at any displacement: {what}')
         gap = -radius_squared if radius_squared < -tolerance * size else Decimal(0)
-        return Factor(False, True, 1.0, 1.0, _split(centre), gap=float(gap))
+        return Factor(FactorForm.TOUCH, 1.0, split(centre), gap=float(gap), periodic=False)
     radius = radius_squared.sqrt()
-    return Factor(False, False, float(orientation), 1.0, _split(centre - radius),
-                  _split(centre + radius))
+    return Factor(FactorForm.ROOTS, 1.0, split(centre - radius), split(centre + radius),
+                  orientation=float(orientation), periodic=False)
 
 
 def _angle(vector: Vector) -> float:
@@ -162,7 +121,7 @@ def _angle(vector: Vector) -> float:
 
 
 def _decimal_angle(vector: tuple[Decimal, Decimal]) -> Decimal:
-    return _atan2(vector[1], vector[0])
+    return atan2(vector[1], vector[0])
 
 
 def _arcs(factors: tuple[Factor, ...]) -> list[tuple[float, float]]:
@@ -218,7 +177,7 @@ class PrismaticLoop:
         self.angle_a = _angle(self.link_a)
         self.angle_c = _angle(self.link_c)
         with localcontext() as context:
-            context.prec = _DIGITS
+            context.prec = DIGITS
             _constants(self, links, slide)
         self.factors = _factors(self)
         self.range = _range(self)
@@ -233,7 +192,7 @@ class PrismaticLoop:
         """
         values = []
         for factor in self.factors:
-            result, nearest = factor.evaluate(value)
+            result, nearest = factor_value(factor, value)
             if result < 0.0:
                 raise self.range.unreachable(value)
             if result == 0.0 and not factor.touching or too_close(value, nearest):
@@ -252,7 +211,7 @@ class PrismaticLoop:
         side named by ``branch`` at ``value``, so σ_a = branch·sign(m); at m = 0 itself, where
         the sides meet, the side just past it (the sign of m's derivative).
         """
-        unit = factor.unit(value, factor.first)
+        unit = factor_unit(factor, value, factor.first)
         if unit != 0.0:
             return branch * math.copysign(1.0, unit)
         if factor.periodic:
@@ -326,8 +285,9 @@ class PrismaticLoop:
         across = self.offset + cross  # e = q × ŝ
         along = branch * math.sqrt(lower * upper)  # t
         first, second = self.factors
-        first_unit = abs(first.unit(angle, first.first)) if first.is_change else math.inf
-        second_unit = abs(second.unit(angle, second.first)) if second.is_change else math.inf
+        first_unit = abs(factor_unit(first, angle, first.first)) if first.is_change else math.inf
+        second_unit = (abs(factor_unit(second, angle, second.first)) if second.is_change
+                       else math.inf)
         # Q = e'/t, finite through a change point where e' and t vanish together
         if first_unit <= second_unit and first.is_change:
             sign = self._analytic_sign(branch, first, angle)
@@ -416,8 +376,8 @@ class PrismaticLoop:
             if not factor.is_change:
                 continue
             if factor.periodic:
-                flips += abs(_turns_past(value_to, factor.first)
-                             - _turns_past(value_from, factor.first))
+                flips += abs(turns_past(value_to, factor.first)
+                             - turns_past(value_from, factor.first))
             else:
                 flips += ((offset_from(value_to, factor.first) >= 0.0)
                           != (offset_from(value_from, factor.first) >= 0.0))
@@ -442,7 +402,7 @@ def _constants(loop: PrismaticLoop, links: tuple[Vector, ...], slide: Vector) ->
     loop.m = (float(loop._m[0]), float(loop._m[1]))
     loop.offset = float(loop._offset)
     loop.along = float(loop._along)
-    loop.centre = _split(-loop._along)
+    loop.centre = split(-loop._along)
     loop.squares_a = float(loop._length_a ** 2)
     loop.squares = float(loop._length_a ** 2 - loop._length_c ** 2)
     loop.scale = float(max(loop._length_a, loop._length_c, abs(loop._m[0]),
@@ -452,7 +412,7 @@ def _constants(loop: PrismaticLoop, links: tuple[Vector, ...], slide: Vector) ->
 def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
     """Return the discriminant's factors for this case (module docstring)."""
     with localcontext() as context:
-        context.prec = _DIGITS
+        context.prec = DIGITS
         length_a, length_c, offset = loop._length_a, loop._length_c, loop._offset
         if loop.case is KnownCase.SLIDE:
             centre = -loop._along
@@ -470,36 +430,34 @@ def _factors(loop: PrismaticLoop) -> tuple[Factor, ...]:
             what = (f'the pivots next to the slide are never {float(abs(offset)):.6g} m '
                     "apart (the slide line's offset)")
             return (_sinusoid(length_a ** 2 + length_c ** 2 - offset ** 2,
-                              2 * length_a * length_c, _PI - turn, 1, what),)
+                              2 * length_a * length_c, PI - turn, 1, what),)
         near, radius = ((loop.link_c, length_a) if loop.sense > 0
                         else (loop.link_a, length_c))
         near_length = (Decimal(near[0]) ** 2 + Decimal(near[1]) ** 2).sqrt()
         # e(φ) = e₀ + |v|·sin(κ − sense·φ), κ = arg ŝ − arg v
         kappa = _decimal_angle(loop._slide) - _decimal_angle(_decimal(near))
         what = (f'the circle of radius {float(radius):.6g} m never meets the slide line')
-        return (_sinusoid(radius - offset, near_length, kappa - _PI / 2, loop.sense, what),
-                _sinusoid(radius + offset, near_length, kappa + _PI / 2, loop.sense, what))
+        return (_sinusoid(radius - offset, near_length, kappa - PI / 2, loop.sense, what),
+                _sinusoid(radius + offset, near_length, kappa + PI / 2, loop.sense, what))
 
 
-def _range(loop: PrismaticLoop) -> KnownJointRange:
+def _range(loop: PrismaticLoop) -> Reachability:
     change_points = tuple(factor.first[0] for factor in loop.factors if factor.is_change)
     if loop.case is KnownCase.SLIDE:
         stretched, folded = loop.factors
         low, high = stretched.first[0], stretched.second[0]
         intervals = (((low, folded.first[0]), (folded.second[0], high))
                      if not folded.touching else ((low, high),))
-        return KnownJointRange(loop.known, False, intervals,
-                               tuple(end for piece in intervals for end in piece),
-                               change_points)
+        return Reachability(intervals, tuple(end for piece in intervals for end in piece),
+                            change_points, periodic=False, joint=loop.known)
     arcs = _arcs(loop.factors)
     if not arcs:
         raise GeometryError(f'the loop cannot close at any angle of joint {loop.known}')
     full = arcs == [(-math.pi, math.pi)]
     intervals = tuple(_centred(arc) for arc in arcs)
-    return KnownJointRange(
-        loop.known, True, intervals,
-        () if full else tuple(end for piece in intervals for end in piece),
-        tuple(wrap_angle(point) for point in change_points))
+    return Reachability(
+        intervals, () if full else tuple(end for piece in intervals for end in piece),
+        tuple(wrap_angle(point) for point in change_points), joint=loop.known)
 
 
 def _minus(point: Vector, origin: Vector) -> Vector:

@@ -12,9 +12,11 @@ double-doubles): ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)) for tw
 sin²(½(α − a)) for a change point (a double zero, whose root continues analytically), so h is
 exact to rounding however close α is, after any number of turns too.
 
-Also the refusal rule that follows from float64's limit (``RATE_ACCURACY``), the closure of a
-linkage whose pin A passes through C (``PIVOT_PASSAGE``), and the double-double arithmetic that
-``continuation`` shares to decide on which side of a change point a float lies.
+The factors of a loop with a prismatic joint (``prismatic_loop``) take the same forms
+(``geometry.Factor``), evaluated one at a time by ``factor_value``, in an angle or a
+displacement. Also the refusal rule that follows from float64's limit (``RATE_ACCURACY``), the
+closure of a linkage whose pin A passes through C (``PIVOT_PASSAGE``), and the double-double
+arithmetic that ``continuation`` shares to decide on which side of a change point a float lies.
 """
 
 from __future__ import annotations
@@ -23,7 +25,13 @@ from dataclasses import dataclass
 import math
 from typing import Callable, Union
 
-from linkage_kinematics.kinematics.geometry import _PLAIN, _TOUCH, LoopClosure, TWO_PI
+from linkage_kinematics.kinematics.geometry import (
+    DoubleDouble,
+    Factor,
+    FactorForm,
+    LoopClosure,
+    TWO_PI,
+)
 import numpy as np
 
 FloatOrArray = Union[float, np.ndarray]
@@ -161,13 +169,36 @@ def half_sine(alpha: FloatOrArray, point: tuple[float, float], sin: Callable) ->
     return value
 
 
+def factor_unit(factor: Factor, value: float, point: DoubleDouble) -> float:
+    """sin(½(x − point)) for an angle, x − point for a displacement: exact near the point."""
+    if factor.periodic:
+        return half_sine(value, point, math.sin)
+    return offset_from(value, point)
+
+
+def factor_value(factor: Factor, value: float) -> tuple[float, float]:
+    """
+    Return ``factor`` at ``value`` and its nearest root's unit (inf if it has none).
+
+    For the ROOTS and TOUCH forms (a loop with a prismatic joint has no other), one value at a
+    time; the unit is ~½·(x − root) for a displacement, as |sin(½(x − root))| for an angle, the
+    measure ``too_close`` takes.
+    """
+    first = factor_unit(factor, value, factor.first)
+    if factor.touching:
+        return factor.gap + factor.scale * first * first, math.inf
+    second = factor_unit(factor, value, factor.second)
+    return (factor.orientation * factor.scale * first * second,
+            min(abs(first), abs(second)) * (1.0 if factor.periodic else 0.5))
+
+
 def exact_factors(
     closure: LoopClosure, alpha: FloatOrArray, distance: FloatOrArray, sin: Callable
 ) -> tuple[FloatOrArray, FloatOrArray, LoopCheck | None]:
     """
     Return Heron's two factors (AB + BC)² − d² and d² − (AB − BC)², and their LoopCheck.
 
-    Each in the form geometry.LoopFactor names: from d; from the offsets to its two dead points
+    Each in the form its ``geometry.Factor`` names: from d; from the offsets to its two dead points
     a₁, a₂ as ∓4·OA·OC·sin(½(α − a₁))·sin(½(α − a₂)); or touching zero as gap +
     4·OA·OC·sin²(½(α − a)). A factor that is negative (the loop does not close) is returned as 0:
     B is then placed on the dead point (h = 0), where solve refuses and solve_pose gives the
@@ -175,24 +206,23 @@ def exact_factors(
     closes and no dead point is near enough to be checked.
     """
     is_array = isinstance(alpha, np.ndarray)
-    scale = closure.scale
     nearest_dead = None
     closes = True
     factors = []
-    for part, orientation in ((closure.stretched, -1.0), (closure.folded, 1.0)):
-        kind = part.kind
-        if kind == _PLAIN:
+    for part in (closure.stretched, closure.folded):
+        form = part.form
+        if form is FactorForm.PLAIN:
             length = part.length
-            value = orientation * (distance - length) * (distance + length)
+            value = part.orientation * (distance - length) * (distance + length)
             closes = closes & (value > 0.0)
             factors.append(value)
             continue
         first = half_sine(alpha, part.first, sin)
-        if kind == _TOUCH:
-            factors.append(part.gap + scale * first * first)
+        if form is FactorForm.TOUCH:
+            factors.append(part.gap + part.scale * first * first)
             continue
         second = half_sine(alpha, part.second, sin)
-        value = orientation * scale * first * second
+        value = part.orientation * part.scale * first * second
         closes = closes & (value > 0.0)
         first = abs(first)
         second = abs(second)

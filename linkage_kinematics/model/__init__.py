@@ -7,9 +7,6 @@ What a mechanism looks like to ROS tools, as pure data (no ROS).
 ``joints`` (each driver's URDF tree and the mapping to a lab's joint names, directions and
 offsets), ``urdf`` (the node's URDF), ``scene`` (the colours and sizes the markers and the URDF
 draw with), ``urdf_reader`` (a URDF's links and joints, read once with urdf_parser_py) and
-``robot_transforms`` (robot_state_publisher's transforms of a URDF at a joint state), and a lab's
-URDF's own closed loops: ``loop_urdf`` (the tree at the zero pose, and the ``<constraint>``
-elements), ``loop_geometry`` (each constraint's planar loop, with its joints' signs) and
-``loops`` (the loops ordered from the measured joints, and solved sample by sample). Imports only
-``kinematics`` (and urdf_parser_py, lxml).
+``robot_transforms`` (robot_state_publisher's transforms of a URDF at a joint state). A lab's
+URDF's closed loops are ``loops``'. Imports only ``kinematics`` (and urdf_parser_py, lxml).
 """

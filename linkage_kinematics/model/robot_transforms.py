@@ -4,8 +4,9 @@
 """
 The transforms robot_state_publisher publishes for a URDF and a joint state.
 
-A pure module: ``RobotTransforms`` takes a URDF's joints as ``urdf_reader`` reads them (with
-urdf_parser_py, as robot_state_publisher reads them with urdfdom) and computes, as
+A pure module: ``RobotTransforms`` takes a URDF's joints as ``urdf_reader`` read them (with
+urdf_parser_py, as robot_state_publisher reads them with urdfdom; the parsed ``UrdfTree`` is
+handed in, so a description is parsed once for every reader) and computes, as
 robot_state_publisher (Jazzy) does through kdl_parser and KDL,
 
 * for each fixed joint, the transform parent link → child link, published once on /tf_static
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 import math
 from typing import Any
 
-from linkage_kinematics.model.urdf_reader import Quaternion, read_urdf, UrdfJoint, Vector
+from linkage_kinematics.model.urdf_reader import Quaternion, UrdfJoint, UrdfTree, Vector
 
 
 @dataclass(frozen=True)
@@ -67,15 +68,9 @@ def rotate(rotation: Quaternion, vector: Vector) -> Vector:
 
 
 class RobotTransforms:
-    """
-    The joints of one URDF, and the transforms robot_state_publisher publishes for them.
+    """The joints of a parsed URDF, and the transforms robot_state_publisher publishes for them."""
 
-    Raises urdf_reader.UrdfError for a text that is not a URDF robot, or whose joints do not
-    form a tree.
-    """
-
-    def __init__(self, urdf: str, frame_prefix: str = '') -> None:
-        tree = read_urdf(urdf)
+    def __init__(self, tree: UrdfTree, frame_prefix: str = '') -> None:
         self.root_link: str = tree.root_link
         self.frame_prefix = frame_prefix
         # robot_state_publisher keeps its joints in maps keyed by name

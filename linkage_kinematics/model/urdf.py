@@ -22,18 +22,22 @@ it: the joint's axis is direction·z and its origin is turned by −direction·o
 that the child frame turns by direction·(q − offset), the node's value, as above.
 
 The pivot the tree leaves open is written as the loop's cut joint, a revolute ``<constraint>``
-(urdfdom PR #264, as ``model.loops`` reads it; robot_state_publisher's parser ignores it) named
-``pivot_c`` or ``pivot_o``: its parent frame is the pivot on the root link, its child frame the
-chain's end, (BC, 0, 0) in the rocker or (OA, 0, 0) in the disk, turned so that the two frames
-are parallel at the zero pose. They coincide wherever the loop closes; the zero pose (every
+(urdfdom PR #264, as ``loops.description`` reads it; robot_state_publisher's parser ignores it)
+named ``pivot_c`` or ``pivot_o``: its parent frame is the pivot on the root link, its child frame
+the chain's end, (BC, 0, 0) in the rocker or (OA, 0, 0) in the disk, turned so that the two
+frames are parallel at the zero pose. They coincide wherever the loop closes; the zero pose (every
 joint at 0) is in general not such a pose, so there they differ by its closure gap.
 
 The root link (``frame_id``, by default ``linkage_base``) shows both ground pivots.
+``node_description`` is the text of one geometry, frame, set of joints and driver, read once
+(``urdf_reader``) for every reader of it: the measured mode's loop and the log's TF.
 Regenerate the installed file with ``python -m linkage_kinematics.model.urdf > urdf/linkage.urdf``.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
 import math
 
 from linkage_kinematics.kinematics.geometry import FourBar, preset
@@ -52,6 +56,7 @@ from linkage_kinematics.model.scene import (
     Rgba,
     ROCKER_COLOR,
 )
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfTree
 
 DEFAULT_FRAME_ID = 'linkage_base'
 _PIN_RADIUS = 0.5 * PIN_DIAMETER
@@ -232,6 +237,28 @@ def urdf_text(
         + cut
         + '</robot>\n'
     )
+
+
+@dataclass(frozen=True)
+class NodeDescription:
+    """The node's URDF text, and the text as ``urdf_reader`` reads it (parsed at first use)."""
+
+    text: str
+
+    @cached_property
+    def tree(self) -> UrdfTree:
+        """Return the parsed URDF, the same for every reader (a URDF the package wrote reads)."""
+        return read_urdf(self.text)
+
+
+# The node's description is asked for by its outputs (published, and its TF logged) and by the
+# measured mode's loop: the latest few are kept, so that both read one parse of one text. A
+# parameter change makes a new one; four cover switching back and forth.
+@lru_cache(maxsize=4)
+def node_description(linkage: FourBar, frame_id: str, joints: JointMap,
+                     driver: Driver) -> NodeDescription:
+    """Return the node's description for these (``urdf_text``), the same one for equal values."""
+    return NodeDescription(urdf_text(linkage, frame_id, joints, driver))
 
 
 if __name__ == '__main__':

@@ -1,7 +1,7 @@
 # Copyright 2026 linkage_kinematics maintainers
 # SPDX-License-Identifier: Apache-2.0
 
-"""``linkage_node``'s exit statuses (README: Parameters, exit statuses), defined once."""
+"""``linkage_node``'s exit statuses (docs/parameters.md: exit statuses), defined once."""
 
 from enum import IntEnum
 

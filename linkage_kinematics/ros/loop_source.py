@@ -4,13 +4,14 @@
 """
 The measured source of ``loops:=robot_description``: every loop of a lab's URDF, closed on ROS.
 
-``RobotLoopsSubscription`` is a ``Source``: it reads the robot description (the parameter
+``RobotLoopsSubscription`` is a ``source.Source``: it reads the robot description (the parameter
 ``robot_description``, or the relative ``robot_description`` topic as robot_state_publisher
-publishes it), feeds each ``measured_joint_states`` message to a ``run.robot_loops``
-``RobotLoopsFollower`` and publishes the passive loop joints it solves on ``joint_states``,
-stamped as the input. The node publishes no URDF, ``linkage/state`` or markers of its own
-then: those describe its own four-bar. Its bag holds the input, the completed joint states,
-the description and the /tf robot_state_publisher would publish for the whole robot.
+publishes it), feeds each ``measured_joint_states`` message (``measured_input.MeasuredInput``)
+to a ``loops.follower`` ``RobotLoopsFollower`` and publishes the passive loop joints it solves
+on ``joint_states``, stamped as the input. The node publishes no URDF, ``linkage/state`` or
+markers of its own then: those describe its own four-bar. Its bag holds the input, the
+completed joint states, the description and the /tf robot_state_publisher would publish for the
+whole robot.
 """
 
 from __future__ import annotations
@@ -20,35 +21,24 @@ from dataclasses import replace
 import math
 from typing import Any, Protocol
 
-from linkage_kinematics.bag.cdr import JointStateDecoder
-from linkage_kinematics.model.loop_urdf import LoopError
-from linkage_kinematics.model.urdf_reader import UrdfError
+from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.follower import LoopDrop, RobotLoopsFollower
+from linkage_kinematics.loops.intake import DropReason
+from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
+from linkage_kinematics.ros.measured_input import MeasuredInput
 from linkage_kinematics.ros.messages import RobotStateTransforms
 from linkage_kinematics.ros.outputs import (
-    MEASURED_QOS,
-    MEASURED_TOPIC,
     NodeOutputs,
     ROBOT_DESCRIPTION_QOS,
     ROBOT_DESCRIPTION_TOPIC,
     StartupError,
 )
-from linkage_kinematics.ros.sources import SourceHost
+from linkage_kinematics.ros.source import SourceHost
 from linkage_kinematics.run.configuration import RunConfiguration
 from linkage_kinematics.run.control import ServiceAnswer
-from linkage_kinematics.run.diagnostics import RateMeter, StatusInputs, StatusSchedule
-from linkage_kinematics.run.loop_diagnostics import (
-    loop_statuses,
-    LoopsHealth,
-    LoopsView,
-    Status,
-)
-from linkage_kinematics.run.robot_loops import (
-    LoopDrop,
-    LoopRejection,
-    read_loops,
-    RobotLoopsFollower,
-)
-from sensor_msgs.msg import JointState
+from linkage_kinematics.run.diagnostics import RateMeter, Status, StatusInputs, StatusSchedule
+from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
 from std_msgs.msg import String
 
 
@@ -64,11 +54,11 @@ class ClosedRobot:
 
     def __init__(self, urdf: str, config: RunConfiguration) -> None:
         """Read ``urdf``; LoopError or UrdfError, one line naming the problem, if it cannot."""
-        loops = read_loops(urdf)
+        tree = read_urdf(urdf)  # once, for the loops and for robot_state_publisher's TF
         self.urdf = urdf
-        self.follower = RobotLoopsFollower(loops, config.loop_measured_joints,
-                                           dict(config.loop_branches), config.max_jump)
-        self.transforms = RobotStateTransforms(urdf, config.frame_prefix)
+        self.follower = RobotLoopsFollower(read_loops(tree), config.loops.measured_joints,
+                                           dict(config.loops.branches), config.measured.max_jump)
+        self.transforms = RobotStateTransforms(tree, config.outputs.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
 
@@ -129,23 +119,27 @@ def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
 
     Raises StartupError, one line naming the problem, for a description that cannot be closed.
     """
-    if not config.robot_description:
+    if not config.loops.robot_description:
         return None
     try:
-        return ClosedRobot(config.robot_description, config)
+        return ClosedRobot(config.loops.robot_description, config)
     except (LoopError, UrdfError) as error:
         raise StartupError('cannot close the loops of parameter robot_description: '
                            + str(error).replace('\n', '; ')) from None
 
 
-class RobotLoopsSubscription:
-    """The source of ``loops:=robot_description``: descriptions and measured joints in."""
+class RobotLoopsSubscription(MeasuredInput):
+    """
+    The source of ``loops:=robot_description``: descriptions and measured joints in.
 
-    missed_deadlines = 0  # no deadlines: the input sets the pace
+    The input's bytes are also logged as received (``record_input``).
+    """
+
     health = None  # no four-bar: its statuses are this source's own (``statuses``)
+    paused_answer = 'paused: the measured joints are ignored'
+    resumed_answer = 'following the measured joints again from their next sample'
 
     def __init__(self, host: LoopsHost, outputs: NodeOutputs, robot: ClosedRobot | None) -> None:
-        self._host = host
         self._outputs = outputs
         self._robot: ClosedRobot | None = None
         self._loops_health = LoopsHealth(host.now_ns())
@@ -154,22 +148,15 @@ class RobotLoopsSubscription:
         self._problem: str | None = None
         self._input_positions: dict[str, float] = {}  # joints outside the loops, as last heard
         self._tree: TreePositions | None = None  # the robot's /tf positions
-        self.stale = False
         self._following = False  # a message of this motion followed since the last start
-        self._description_from = f'topic {outputs.description_topic}'
-        if robot is not None:
-            self._description_from = 'parameter robot_description'
-            self._take(robot)
-        else:
+        self._description_from = ('parameter robot_description' if robot is not None
+                                  else f'topic {outputs.description_topic}')
+        if robot is None:  # subscribed before the input, as the node always was
             host.create_subscription(String, ROBOT_DESCRIPTION_TOPIC, self._on_description,
                                      ROBOT_DESCRIPTION_QOS)
-        # raw: logged as received, and read by JointStateDecoder in a sixth of
-        # deserialize_message's time
-        self._decoder = JointStateDecoder()
-        host.create_subscription(JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS,
-                                 raw=True)
-        self._freshness_timer = host.create_timer(0.25 * host.config.measured_timeout,
-                                                  self._check_freshness)
+        super().__init__(host, self._loops_health)
+        if robot is not None:
+            self._take(robot)
         self._show_activity()
 
     def start(self) -> None:
@@ -250,10 +237,8 @@ class RobotLoopsSubscription:
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: the thresholds (timeout, jump)."""
         if self._robot is not None:
-            self._robot.follower.max_jump = new.max_jump
-        self._host.destroy_timer(self._freshness_timer)
-        self._freshness_timer = self._host.create_timer(0.25 * new.measured_timeout,
-                                                        self._check_freshness)
+            self._robot.follower.max_jump = new.measured.max_jump
+        self._retime(new)
 
     def restart(self) -> None:
         """Forget the motion: the next valid message starts it afresh on the planned branches."""
@@ -261,37 +246,15 @@ class RobotLoopsSubscription:
         if self._robot is not None:
             self._robot.follower.restart()
 
-    # ~/pause, ~/resume, ~/reset
-
-    def pause(self) -> ServiceAnswer:
-        """Ignore the input until ~/resume."""
-        host = self._host
-        if not host.control.pause(None, None).success:
-            return ServiceAnswer(False, 'already paused; ~/resume goes on')
-        self._show_activity()
-        host.publish_diagnostics()
-        return ServiceAnswer(True, 'paused: the measured joints are ignored')
-
-    def resume(self) -> ServiceAnswer:
-        """Follow again from the next message, the motion started afresh."""
-        host = self._host
-        answer, _ = host.control.resume()
-        if not answer.success:
-            return answer
-        # What the mechanism did meanwhile is unknown: its next sample starts the motion afresh.
+    def _forget_motion(self) -> None:
         self.restart()
-        self._show_activity()
-        host.publish_diagnostics()
-        return ServiceAnswer(True, 'following the measured joints again from their next sample')
 
     def reset(self) -> ServiceAnswer:
-        """Start the motion afresh at the next valid message."""
-        self.restart()
+        """Start the motion afresh at the next valid message; the status says so at once."""
+        answer = super().reset()
         self._show_activity()
         self._host.publish_diagnostics()  # as ~/pause and ~/resume: the status says what now
-        paused = self._host.control.paused
-        return ServiceAnswer(True, 'the motion starts afresh at the next valid sample' + (
-            '; paused: ~/resume follows it' if paused else ''))
+        return answer
 
     def _on_message(self, data: bytes) -> None:
         host = self._host
@@ -299,13 +262,13 @@ class RobotLoopsSubscription:
             return  # ~/pause: not followed, not counted
         try:
             stamp_ns, names, positions, velocities = self._decoder.decode(data)
-        except ValueError as error:  # not logged: it has no stamp, and readers would refuse it
-            self._loops_health.drop(LoopDrop(LoopRejection.MALFORMED, (), str(error)))
+        except ValueError:  # not logged: it has no stamp, and readers would refuse it
+            self._loops_health.drop(DropReason.MALFORMED)
             return
         robot = self._robot
         if robot is None:
             self._outputs.record_input(data, stamp_ns)
-            self._loops_health.drop(LoopDrop(LoopRejection.NO_DESCRIPTION, (), ''))
+            self._loops_health.drop(DropReason.NO_DESCRIPTION)
             return
         follower = robot.follower
         planned = follower.plan is not None
@@ -313,7 +276,7 @@ class RobotLoopsSubscription:
             followed = follower.follow(stamp_ns, names, positions, velocities)
         except LoopError as error:
             self._outputs.record_input(data, stamp_ns)
-            self._loops_health.drop(LoopDrop(LoopRejection.NOT_PLANNED, (), str(error)))
+            self._loops_health.drop(DropReason.NOT_PLANNED)
             self._report('the measured joints cannot close the loops: '
                          + str(error).replace('\n', '; '))
             return
@@ -325,7 +288,7 @@ class RobotLoopsSubscription:
             self._problem = None
             self._planned()
         if isinstance(followed, LoopDrop):
-            self._loops_health.drop(followed)
+            self._loops_health.drop(followed.reason, followed.constraints)
             return
         self._loops_health.accept(host.now_ns(), followed)
         self._rate_meter.tick()
@@ -340,12 +303,3 @@ class RobotLoopsSubscription:
         if self._schedule.due(stamp_ns) or first:
             self._schedule.sent(stamp_ns)
             host.publish_diagnostics(at_ns=stamp_ns)
-
-    def _check_freshness(self) -> None:
-        """Report at once when the measured data goes stale."""
-        host = self._host
-        if not self.stale and self._loops_health.is_stale(host.now_ns(),
-                                                          host.config.measured_timeout):
-            self.stale = True
-            self.restart()  # a long gap: the next valid message starts afresh
-            host.publish_diagnostics()

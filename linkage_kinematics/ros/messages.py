@@ -7,7 +7,7 @@ The node's messages, from a LinkageState: one way to make each.
 The per-tick messages and the scene are never built as rclpy messages: their encoders
 (``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write their CDR bytes
 straight from the state into a layout prepared once per geometry from a template message
-(``bag.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
+(``shared.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
 describe. The diagnostics are built (``diagnostic_array``) and encoded by ``encode_cdr``. None
 of this computes any kinematics: the values come from the value functions here
 (``joints.JointStream``, ``disk_orientation``) and from
@@ -22,7 +22,6 @@ import math
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, TransformStamped
-from linkage_kinematics.bag.cdr import encode_cdr, FixedShapeEncoder
 from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
@@ -32,6 +31,8 @@ from linkage_kinematics.model.robot_transforms import (
     RobotTransforms,
     Transform,
 )
+from linkage_kinematics.model.urdf_reader import UrdfTree
+from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
@@ -81,7 +82,7 @@ class LinkageStateEncoder:
     """
     The bytes of ``linkage/state`` of one linkage and frame, straight from a state.
 
-    The full state as one trajectory point (README, "Topics"): the coordinates of
+    The full state as one trajectory point (docs/parameters.md, "Topics"): the coordinates of
     ``bag.state_layout``, and as ``time_from_start`` the drive-law time since the motion left
     alpha_start.
     """
@@ -289,15 +290,14 @@ class RobotStateTransforms:
     """
     The /tf_static and /tf messages robot_state_publisher publishes for one URDF, as bytes.
 
-    With robot_state_publisher's ``frame_prefix``; see ``robot_transforms``. Raises
-    urdf_reader.UrdfError for a URDF it cannot read. The /tf of a joint state is written
-    from the joints' prepared transforms (``RobotTransforms.moving``) and a prepared message,
-    both made again only when the joint state's names change; the /tf of the whole robot
-    (``tree_message``) from ones made once.
+    Of a parsed URDF, with robot_state_publisher's ``frame_prefix``; see ``robot_transforms``.
+    The /tf of a joint state is written from the joints' prepared transforms
+    (``RobotTransforms.moving``) and a prepared message, both made again only when the joint
+    state's names change; the /tf of the whole robot (``tree_message``) from ones made once.
     """
 
-    def __init__(self, urdf: str, frame_prefix: str) -> None:
-        self._robot = RobotTransforms(urdf, frame_prefix)
+    def __init__(self, tree: UrdfTree, frame_prefix: str) -> None:
+        self._robot = RobotTransforms(tree, frame_prefix)
         self._names: tuple[str, ...] | None = None
         self._tree: tuple[MovingTransforms, TFMessageEncoder] | None = None
 

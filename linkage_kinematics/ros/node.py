@@ -8,12 +8,13 @@ Publishes the linkage's exact state as the drive law turns the crank, or as a me
 moves it.
 
 A thin shell that wires pure modules to ROS: ``run.configuration`` validates the parameter
-values into a frozen RunConfiguration; one of the two sources of ``ros.sources`` gives the
-states, over ``motion.DriveLawRun`` (the drive law on the node's timer) or
-``measured.MeasuredFollower`` (the driver joint of each ``measured_joint_states`` message), with
-this node as its ``SourceHost``; ``run.diagnostics`` says what ``/diagnostics`` reports;
+values into a frozen RunConfiguration; one source gives the states, with this node as its
+``source.SourceHost``: ``drive_law_source`` over ``motion.DriveLawRun`` (the drive law on the
+node's timer), ``measured_source`` over ``measured.MeasuredFollower`` (the driver joint of each
+``measured_joint_states`` message) or ``loop_source`` over ``loops.follower`` (every loop of a
+lab's URDF); ``run.diagnostics`` says what ``/diagnostics`` reports;
 ``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
-documented in README.md.
+documented in docs/parameters.md.
 """
 
 from __future__ import annotations
@@ -26,8 +27,10 @@ from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import TreeValues
+from linkage_kinematics.ros.drive_law_source import DriveLawTimer
 from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.loop_source import robot_from_parameter, RobotLoopsSubscription
+from linkage_kinematics.ros.measured_source import MeasuredSubscription
 from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
 from linkage_kinematics.ros.parameters import (
     add_ranges,
@@ -35,12 +38,7 @@ from linkage_kinematics.ros.parameters import (
     keep_declared_types,
     parameter_values,
 )
-from linkage_kinematics.ros.sources import (
-    DriveLawTimer,
-    MeasuredSubscription,
-    RunStatus,
-    Source,
-)
+from linkage_kinematics.ros.source import RunStatus, Source
 from linkage_kinematics.run.configuration import (
     build_configuration,
     ConfigurationError,
@@ -72,13 +70,13 @@ DIAGNOSTICS_PERIOD = 1.0  # s
 
 class LinkageNode(RunStatus, Node):
     """
-    Publishes the linkage's state as its source moves it (README: Topics, Parameters).
+    Publishes the linkage's state as its source moves it (docs/parameters.md: Topics, Parameters).
 
     Markers at display_rate_hz, diagnostics at 1 Hz and whenever the activity changes.
     Construction raises ConfigurationError for bad parameters before anything is published or
-    written. ``exit_code`` becomes an ExitCode when the run has ended (see README). The node is
-    its source's ``SourceHost`` and owns the run's status (``RunStatus``: activity, problem,
-    exit code), which the source changes only through it.
+    written. ``exit_code`` becomes an ExitCode when the run has ended (docs/parameters.md,
+    exit statuses). The node is its source's ``SourceHost`` and owns the run's status
+    (``RunStatus``: activity, problem, exit code), which the source changes only through it.
     """
 
     def __init__(self, **node_options: Any) -> None:
@@ -101,15 +99,15 @@ class LinkageNode(RunStatus, Node):
         self._rate_meter = RateMeter()
         self._status_schedule = StatusSchedule()
         self._placement = CpuPlacement()
-        self._place(config.cpu_affinity)
-        loops = config.loops is LoopsSource.ROBOT_DESCRIPTION
+        self._place(config.logging.cpu_affinity)
+        loops = config.loops.source is LoopsSource.ROBOT_DESCRIPTION
         # A description given as a parameter is read before anything is published or written.
         robot = robot_from_parameter(config) if loops else None
         self.outputs = NodeOutputs(self, config, self.parameter_values(),
                                    self._placement.bag_writer_cpus)
         if self.outputs.recorder is not None:
             self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
-        self._marker_timer = self.create_timer(1.0 / config.display_rate_hz,
+        self._marker_timer = self.create_timer(1.0 / config.outputs.display_rate_hz,
                                                self.publish_markers)
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         self.add_pre_set_parameters_callback(keep_declared_types)
@@ -118,7 +116,7 @@ class LinkageNode(RunStatus, Node):
         self._source: Source
         if loops:
             self._source = RobotLoopsSubscription(self, self.outputs, robot)
-        elif config.source is SourceKind.MEASURED:
+        elif config.joints.source is SourceKind.MEASURED:
             self._source = MeasuredSubscription(self)
         else:
             self._source = DriveLawTimer(self)
@@ -139,7 +137,7 @@ class LinkageNode(RunStatus, Node):
         updates = {p.name: p.value for p in changed if p.name in PARAMETER_NAMES}
         try:
             config = build_configuration({**current, **updates})
-            self._placement.check(config.cpu_affinity)
+            self._placement.check(config.logging.cpu_affinity)
         except ConfigurationError as error:
             self._pending = None
             return SetParametersResult(successful=False, reason=str(error))
@@ -163,16 +161,16 @@ class LinkageNode(RunStatus, Node):
         )
         if blocked_note(new) is not None:
             self.get_logger().warning(blocked_note(new))
-        if new.display_rate_hz != old.display_rate_hz:
+        if new.outputs.display_rate_hz != old.outputs.display_rate_hz:
             self.destroy_timer(self._marker_timer)
-            self._marker_timer = self.create_timer(1.0 / new.display_rate_hz,
+            self._marker_timer = self.create_timer(1.0 / new.outputs.display_rate_hz,
                                                    self.publish_markers)
-        if new.cpu_affinity != old.cpu_affinity:
-            self._place(new.cpu_affinity)
+        if new.logging.cpu_affinity != old.logging.cpu_affinity:
+            self._place(new.logging.cpu_affinity)
             if self.outputs.recorder is not None:
                 self.outputs.recorder.run_writer_on(
                     self._placement.bag_writer_cpus or self._placement.available)
-        if new.joints != old.joints:
+        if new.joints.lab != old.joints.lab:
             self.publish_description()  # the lab's names, axes and offsets
         if restarts:
             self.forget_state()
@@ -199,7 +197,7 @@ class LinkageNode(RunStatus, Node):
         if change is not None:
             self.get_logger().info(change)
 
-    # the source's host (sources.SourceHost): publishing, and the status it changes
+    # the source's host (source.SourceHost): publishing, and the status it changes
 
     def now_ns(self) -> int:
         """Return the node clock's time (ns)."""
@@ -341,12 +339,13 @@ def main(args: list[str] | None = None) -> int:
             return ExitCode.CONFIGURATION
         # The events executor dispatches timers and services from C++ instead of rebuilding a
         # wait set in Python for every callback: at 1 kHz it halves the process's CPU
-        # (docs/benchmarks.md, section 3). On simulated time rclpy 7.1.6's events executor
-        # runs a timer created at run time (a rate_hz change) twice at its first /clock step,
-        # which also shifts its schedule by a period, so there the node keeps rclpy's default
-        # executor. The events executor's spin() busy-waits without running timers; spin_once
-        # returns after each callback, and at the latest after the timeout, so the signal
-        # handlers above run and the loop sees the end of the run.
+        # (docs/benchmarks.md, "The node against a minimal hand-written publisher"). On
+        # simulated time rclpy 7.1.6's events executor runs a timer created at run time (a
+        # rate_hz change) twice at its first /clock step, which also shifts its schedule by a
+        # period, so there the node keeps rclpy's default executor. The events executor's
+        # spin() busy-waits without running timers; spin_once returns after each callback, and
+        # at the latest after the timeout, so the signal handlers above run and the loop sees
+        # the end of the run.
         if node.get_parameter('use_sim_time').value:
             executor: Executor = SingleThreadedExecutor()
         else:

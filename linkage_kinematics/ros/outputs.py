@@ -18,14 +18,13 @@ from typing import Any, NamedTuple
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.bag.cdr import encode_cdr
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
 from linkage_kinematics.bag.recorder import Recorder
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream, TreeValues
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.ros import messages
 from linkage_kinematics.run.configuration import (
     ConfigurationError,
@@ -33,8 +32,8 @@ from linkage_kinematics.run.configuration import (
     RunConfiguration,
     SourceKind,
 )
-from linkage_kinematics.run.diagnostics import Level
-from linkage_kinematics.run.loop_diagnostics import Status
+from linkage_kinematics.run.diagnostics import Level, Status
+from linkage_kinematics.shared.cdr import encode_cdr
 from rclpy.duration import Duration
 from rclpy.node import Node
 from rclpy.publisher import Publisher
@@ -98,7 +97,7 @@ class NodeOutputs:
                  bag_writer_cpus: set[int] | None) -> None:
         self._node = node
         self.config = config
-        four_bar = config.loops is LoopsSource.PARAMETERS
+        four_bar = config.loops.source is LoopsSource.PARAMETERS
         self._publishers = Publishers(
             joint_states=node.create_publisher(JointState, 'joint_states', DATA_QOS),
             state=(node.create_publisher(JointTrajectory, 'linkage/state', DATA_QOS)
@@ -108,7 +107,7 @@ class NodeOutputs:
             diagnostics=node.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS),
             robot_description=(
                 node.create_publisher(String, ROBOT_DESCRIPTION_TOPIC, ROBOT_DESCRIPTION_QOS)
-                if config.publish_robot_description and four_bar else None),
+                if config.joints.publish_robot_description and four_bar else None),
         )
         # loops robot_description: the input and the lab's description are logged too
         self.input_topic = node.resolve_topic_name(MEASURED_TOPIC)
@@ -121,9 +120,9 @@ class NodeOutputs:
         self._robot_transforms: messages.RobotStateTransforms | None = None
         self._loop_joint_names: tuple[str, ...] | None = None  # publish_joint_states's encoder's
         # frame_id and frame_prefix are read-only: one frame for the node's life.
-        self._frame_id = config.frame_prefix + config.frame_id
+        self._frame_id = config.outputs.frame_prefix + config.outputs.frame_id
         self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
-                         if config.log_enabled else None)
+                         if config.logging.enabled else None)
 
     def _open_recorder(self, parameter_values: dict[str, Any],
                        cpus: set[int] | None) -> Recorder:
@@ -141,16 +140,16 @@ class NodeOutputs:
         # and the TF robot_state_publisher would publish, logged only (docs/logging.md)
         topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
-        if self.config.loops is LoopsSource.ROBOT_DESCRIPTION:
+        if self.config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
             topics.append((self.description_topic, String, ROBOT_DESCRIPTION_QOS, None))
             # Heard on the topic the node publishes to, the input goes to that topic's record.
             if self.input_topic != self._publishers.joint_states.topic_name:
                 topics.append((self.input_topic, JointState, MEASURED_QOS, None))
         try:
             return Recorder(
-                self.config.log_folder, topics=topics, metadata=metadata, cpus=cpus,
-                max_bag_size=self.config.log_max_bag_size,
-                max_bag_duration=self.config.log_max_bag_duration,
+                self.config.logging.folder, topics=topics, metadata=metadata, cpus=cpus,
+                max_bag_size=self.config.logging.max_bag_size,
+                max_bag_duration=self.config.logging.max_bag_duration,
             )
         except LogFolderError as error:
             raise ConfigurationError('log.folder', str(error)) from None
@@ -176,18 +175,19 @@ class NodeOutputs:
         """Prepare the encoders of the per-state messages for the geometry and joints."""
         if self._prepared_for is self.config:
             return  # a dataclass's != compares every field: once per configuration, not state
-        self._prepared_for = self.config
-        if self._encoded != self.config.linkage:
-            linkage = self.config.linkage
+        self._prepared_for = config = self.config
+        if self._encoded != config.geometry.linkage:
+            linkage = config.geometry.linkage
             self._state_encoder = messages.LinkageStateEncoder(linkage, self._frame_id)
             self._marker_encoder = messages.MarkerArrayEncoder(linkage, self._frame_id)
             self._encoded = linkage
-        if self._streamed != self.config.joints:
+        joints = config.joints
+        if self._streamed != joints.lab:
             # A measured driver stays with its own source: only the passive joints go out.
-            self._joints = JointStream(self.config.joints, self.config.driver,
-                                       include_driver=self.config.source is SourceKind.DRIVE_LAW)
+            self._joints = JointStream(joints.lab, joints.driver,
+                                       include_driver=joints.source is SourceKind.DRIVE_LAW)
             self._joint_state_encoder = messages.JointStateEncoder(self._joints.names)
-            self._streamed = self.config.joints
+            self._streamed = joints.lab
 
     def publish_state(self, state: LinkageState, stamp_ns: int, motion_time: float,
                       joints: TreeValues | None = None) -> None:
@@ -217,25 +217,24 @@ class NodeOutputs:
                   stamp_ns)
 
     def publish_description(self, stamp_ns: int) -> None:
-        """
-        Publish the URDF, if it is published and the geometry or the joints are new.
-
-        And log the /tf_static robot_state_publisher would publish for it (also where the lab's
-        own URDF is used: the node's has the lab's joints).
-        """
+        """Publish the URDF if published and its geometry or joints are new; log its /tf_static."""
         config = self.config
-        described = (config.linkage, config.joints)
-        if self._described == described or config.loops is LoopsSource.ROBOT_DESCRIPTION:
+        joints = config.joints
+        described = (config.geometry.linkage, joints.lab)
+        if self._described == described or config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
             return
         self._described = described
-        text = urdf_text(config.linkage, config.frame_id, config.joints, config.driver)
+        description = node_description(config.geometry.linkage, config.outputs.frame_id,
+                                       joints.lab, joints.driver)
         if self._publishers.robot_description is not None:
-            self.send(self._publishers.robot_description, encode_cdr(String(data=text)),
-                      stamp_ns)
+            self.send(self._publishers.robot_description,
+                      encode_cdr(String(data=description.text)), stamp_ns)
+        # robot_state_publisher's TF, also where a lab runs it on its own URDF: the node's URDF
+        # has the lab's joints
         if self.recorder is not None:
-            self._robot_transforms = messages.RobotStateTransforms(text, config.frame_prefix)
-            self._record(TF_STATIC_TOPIC, self._robot_transforms.static_message(stamp_ns),
-                         stamp_ns)
+            self._robot_transforms = tf = messages.RobotStateTransforms(
+                description.tree, config.outputs.frame_prefix)
+            self._record(TF_STATIC_TOPIC, tf.static_message(stamp_ns), stamp_ns)
 
     # loops robot_description: the lab's description, its closed loops and their input
 
@@ -289,7 +288,7 @@ class NodeOutputs:
         message = messages.diagnostic_array(
             Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000),
             f'{self._node.get_name()}: crank motion',
-            f"four-bar linkage ({config.preset or 'explicit geometry'})",
+            f"four-bar linkage ({config.geometry.preset or 'explicit geometry'})",
             bytes([level]),
             text,
             values,

@@ -8,7 +8,12 @@ Pure functions of parameter values (name → value), no ROS: ``parameter_value``
 against its spec (``parameter_specs``: kind, unit, range, choices), ``build_configuration``
 every value and then what they imply together (the geometry, distinct joint names, the motion),
 raising ConfigurationError naming the first bad parameter; the node, the demo and the tests all
-validate through it. README.md documents each parameter.
+validate through it. docs/parameters.md documents each parameter.
+
+A ``RunConfiguration`` holds the values in the groups ``parameter_specs`` declares them in, one
+frozen dataclass each: ``geometry``, ``motion`` (with the pass it implies), ``outputs``,
+``logging`` (with cpu_affinity, as its group has it), ``joints`` (the source, its driver, the
+lab's joints), ``measured`` and ``loops``; and ``autostart``.
 """
 
 from __future__ import annotations
@@ -52,14 +57,6 @@ _STEP_COUNT_TOLERANCE = 1e-9
 _WHOLE_TURN_TOLERANCE = 1e-9
 
 
-# The fields whose change restarts the motion from alpha_start (README: Run-time changes); a
-# field not named here (a threshold, a rate of the display, the lab's joint names) changes what
-# is reported or how, not where the crank is. The rest of the motion (segment_end, blocked_at,
-# ...) follows from these, and the read-only parameters never change at run time.
-MOTION_FIELDS = ('linkage', 'drive', 'branch', 'alpha_start', 'alpha_end', 'end_behavior', 'mode',
-                 'alpha_step', 'rate_hz')
-
-
 class ConfigurationError(ValueError):
     """A parameter value (or a combination of them) the node cannot run with."""
 
@@ -70,9 +67,19 @@ class ConfigurationError(ValueError):
 
 
 @dataclass(frozen=True)
-class RunConfiguration:
+class Geometry:
+    """The four-bar: its preset ('' for explicit dimensions) and the linkage."""
+
+    preset: str
+    linkage: FourBar
+    # The linkage as its driver turns it: ``linkage``, or seen from C for the rocker.
+    driven_linkage: FourBar
+
+
+@dataclass(frozen=True)
+class Motion:
     """
-    Validated parameters plus the motion they imply; replaced as a whole, never mutated.
+    The drive law's motion: branch, drive law, the pass and its pace, and what they imply.
 
     ``segment_end`` is where one pass of the motion ends: alpha_end, or ``blocked_at``, the
     first dead point the crank meets on its way there (change points do not stop it).
@@ -82,8 +89,6 @@ class RunConfiguration:
     starts (no dead point, duration 0).
     """
 
-    preset: str
-    linkage: FourBar
     drive: DriveLaw
     branch: int
     alpha_start: float
@@ -92,32 +97,6 @@ class RunConfiguration:
     mode: MotionMode
     alpha_step: float
     rate_hz: float
-    display_rate_hz: float
-    frame_id: str
-    frame_prefix: str
-    min_transmission_angle: float
-    dead_point_warning: float
-    log_enabled: bool
-    log_folder: Path
-    log_max_bag_size: int
-    log_max_bag_duration: float
-    cpu_affinity: int
-    source: SourceKind
-    driver: Driver
-    # The linkage as its driver turns it: ``linkage``, or seen from C for the rocker.
-    driven_linkage: FourBar
-    joints: JointMap
-    publish_robot_description: bool
-    measured_timeout: float
-    max_jump: float
-    acceleration_time_constant: float
-    # loops robot_description: the measured joints (empty: those of the first message), each
-    # constraint's assembly branch override (name, ±1), and the URDF ('': from the topic)
-    loops: LoopsSource
-    loop_measured_joints: tuple[str, ...]
-    loop_branches: tuple[tuple[str, int], ...]
-    robot_description: str
-    autostart: bool
     direction: int
     segment_end: float
     blocked_at: float | None
@@ -134,9 +113,87 @@ class RunConfiguration:
         """
         return DriveLaw(-self.drive.omega0, -self.drive.k)
 
+
+@dataclass(frozen=True)
+class Outputs:
+    """The marker rate, the frames the node publishes in, and the diagnostics' thresholds (rad)."""
+
+    display_rate_hz: float
+    frame_id: str
+    frame_prefix: str
+    min_transmission_angle: float
+    dead_point_warning: float
+
+
+@dataclass(frozen=True)
+class Logging:
+    """The bag (``log.*``), and the CPU the node's process and its bag writer run on."""
+
+    enabled: bool
+    folder: Path
+    max_bag_size: int
+    max_bag_duration: float
+    cpu_affinity: int
+
+
+@dataclass(frozen=True)
+class Joints:
+    """Where the motion comes from, the joint that drives it, the lab's joints, the URDF's."""
+
+    source: SourceKind
+    driver: Driver
+    lab: JointMap
+    publish_robot_description: bool
+
+
+@dataclass(frozen=True)
+class Measured:
+    """How the measured source judges and filters its samples (``measured.*``)."""
+
+    timeout: float
+    max_jump: float
+    acceleration_time_constant: float
+
+
+@dataclass(frozen=True)
+class Loops:
+    """
+    Which loops the measured source closes (``loops``), and how.
+
+    With ``loops:=robot_description``: the measured joints (empty: those of the first message),
+    each constraint's assembly branch override (name, ±1), and the URDF ('': from the topic).
+    """
+
+    source: LoopsSource
+    measured_joints: tuple[str, ...]
+    branches: tuple[tuple[str, int], ...]
+    robot_description: str
+
+
+@dataclass(frozen=True)
+class RunConfiguration:
+    """Validated parameters plus the motion they imply, by group; replaced whole, never mutated."""
+
+    geometry: Geometry
+    motion: Motion
+    outputs: Outputs
+    logging: Logging
+    joints: Joints
+    measured: Measured
+    loops: Loops
+    autostart: bool
+
     def restarts_motion(self, other: RunConfiguration) -> bool:
-        """Whether switching from ``other`` to this configuration changes the motion itself."""
-        return any(getattr(self, name) != getattr(other, name) for name in MOTION_FIELDS)
+        """
+        Whether switching from ``other`` to this configuration changes the motion itself.
+
+        The geometry or the motion (docs/parameters.md: run-time changes); a threshold, a rate
+        of the display, the lab's joint names change what is reported or how, not where the
+        crank is.
+        The pass follows from these, and the read-only parameters never change at run time.
+        """
+        return (self.geometry.linkage != other.geometry.linkage
+                or self.motion != other.motion)
 
 
 # --- validation: pure functions from parameter values to a RunConfiguration ---------------
@@ -391,48 +448,62 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
     alpha_start, alpha_end = checked['alpha_start'], checked['alpha_end']
     driver = checked['driver']
     return RunConfiguration(
-        preset=preset_name,
-        linkage=linkage,
-        drive=drive,
-        branch=checked['branch'],
-        alpha_start=alpha_start,
-        alpha_end=alpha_end,
-        end_behavior=checked['end_behavior'],
-        mode=checked['mode'],
-        alpha_step=checked['alpha_step'],
-        rate_hz=checked['rate_hz'],
-        display_rate_hz=checked['display_rate_hz'],
-        frame_id=checked['frame_id'],
-        frame_prefix=checked['frame_prefix'],
-        min_transmission_angle=checked['diagnostics.min_transmission_angle'],
-        dead_point_warning=checked['diagnostics.dead_point_warning'],
-        log_enabled=checked['log.enabled'],
-        log_folder=Path(checked['log.folder']),
-        log_max_bag_size=checked['log.max_bag_size'],
-        log_max_bag_duration=checked['log.max_bag_duration'],
-        cpu_affinity=checked['cpu_affinity'],
-        source=checked['source'],
-        driver=driver,
-        driven_linkage=linkage if driver is Driver.CRANK else seen_from_rocker(linkage),
-        joints=joints,
-        publish_robot_description=checked['publish_robot_description'],
-        measured_timeout=checked['measured.timeout'],
-        max_jump=checked['measured.max_jump'],
-        acceleration_time_constant=checked['measured.acceleration_time_constant'],
-        loops=checked['loops'],
-        loop_measured_joints=tuple(checked['loops.measured_joints']),
-        loop_branches=_loop_branches(checked['loops.branches']),
-        robot_description=checked['robot_description'],
-        autostart=checked['autostart'],
-        direction=1 if segment_end > alpha_start else -1,
-        segment_end=segment_end,
-        blocked_at=blocked_at,
-        segment_duration=segment_duration,
-        whole_turns=(
-            blocked_at is None
-            and abs(math.remainder(alpha_end - alpha_start, TWO_PI)) <= _WHOLE_TURN_TOLERANCE
+        geometry=Geometry(
+            preset=preset_name,
+            linkage=linkage,
+            driven_linkage=linkage if driver is Driver.CRANK else seen_from_rocker(linkage),
         ),
-        step_count=step_count,
+        motion=Motion(
+            drive=drive,
+            branch=checked['branch'],
+            alpha_start=alpha_start,
+            alpha_end=alpha_end,
+            end_behavior=checked['end_behavior'],
+            mode=checked['mode'],
+            alpha_step=checked['alpha_step'],
+            rate_hz=checked['rate_hz'],
+            direction=1 if segment_end > alpha_start else -1,
+            segment_end=segment_end,
+            blocked_at=blocked_at,
+            segment_duration=segment_duration,
+            whole_turns=(
+                blocked_at is None
+                and abs(math.remainder(alpha_end - alpha_start, TWO_PI)) <= _WHOLE_TURN_TOLERANCE
+            ),
+            step_count=step_count,
+        ),
+        outputs=Outputs(
+            display_rate_hz=checked['display_rate_hz'],
+            frame_id=checked['frame_id'],
+            frame_prefix=checked['frame_prefix'],
+            min_transmission_angle=checked['diagnostics.min_transmission_angle'],
+            dead_point_warning=checked['diagnostics.dead_point_warning'],
+        ),
+        logging=Logging(
+            enabled=checked['log.enabled'],
+            folder=Path(checked['log.folder']),
+            max_bag_size=checked['log.max_bag_size'],
+            max_bag_duration=checked['log.max_bag_duration'],
+            cpu_affinity=checked['cpu_affinity'],
+        ),
+        joints=Joints(
+            source=checked['source'],
+            driver=driver,
+            lab=joints,
+            publish_robot_description=checked['publish_robot_description'],
+        ),
+        measured=Measured(
+            timeout=checked['measured.timeout'],
+            max_jump=checked['measured.max_jump'],
+            acceleration_time_constant=checked['measured.acceleration_time_constant'],
+        ),
+        loops=Loops(
+            source=checked['loops'],
+            measured_joints=tuple(checked['loops.measured_joints']),
+            branches=_loop_branches(checked['loops.branches']),
+            robot_description=checked['robot_description'],
+        ),
+        autostart=checked['autostart'],
     )
 
 

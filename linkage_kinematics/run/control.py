@@ -6,7 +6,7 @@ Start control: whether the motion runs, and what ``~/pause``, ``~/resume`` and `
 
 A pure state machine (no ROS): the node asks it, answers each std_srvs/srv/Trigger call with the
 returned ServiceAnswer and moves the motion's time origin by the motion time it hands back, so
-that a paused motion goes on where it stopped. README.md documents the services.
+that a paused motion goes on where it stopped. docs/parameters.md documents the services.
 """
 
 from __future__ import annotations

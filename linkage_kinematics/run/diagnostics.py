@@ -7,27 +7,27 @@ What the node's diagnostics say and when, without ROS.
 ``assess`` gives the status's level and message and ``report`` its whole content, from the
 ``StatusInputs`` the node has at that moment;
 ``MeasuredHealth`` is the measured source's record of dropped samples and of the time since
-the last valid one. ``key_values`` formats the status's key values (README, "Diagnostics") so
-that a viewer shows them as they are: counts as integers, small residuals in scientific
-notation, and in each mode only the rate it uses. ``StatusSchedule`` says which states a
-status goes out with: one at least every ``STATUS_PERIOD`` of mechanism time, so that a
-replayed bag's diagnostics move with the mechanism. ``RateMeter`` measures the achieved state
-rate over the last ``RATE_WINDOW``, so that statuses that close together do not report the
-jitter of a few ticks.
+the last valid one. ``key_values`` formats the status's key values (docs/parameters.md,
+"Diagnostics") so that a viewer shows them as they are: counts as integers, small residuals
+in scientific notation, and in each mode only the rate it uses. ``StatusSchedule`` says which
+states a status goes out with: one at least every ``STATUS_PERIOD`` of mechanism time, so that
+a replayed bag's diagnostics move with the mechanism. ``RateMeter`` measures the achieved
+state rate over the last ``RATE_WINDOW``, so that statuses that close together do not report
+the jitter of a few ticks.
 """
 
 from __future__ import annotations
 
 import collections
 from dataclasses import dataclass
-from enum import Enum, IntEnum
+from enum import IntEnum
 import math
 
 from linkage_kinematics.kinematics.solver import LinkageState, loop_closure_residual
+from linkage_kinematics.loops.intake import DropReason, Estimate, FOUR_BAR_DROPS
 from linkage_kinematics.model.joints import Driver, Link
 from linkage_kinematics.run.configuration import MotionMode, RunConfiguration, SourceKind
 from linkage_kinematics.run.control import RunState
-from linkage_kinematics.run.measured import Estimate, Rejection
 from linkage_kinematics.run.motion import blocked_note
 
 STATUS_PERIOD = 0.1  # s of mechanism time between statuses sent with the states
@@ -95,7 +95,7 @@ class RateMeter:
 @dataclass(frozen=True, kw_only=True)
 class StatusInputs:
     """
-    What one status is made of, as the node has it when it sends one (README, Diagnostics).
+    What one status is made of, as the node has it when it sends one (docs/parameters.md).
 
     ``run_state`` says whether the motion runs or is paused and ``state`` is the latest state
     (None before the first). ``problem`` makes the status ERROR (the crank cannot go on, the
@@ -119,24 +119,25 @@ class StatusInputs:
 
 
 def key_values(inputs: StatusInputs) -> dict[str, str]:
-    """Return the status's key values (README, Diagnostics) as diagnostic_msgs/KeyValue texts."""
+    """Return the status's key values (docs/parameters.md) as diagnostic_msgs/KeyValue texts."""
     config, state, health = inputs.config, inputs.state, inputs.health
+    motion = config.motion
     log_file, log_size = inputs.log_file, inputs.log_size
     # The state first, then the pace, the log and the run's settings: a diagnostics panel shows
     # the values that change at the top.
     values = {}
     if state is not None:
         # Distances along the driver's travel: the rocker-driven chain's for the rocker.
-        reachability = config.driven_linkage.reachability
+        reachability = config.geometry.driven_linkage.reachability
         angle = driver_angle(config, state)
         distance = reachability.dead_point_distance(angle)
         change_distance = reachability.change_point_distance(angle)
-        residual = float(loop_closure_residual(config.linkage, state))
+        residual = float(loop_closure_residual(config.geometry.linkage, state))
         values.update({
             'alpha (deg)': f'{math.degrees(state.alpha):.6f}',
             'alpha (rad)': repr(state.alpha),
             **({'rocker angle (deg)': f'{math.degrees(angle):.6f}'}
-               if config.driver is Driver.ROCKER else {}),
+               if config.joints.driver is Driver.ROCKER else {}),
             'transmission angle (deg)': f'{math.degrees(state.transmission_angle):.6f}',
             'dead point distance (deg)': (
                 'none (full rotation)' if distance is None else f'{math.degrees(distance):.6f}'
@@ -157,17 +158,17 @@ def key_values(inputs: StatusInputs) -> dict[str, str]:
         return values
     # Each mode reports what paces it: rate_hz in real_time; in fixed_step the drive law sets
     # the pace, and rate_hz is not used.
-    if config.mode == MotionMode.REAL_TIME:
-        values['rate_hz'] = f'{config.rate_hz:g}'
+    if motion.mode == MotionMode.REAL_TIME:
+        values['rate_hz'] = f'{motion.rate_hz:g}'
     else:
-        values['alpha_step (deg)'] = f'{math.degrees(config.alpha_step):.6g}'
+        values['alpha_step (deg)'] = f'{math.degrees(motion.alpha_step):.6g}'
     values['missed deadlines'] = str(int(inputs.missed_deadlines))
     if log_file is not None and log_size is not None:
         values['log size (bytes)'] = str(int(log_size))
     values['log file'] = LOG_DISABLED if log_file is None else log_file
     values['run state'] = inputs.run_state.value
-    values['mode'] = config.mode.value
-    values['end behavior'] = config.end_behavior.value
+    values['mode'] = motion.mode.value
+    values['end behavior'] = motion.end_behavior.value
     return values
 
 
@@ -180,9 +181,20 @@ class Level(IntEnum):
     STALE = 3
 
 
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic_msgs/DiagnosticStatus: its task (after the node's name) and content."""
+
+    task: str
+    hardware_id: str
+    level: Level
+    message: str
+    values: dict[str, str]
+
+
 def driver_angle(config: RunConfiguration, state: LinkageState) -> float:
     """Return the driver's angle in ``state``: α for the crank, θ_BC = π − β for the rocker."""
-    return state.alpha if config.driver is Driver.CRANK else math.pi - state.beta
+    return state.alpha if config.joints.driver is Driver.CRANK else math.pi - state.beta
 
 
 def assess(
@@ -199,28 +211,29 @@ def assess(
     WARN for ``warnings`` (e.g. dropped samples), near a dead point or a change point or at a
     poor transmission angle, else OK with ``activity``.
     """
+    outputs = config.outputs
     if problem is not None:
         return Level.ERROR, problem
     warnings = list(warnings)
     if state is not None:
         deviation = min(state.transmission_angle, math.pi - state.transmission_angle)
-        if deviation < config.min_transmission_angle:
+        if deviation < outputs.min_transmission_angle:
             warnings.append(
                 f'transmission angle {math.degrees(state.transmission_angle):.2f}° is within '
-                f'{math.degrees(config.min_transmission_angle):.2f}° of a straight line'
+                f'{math.degrees(outputs.min_transmission_angle):.2f}° of a straight line'
             )
-        reachability = config.driven_linkage.reachability
+        reachability = config.geometry.driven_linkage.reachability
         angle = driver_angle(config, state)
         distance = reachability.dead_point_distance(angle)
-        if distance is not None and distance < config.dead_point_warning:
+        if distance is not None and distance < outputs.dead_point_warning:
             warnings.append(f'{math.degrees(distance):.3f}° from a dead point')
         distance = reachability.change_point_distance(angle)
-        if distance is not None and distance < config.dead_point_warning:
+        if distance is not None and distance < outputs.dead_point_warning:
             warnings.append(
                 f'{math.degrees(distance):.3f}° from a change point (the assemblies meet; the '
                 'motion continues smoothly on its branch)'
             )
-    note = blocked_note(config) if config.source is SourceKind.DRIVE_LAW else None
+    note = blocked_note(config) if config.joints.source is SourceKind.DRIVE_LAW else None
     if note is not None:
         warnings.append(note)
     if warnings:
@@ -230,7 +243,7 @@ def assess(
 
 def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
     """
-    Return the level, message and key values of one status (README, Diagnostics).
+    Return the level, message and key values of one status (docs/parameters.md, Diagnostics).
 
     A measured source's drops since the last status make it WARN and its staleness ERROR.
     """
@@ -238,8 +251,8 @@ def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
     warnings: tuple[str, ...] = ()
     if health is not None:
         warnings = health.take_warnings()
-        driver_name = config.joints[Link(config.driver.value)].name
-        problem = problem or health.problem(inputs.now_ns, config.measured_timeout, driver_name)
+        driver_name = config.joints.lab[Link(config.joints.driver.value)].name
+        problem = problem or health.problem(inputs.now_ns, config.measured.timeout, driver_name)
     values = key_values(inputs)
     level, text = assess(config, inputs.state, problem, inputs.activity, warnings)
     return level, text, values
@@ -247,19 +260,31 @@ def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
 
 class Freshness:
     """
-    How fresh a measured source's data is: its valid samples, and when the last one came.
+    A measured source's samples: the valid ones, when the last came, and those dropped, by reason.
 
     No valid sample for ``measured.timeout`` (node clock) makes the source's status ERROR, as
     diagnostic_updater's frequency status says ERROR when no event came in its window. Both
     measured sources' health records (``MeasuredHealth``, ``loop_diagnostics.LoopsHealth``),
-    each with ``totals``, its dropped samples by reason (a member of ``reasons``).
+    each with ``totals``, its dropped samples by reason (one of its mode's ``reasons``, in the
+    order its key values list them), and those since its last status (``_take_window``).
     """
 
-    def __init__(self, start_ns: int, reasons: type[Enum]) -> None:
+    def __init__(self, start_ns: int, reasons: tuple[DropReason, ...]) -> None:
         self.accepted = 0
         self.last_valid_ns: int | None = None
         self.totals = dict.fromkeys(reasons, 0)
+        self._window = dict.fromkeys(reasons, 0)
         self._start_ns = start_ns
+
+    def drop(self, reason: DropReason) -> None:
+        """Count a dropped sample."""
+        self.totals[reason] += 1
+        self._window[reason] += 1
+
+    def _take_window(self) -> dict[DropReason, int]:
+        """Return the drops since the last call, by reason, and start a new window."""
+        window, self._window = self._window, dict.fromkeys(self.totals, 0)
+        return window
 
     def _accepted_at(self, now_ns: int) -> None:
         self.accepted += 1
@@ -302,13 +327,8 @@ class MeasuredHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns, Rejection)
-        self._window = dict.fromkeys(Rejection, 0)
+        super().__init__(start_ns, FOUR_BAR_DROPS)
         self.velocity: Estimate | None = None
-
-    def drop(self, rejection: Rejection) -> None:
-        self.totals[rejection] += 1
-        self._window[rejection] += 1
 
     def accept(self, now_ns: int, velocity: Estimate) -> None:
         self._accepted_at(now_ns)
@@ -320,28 +340,27 @@ class MeasuredHealth(Freshness):
 
     def take_warnings(self) -> tuple[str, ...]:
         """Return the drops since the last call, one text per reason, and start a new window."""
-        warnings = tuple(
-            f'dropped {count} sample{"s" if count > 1 else ""} {rejection.value}'
-            for rejection, count in self._window.items() if count
+        return tuple(
+            f'dropped {count} sample{"s" if count > 1 else ""} {reason.value}'
+            for reason, count in self._take_window().items() if count
         )
-        self._window = dict.fromkeys(Rejection, 0)
-        return warnings
 
     def values(self, now_ns: int, config: RunConfiguration) -> dict[str, str]:
         """Return the key values: counts, freshness, and which quantities are estimates."""
-        values = {'source': 'measured', 'driver': config.driver.value,
+        joints = config.joints
+        values = {'source': 'measured', 'driver': joints.driver.value,
                   **self.sample_values(now_ns)}
-        values['measured'] = f'{config.driver.value} angle' + (
-            f', {config.driver.value} angular velocity'
+        values['measured'] = f'{joints.driver.value} angle' + (
+            f', {joints.driver.value} angular velocity'
             if self.velocity is Estimate.MEASURED else '')
         values['exact functions of the measured'] = (
             'every angle and position, passive joints' + (
                 ', every velocity' if self.velocity is Estimate.MEASURED else ''))
         values['estimated'] = (
             ('' if self.velocity is Estimate.MEASURED
-             else f'{config.driver.value} angular velocity '
+             else f'{joints.driver.value} angular velocity '
              f'({(self.velocity or Estimate.BACKWARD_DIFFERENCE).value}) and every velocity; ')
-            + f'{config.driver.value} angular acceleration (low-pass filtered difference, '
-            f'τ = {config.acceleration_time_constant:g} s) and every acceleration'
+            + f'{joints.driver.value} angular acceleration (low-pass filtered difference, '
+            f'τ = {config.measured.acceleration_time_constant:g} s) and every acceleration'
         )
         return values

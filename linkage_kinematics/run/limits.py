@@ -2,11 +2,12 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The limits of the node's parameters, one owner for each: validation, descriptors and the bag.
+The limits of the node's parameters, one owner for each: their validation and descriptors.
 
 ``parameter_specs`` puts them into each parameter's contract (which ``configuration`` checks
-values against and the descriptors show), ``configuration`` checks the pass against
-MIN_PASS_DURATION, and ``bag.writer`` enforces rosbag2's split rule with the same two numbers.
+values against and the descriptors show), and ``configuration`` checks the pass against
+MIN_PASS_DURATION. rosbag2's split numbers, which the bag writer applies too, have their owner
+beneath both (``shared.rosbag2_split``).
 """
 
 MAX_RATE_HZ = 10000.0
@@ -25,7 +26,3 @@ MAX_DRIVE_GAIN = 1e4  # 1/s, the largest |k|
 MIN_PASS_DURATION = 1e-6
 MAX_TIMEOUT = 3600.0  # s
 MAX_TIME_CONSTANT = 10.0  # s
-# rosbag2's smallest max_bagfile_size for its MCAP storage (get_minimum_split_file_size), and
-# its value for "never split" (of both max_bagfile_size and max_bagfile_duration).
-MIN_SPLIT_SIZE = 1024
-NO_SPLIT = 0

@@ -18,41 +18,26 @@ from dataclasses import dataclass
 import math
 
 from linkage_kinematics.kinematics.planar_loop import JointKind
-from linkage_kinematics.model.loops import LoopPlan, PlannedLoop
+from linkage_kinematics.loops.follower import dead_point_distances, LoopSample
+from linkage_kinematics.loops.intake import DropReason, Estimate, LOOPS_DROPS
+from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
 from linkage_kinematics.run.diagnostics import (
     Freshness,
     Level,
     LOG_DISABLED,
     NOT_MEASURED,
+    Status,
     StatusInputs,
-)
-from linkage_kinematics.run.measured import Estimate
-from linkage_kinematics.run.robot_loops import (
-    dead_point_distances,
-    LoopDrop,
-    LoopRejection,
-    LoopSample,
 )
 
 NODE_TASK = 'robot loops'
 
 
-@dataclass(frozen=True)
-class Status:
-    """One diagnostic_msgs/DiagnosticStatus: its task (after the node's name) and content."""
-
-    task: str
-    hardware_id: str
-    level: Level
-    message: str
-    values: dict[str, str]
+def _counts() -> dict[DropReason, int]:
+    return dict.fromkeys(LOOPS_DROPS, 0)
 
 
-def _counts() -> dict[LoopRejection, int]:
-    return dict.fromkeys(LoopRejection, 0)
-
-
-def _dropped(count: int, reason: LoopRejection) -> str:
+def _dropped(count: int, reason: DropReason) -> str:
     return f'dropped {count} message{"s" if count > 1 else ""} {reason.value}'
 
 
@@ -65,19 +50,17 @@ class LoopsHealth(Freshness):
     """
 
     def __init__(self, start_ns: int) -> None:
-        super().__init__(start_ns, LoopRejection)
-        self._window = _counts()
-        self.per_loop: dict[str, dict[LoopRejection, int]] = {}
-        self._loop_window: dict[str, dict[LoopRejection, int]] = {}
+        super().__init__(start_ns, LOOPS_DROPS)
+        self.per_loop: dict[str, dict[DropReason, int]] = {}
+        self._loop_window: dict[str, dict[DropReason, int]] = {}
         self.last: LoopSample | None = None
 
-    def drop(self, drop: LoopDrop) -> None:
+    def drop(self, reason: DropReason, constraints: tuple[str, ...] = ()) -> None:
         """Count a dropped message, for the node and for each loop it concerned."""
-        self.totals[drop.reason] += 1
-        self._window[drop.reason] += 1
-        for constraint in drop.constraints:
+        super().drop(reason)
+        for constraint in constraints:
             for counts in (self.per_loop, self._loop_window):
-                counts.setdefault(constraint, _counts())[drop.reason] += 1
+                counts.setdefault(constraint, _counts())[reason] += 1
 
     def accept(self, now_ns: int, sample: LoopSample) -> None:
         """Note a message followed at node-clock time ``now_ns``."""
@@ -90,11 +73,12 @@ class LoopsHealth(Freshness):
 
     def take_warnings(self) -> tuple[tuple[str, ...], dict[str, tuple[str, ...]]]:
         """Return the drops since the last call (the node's, each loop's) and start anew."""
-        node = tuple(_dropped(count, reason) for reason, count in self._window.items() if count)
+        node = tuple(_dropped(count, reason)
+                     for reason, count in self._take_window().items() if count)
         loops = {constraint: tuple(_dropped(count, reason)
                                    for reason, count in counts.items() if count)
                  for constraint, counts in self._loop_window.items()}
-        self._window, self._loop_window = _counts(), {}
+        self._loop_window = {}
         return node, loops
 
 
@@ -154,10 +138,10 @@ def _loop_status(inputs: StatusInputs, view: LoopsView, planned: PlannedLoop,
     counts = health.per_loop.get(constraint, _counts())
     values['dropped samples'] = str(sum(counts.values()))
     values.update({f'dropped {reason.value}': str(count) for reason, count in counts.items()
-                   if reason is not LoopRejection.NO_DESCRIPTION})
+                   if reason is not DropReason.NO_DESCRIPTION})
     notes = list(warnings)
     if (distance is not None and known.kind is JointKind.REVOLUTE
-            and distance < inputs.config.dead_point_warning):
+            and distance < inputs.config.outputs.dead_point_warning):
         notes.append(f'{known.name} is {math.degrees(distance):.3f}° from a dead point')
     if notes:
         level, message = Level.WARN, '; '.join(notes)
@@ -201,14 +185,14 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
 
 def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
     """
-    Return the node's status and one per loop (README, Diagnostics).
+    Return the node's status and one per loop (docs/parameters.md, Diagnostics).
 
     The node's: ERROR for ``inputs.problem`` (a description that cannot be closed, the log
     failed) or stale data, WARN for drops since the last status, else OK with the activity.
     """
     health = view.health
     node_warnings, loop_warnings = health.take_warnings()
-    stale = health.problem(inputs.now_ns, inputs.config.measured_timeout)
+    stale = health.problem(inputs.now_ns, inputs.config.measured.timeout)
     if stale is not None and inputs.activity.startswith('waiting'):
         stale = f'{stale}; {inputs.activity}'  # say what the node still waits for
     problem = inputs.problem or stale

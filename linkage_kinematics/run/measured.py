@@ -5,14 +5,16 @@
 The measured source: one measured driver joint in, the exact state of the linkage out.
 
 ``MeasuredFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
-positions, velocities), picks the driver joint by its lab name, maps it to the node's
-convention (``joints.JointMapping.from_lab``), unwraps it across turns and solves the linkage
-at it: the crank directly, the rocker through the mechanism seen from C (``inversion``).
+positions, velocities), takes the driver joint in through the measured modes' one
+``loops.intake.Intake`` (by its lab name, mapped to the node's convention by
+``joints.JointMapping.from_lab``, unwrapped across turns) and solves the linkage at it: the
+crank directly, the rocker through the mechanism seen from C (``inversion``).
 
 The passive joints come the general way, as from a lab's URDF: the node's own URDF for the
-configuration (``model.urdf``, whose ``<constraint>`` closes its loop) is read by
-``model.loops``, planned with the driver measured, and its ``LoopSolver`` turns the driver's lab
-value and velocity into the passive joints' lab values and velocities. The four-bar's
+configuration (``model.urdf``, whose ``<constraint>`` closes its loop; its text read once,
+``node_description``) is read by ``loops.plan``, planned with the driver measured, and its
+``LoopSolver`` turns the driver's lab value and velocity into the passive joints' lab values and
+velocities. The four-bar's
 ``LinkageState`` (``linkage/state``, the scene, diagnostics) still comes from its closed form:
 it holds the accelerations and pins the loop solver does not compute.
 
@@ -31,7 +33,7 @@ What is measured, exact or estimated:
   difference; a step in ω̇ is followed with time constant τ, so the estimate lags by about τ),
   and 0 for a first sample; every other acceleration is then an estimate too.
 
-A sample that cannot be used is dropped and its ``Rejection`` returned; nothing of it is kept.
+A sample that cannot be used is dropped and its ``DropReason`` returned; nothing of it is kept.
 No ROS.
 """
 
@@ -39,7 +41,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from enum import StrEnum
 import math
 
 from linkage_kinematics.kinematics.geometry import TWO_PI, UnreachableError
@@ -53,56 +54,16 @@ from linkage_kinematics.kinematics.solver import (
     solve,
     unwrap_near,
 )
+from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
+from linkage_kinematics.loops.plan import find_loops, LoopPlan, RobotLoops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.model.joints import Driver, Link, TREE_ORDER, TreeValues
-from linkage_kinematics.model.loops import (
-    find_loops,
-    LoopPlan,
-    LoopSampleError,
-    LoopSolver,
-    RobotLoops,
-)
-from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.run.configuration import RunConfiguration
 
 # Far below any distance between two change points, far above the rounding of the loop's
 # geometry (rad): where the four-bar's and the loop's change points are told apart.
 _CHANGE_POINT_CLEARANCE = 1e-9
-
-
-class Rejection(StrEnum):
-    """Why a measured sample was dropped (the text names it in diagnostics)."""
-
-    NO_DRIVER = 'without the driver joint'
-    NON_FINITE = 'with a NaN or infinite position or velocity'
-    STAMP_NOT_NEWER = 'with a stamp not newer than the last one used'
-    UNREACHABLE = 'at a driver angle the loop cannot reach (or at a dead point)'
-    JUMP = 'jumping further than measured.max_jump'
-    MALFORMED = 'whose bytes are not a well-formed JointState'
-
-
-class Estimate(StrEnum):
-    """How the driver's angular velocity of a sample was obtained."""
-
-    MEASURED = 'measured'
-    BACKWARD_DIFFERENCE = 'estimated (backward difference of angles)'
-    FIRST_SAMPLE = 'estimated (0: first sample without velocity)'
-
-
-def joint_velocity(stamp_ns: int, value: float, measured: float | None,
-                   last: tuple[int, float] | None) -> tuple[float, Estimate]:
-    """
-    Return a measured joint's velocity at ``value`` (stamp ``stamp_ns``) and how it was obtained.
-
-    ``measured`` when the message carries it; else the backward difference from ``last``
-    (its stamp in ns and its value, unwrapped to ``value``'s turn) over the header stamps, and 0
-    for a first sample (``last`` None).
-    """
-    if measured is not None:
-        return measured, Estimate.MEASURED
-    if last is None:
-        return 0.0, Estimate.FIRST_SAMPLE
-    last_stamp_ns, last_value = last
-    return (value - last_value) / ((stamp_ns - last_stamp_ns) * 1e-9), Estimate.BACKWARD_DIFFERENCE
 
 
 @dataclass(frozen=True)
@@ -129,9 +90,7 @@ class _Anchor:
     """Where the followed motion is known: a driver angle, its assembly and its stamp."""
 
     stamp_ns: int
-    angle: float  # unwrapped, node convention
     encoder_angle: float  # as measured, node convention
-    turns: int  # whole turns from encoder_angle to angle
     crank_angle: float  # α, unwrapped
     omega: float
     omega_dot: float
@@ -141,12 +100,16 @@ class MeasuredFollower:
     """Follows the measured driver joint; one per run, ``restart`` forgets the motion."""
 
     def __init__(self, config: RunConfiguration) -> None:
+        joints = config.joints
         self.config = config
-        self._mapping = config.joints[Link(config.driver.value)]
+        self._mapping = joints.lab[Link(joints.driver.value)]
         # Messages that hold only the joints this node publishes are its own output coming
         # back (it may listen on the topic it publishes to): ignored, not counted.
-        self._passive = tuple(config.joints[link] for link in TREE_ORDER[config.driver][1:])
-        self._own_names = frozenset(mapping.name for mapping in self._passive)
+        self._passive = tuple(joints.lab[link] for link in TREE_ORDER[joints.driver][1:])
+        self._intake = Intake(
+            (self._mapping.name,), (self._mapping.name,), config.measured.max_jump,
+            DropReason.NO_DRIVER, own_output=(mapping.name for mapping in self._passive),
+            mappings=(self._mapping,))
         self._loops = _node_loops(config)
         # The passive joints published last (lab values), kept across restarts so that they
         # stay continuous; at first the node's zero, as every joint stream starts.
@@ -155,6 +118,7 @@ class MeasuredFollower:
 
     def restart(self) -> None:
         """Forget the motion: the next valid sample starts it again on ``branch``."""
+        self._intake.restart()
         self._first: _Anchor | None = None
         self._last: _Anchor | None = None
         self._solver: LoopSolver | None = None  # planned at the motion's first sample
@@ -166,8 +130,9 @@ class MeasuredFollower:
         New thresholds (timeout, jump, filter) go on following the same motion; a new geometry
         (a new loop) comes with a restart of the motion.
         """
-        if config.linkage != self.config.linkage:
+        if config.geometry.linkage != self.config.geometry.linkage:
             self._loops = _node_loops(config)
+        self._intake.max_jump = config.measured.max_jump
         self.config = config
 
     def follow(
@@ -176,40 +141,28 @@ class MeasuredFollower:
         names: Sequence[str],
         positions: Sequence[float],
         velocities: Sequence[float],
-    ) -> FollowedSample | Rejection | None:
+    ) -> FollowedSample | DropReason | None:
         """
         Return the state at one message's driver sample, or why it was dropped.
 
         None for a message that is this node's own output (see ``__init__``).
         """
-        try:
-            index = names.index(self._mapping.name)
-            measured_angle = positions[index]
-        except (ValueError, IndexError):
-            if names and self._own_names.issuperset(names):
-                return None
-            return Rejection.NO_DRIVER
-        measured_velocity = velocities[index] if index < len(velocities) else None
-        if not math.isfinite(measured_angle) or (
-                measured_velocity is not None and not math.isfinite(measured_velocity)):
-            return Rejection.NON_FINITE
-        last = self._last
-        if last is not None and stamp_ns <= last.stamp_ns:
-            return Rejection.STAMP_NOT_NEWER
+        taken = self._intake.take(stamp_ns, names, positions, velocities)
+        if taken.__class__ is not tuple:
+            return None if taken is None else taken.reason
+        (measured_angle,), (angle,), (omega,), (estimate,) = taken
+        # the driver's angle as measured, and the whole turns the intake unwrapped it by
         encoder_angle = self._mapping.from_lab(measured_angle)
-        # An encoder that wraps (at ±π, or anywhere) is unwrapped: whole turns are counted.
-        turns = 0 if last is None else round((last.angle - encoder_angle) / TWO_PI)
-        angle = encoder_angle + turns * TWO_PI
-        if last is not None and abs(angle - last.angle) > self.config.max_jump:
-            return Rejection.JUMP
-        omega, omega_dot, estimate = self._rates(stamp_ns, angle, measured_velocity)
+        turns = round((angle - encoder_angle) / TWO_PI)
+        omega_dot = self._acceleration(stamp_ns, omega)
         try:
             state = self._solve(encoder_angle, turns, omega, omega_dot)
             joints = self._complete(encoder_angle, measured_angle,
                                     self._mapping.direction * omega)
         except (DeadPointError, UnreachableError, LoopSampleError):
-            return Rejection.UNREACHABLE
-        anchor = _Anchor(stamp_ns, angle, encoder_angle, turns, state.alpha, omega, omega_dot)
+            return DropReason.DRIVER_UNREACHABLE
+        self._intake.keep(stamp_ns, taken[1])
+        anchor = _Anchor(stamp_ns, encoder_angle, state.alpha, omega, omega_dot)
         if self._first is None:
             self._first = anchor
         self._last = anchor
@@ -252,29 +205,24 @@ class MeasuredFollower:
         """
         config = self.config
         nearby = encoder_angle + _CHANGE_POINT_CLEARANCE
-        branch = continued_branch(config.driven_linkage, encoder_angle, config.branch, nearby)
+        branch = continued_branch(config.geometry.driven_linkage, encoder_angle,
+                                  config.motion.branch, nearby)
         (loop,) = self._loops.loops
         known = loop.joint(self._mapping.name)
         branch = continued_branch_of(loop.planar, known.index,
                                      known.sign * self._mapping.to_lab(nearby), branch, 0.0)
         return self._loops.plan([known.name], {loop.constraint: branch})
 
-    def _rates(
-        self, stamp_ns: int, angle: float, measured_velocity: float | None
-    ) -> tuple[float, float, Estimate]:
-        """Return the driver's ω and ω̇ (node convention) and how ω was obtained."""
+    def _acceleration(self, stamp_ns: int, omega: float) -> float:
+        """Return the driver's ω̇ (node convention) at ``omega``: the filtered difference."""
         last = self._last
-        omega, estimate = joint_velocity(
-            stamp_ns, angle,
-            None if measured_velocity is None else self._mapping.direction * measured_velocity,
-            None if last is None else (last.stamp_ns, last.angle))
         if last is None:
-            return omega, 0.0, estimate
+            return 0.0
         interval = (stamp_ns - last.stamp_ns) * 1e-9
         raw = (omega - last.omega) / interval
-        time_constant = self.config.acceleration_time_constant
+        time_constant = self.config.measured.acceleration_time_constant
         keep = math.exp(-interval / time_constant) if time_constant > 0.0 else 0.0
-        return omega, keep * last.omega_dot + (1.0 - keep) * raw, estimate
+        return keep * last.omega_dot + (1.0 - keep) * raw
 
     def _solve(self, encoder_angle: float, turns: int, omega: float,
                omega_dot: float) -> LinkageState:
@@ -285,18 +233,18 @@ class MeasuredFollower:
         reached from its first sample through any change points, with α unwrapped.
         """
         config = self.config
-        driven = config.driven_linkage
+        driven = config.geometry.driven_linkage
         first = self._first
         if first is None:
-            branch = config.branch
+            branch = config.motion.branch
         else:
-            branch = continued_branch(driven, first.encoder_angle, config.branch,
+            branch = continued_branch(driven, first.encoder_angle, config.motion.branch,
                                       encoder_angle, turns=turns)
         rates = CrankRates(omega, omega_dot)
-        if config.driver is Driver.CRANK:
+        if config.joints.driver is Driver.CRANK:
             state = solve(driven, encoder_angle, rates, branch)
             return replace(state, alpha=state.alpha + turns * TWO_PI) if turns else state
-        state = solve_from_rocker(config.linkage, driven, encoder_angle, rates, branch)
+        state = solve_from_rocker(config.geometry.linkage, driven, encoder_angle, rates, branch)
         if self._last is None:
             return state
         # The crank driven by the rocker may turn fully (a double crank): α stays continuous.
@@ -305,4 +253,5 @@ class MeasuredFollower:
 
 def _node_loops(config: RunConfiguration) -> RobotLoops:
     """Return the loop of the node's own URDF for ``config`` (one four-bar, ``model.urdf``)."""
-    return find_loops(urdf_text(config.linkage, config.frame_id, config.joints, config.driver))
+    return find_loops(node_description(config.geometry.linkage, config.outputs.frame_id,
+                                       config.joints.lab, config.joints.driver).tree)

@@ -48,8 +48,9 @@ class MotionSample:
 
 def _clamp_to_segment(config: RunConfiguration, alpha: float) -> float:
     # alpha_at near the end of a pass may overshoot the end by a rounding error.
-    if config.direction * (alpha - config.segment_end) > 0.0:
-        return config.segment_end
+    motion = config.motion
+    if motion.direction * (alpha - motion.segment_end) > 0.0:
+        return motion.segment_end
     return alpha
 
 
@@ -59,22 +60,23 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
 
     None when a 'stop' motion has reached a dead point before alpha_end: the crank cannot go on.
     """
-    duration = config.segment_duration
-    if config.end_behavior == EndBehavior.STOP:
+    motion = config.motion
+    duration = motion.segment_duration
+    if motion.end_behavior == EndBehavior.STOP:
         if elapsed >= duration:
-            if config.blocked_at is not None:
+            if motion.blocked_at is not None:
                 return None
-            return MotionSample(config.alpha_end, motion_time=duration, final=True)
+            return MotionSample(motion.alpha_end, motion_time=duration, final=True)
         return MotionSample(
-            _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, elapsed)),
+            _clamp_to_segment(config, motion.drive.alpha_at(motion.alpha_start, elapsed)),
             motion_time=elapsed,
         )
-    if config.end_behavior == EndBehavior.LOOP:
+    if motion.end_behavior == EndBehavior.LOOP:
         passes = math.floor(elapsed / duration)
         in_pass = elapsed - passes * duration
         return MotionSample(
-            _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, in_pass)),
-            turn_offset=passes * (config.alpha_end - config.alpha_start) if config.whole_turns
+            _clamp_to_segment(config, motion.drive.alpha_at(motion.alpha_start, in_pass)),
+            turn_offset=passes * (motion.alpha_end - motion.alpha_start) if motion.whole_turns
             else 0.0,
             motion_time=elapsed,
             pass_index=passes,
@@ -85,7 +87,7 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
     backwards = in_cycle > duration
     in_pass = 2.0 * duration - in_cycle if backwards else in_cycle
     return MotionSample(
-        _clamp_to_segment(config, config.drive.alpha_at(config.alpha_start, in_pass)),
+        _clamp_to_segment(config, motion.drive.alpha_at(motion.alpha_start, in_pass)),
         is_reversed=backwards,
         motion_time=elapsed,
         pass_index=2 * cycles + backwards,
@@ -93,9 +95,10 @@ def sample_at_time(config: RunConfiguration, elapsed: float) -> MotionSample | N
 
 
 def _step_alpha(config: RunConfiguration, index: int) -> float:
-    if index >= config.step_count:
-        return config.segment_end
-    return config.alpha_start + config.direction * index * config.alpha_step
+    motion = config.motion
+    if index >= motion.step_count:
+        return motion.segment_end
+    return motion.alpha_start + motion.direction * index * motion.alpha_step
 
 
 def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
@@ -105,26 +108,27 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
     One pass visits the ``step_count`` steps before its end and then alpha_end itself (not a
     dead point, which has no state). None as in ``sample_at_time``.
     """
-    points = config.step_count + (0 if config.blocked_at is not None else 1)
-    duration = config.segment_duration
+    motion = config.motion
+    points = motion.step_count + (0 if motion.blocked_at is not None else 1)
+    duration = motion.segment_duration
 
     def time_of(alpha: float) -> float:
-        return config.drive.time_to(config.alpha_start, alpha)
+        return motion.drive.time_to(motion.alpha_start, alpha)
 
-    if config.end_behavior == EndBehavior.STOP:
+    if motion.end_behavior == EndBehavior.STOP:
         if step >= points:
             return None
         alpha = _step_alpha(config, step)
         return MotionSample(alpha, motion_time=time_of(alpha), final=(
-            config.blocked_at is None and step == points - 1))
-    if config.end_behavior == EndBehavior.LOOP:
+            motion.blocked_at is None and step == points - 1))
+    if motion.end_behavior == EndBehavior.LOOP:
         # Over whole turns the end of one pass is the start of the next: visit it once.
-        per_pass = config.step_count if config.whole_turns else points
+        per_pass = motion.step_count if motion.whole_turns else points
         passes, index = divmod(step, per_pass)
         alpha = _step_alpha(config, index)
         return MotionSample(
             alpha,
-            turn_offset=passes * (config.alpha_end - config.alpha_start) if config.whole_turns
+            turn_offset=passes * (motion.alpha_end - motion.alpha_start) if motion.whole_turns
             else 0.0,
             motion_time=passes * duration + time_of(alpha),
             pass_index=passes,
@@ -145,14 +149,15 @@ def sample_at_step(config: RunConfiguration, step: int) -> MotionSample | None:
 
 def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState:
     """Return the library's state for a motion sample (raises as ``kinematics.solve``)."""
-    drive = config.reverse_drive if sample.is_reversed else config.drive
+    motion = config.motion
+    drive = motion.reverse_drive if sample.is_reversed else motion.drive
     # `branch` names the assembly at alpha_start; through change points the mechanism goes on
     # on its smooth branch, which after an odd number of them is the other side.
     branch = continued_branch(
-        config.linkage, config.alpha_start, config.branch, sample.alpha,
+        config.geometry.linkage, motion.alpha_start, motion.branch, sample.alpha,
         turns=round(sample.turn_offset / TWO_PI),
     )
-    state = solve(config.linkage, sample.alpha, drive, branch)
+    state = solve(config.geometry.linkage, sample.alpha, drive, branch)
     if sample.turn_offset:
         state = replace(state, alpha=state.alpha + sample.turn_offset)
     return state
@@ -160,16 +165,17 @@ def solve_sample(config: RunConfiguration, sample: MotionSample) -> LinkageState
 
 def blocked_note(config: RunConfiguration) -> str | None:
     """Return what happens at a dead point that lies before alpha_end; None if there is none."""
-    if config.blocked_at is None:
+    motion = config.motion
+    if motion.blocked_at is None:
         return None
     outcome = {
         EndBehavior.STOP: 'the run will end there with an error',
         EndBehavior.LOOP: 'the crank restarts from alpha_start there',
         EndBehavior.BOUNCE: 'the crank reverses there',
-    }[config.end_behavior]
+    }[motion.end_behavior]
     return (
-        f'dead point at {math.degrees(config.blocked_at):.6f}° before alpha_end = '
-        f'{math.degrees(config.alpha_end):.6f}°: {outcome}'
+        f'dead point at {math.degrees(motion.blocked_at):.6f}° before alpha_end = '
+        f'{math.degrees(motion.alpha_end):.6f}°: {outcome}'
     )
 
 
@@ -180,23 +186,25 @@ def met_dead_point(config: RunConfiguration, previous_pass: int, current_pass: i
     That is, between a sample of pass ``previous_pass`` and one of pass ``current_pass``: 'loop'
     meets it at the end of every pass, 'bounce' at the end of every forward (even) pass.
     """
-    if config.blocked_at is None or current_pass <= previous_pass:
+    motion = config.motion
+    if motion.blocked_at is None or current_pass <= previous_pass:
         return False
-    if config.end_behavior == EndBehavior.BOUNCE:
+    if motion.end_behavior == EndBehavior.BOUNCE:
         return previous_pass % 2 == 0 or current_pass - previous_pass >= 2
     return True
 
 
 def dead_point_problem(config: RunConfiguration) -> str:
     """Return the ERROR message for the crank meeting ``blocked_at``: where, and what it does."""
+    motion = config.motion
     outcome = {
         EndBehavior.STOP: 'stops; the run cannot go on',
         EndBehavior.LOOP: 'restarts from alpha_start',
         EndBehavior.BOUNCE: 'reverses',
-    }[config.end_behavior]
+    }[motion.end_behavior]
     return (
-        f'the crank cannot go past the dead point at {math.degrees(config.blocked_at):.6f}° '
-        f'before alpha_end = {math.degrees(config.alpha_end):.6f}°: it {outcome}'
+        f'the crank cannot go past the dead point at {math.degrees(motion.blocked_at):.6f}° '
+        f'before alpha_end = {math.degrees(motion.alpha_end):.6f}°: it {outcome}'
     )
 
 
@@ -248,8 +256,9 @@ class DriveLawRun:
         In fixed_step mode the timer is re-armed for each step's time (``advance``'s second
         value) and this first period only starts it.
         """
-        if self.config.mode is MotionMode.REAL_TIME:
-            return 1.0 / self.config.rate_hz
+        motion = self.config.motion
+        if motion.mode is MotionMode.REAL_TIME:
+            return 1.0 / motion.rate_hz
         return 1e-3
 
     def advance(self, now_ns: int) -> tuple[list[DueState], int | None, bool]:
@@ -263,7 +272,7 @@ class DriveLawRun:
         if self.start_ns is None or now_ns < self.start_ns:
             self.restart()
             self.start_ns = now_ns
-        if self.config.mode is MotionMode.REAL_TIME:
+        if self.config.motion.mode is MotionMode.REAL_TIME:
             return self._advance_in_real_time(now_ns)
         return self._advance_steps(now_ns)
 
@@ -273,7 +282,7 @@ class DriveLawRun:
         # A period that passed without a tick is a missed deadline; rcl timers skip such
         # periods rather than firing twice, so the shortfall stays visible.
         self._ticks += 1
-        due = math.floor(elapsed * config.rate_hz + 1e-6) + 1
+        due = math.floor(elapsed * config.motion.rate_hz + 1e-6) + 1
         self.missed_deadlines = max(
             self.missed_deadlines, self._missed_before_restart + due - self._ticks)
         sample = sample_at_time(config, elapsed)

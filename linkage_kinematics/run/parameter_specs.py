@@ -37,10 +37,9 @@ from linkage_kinematics.run.limits import (
     MAX_RATE_HZ,
     MAX_TIME_CONSTANT,
     MAX_TIMEOUT,
-    MIN_SPLIT_SIZE,
     NO_CPU_AFFINITY,
-    NO_SPLIT,
 )
+from linkage_kinematics.shared.rosbag2_split import MIN_SPLIT_SIZE, NO_SPLIT
 
 NODE_NAME = 'linkage_node'
 
@@ -329,7 +328,7 @@ def _measured_specs() -> tuple[ParameterSpec, ...]:
 
 
 def _loop_specs() -> tuple[ParameterSpec, ...]:
-    """Return which loops the measured source closes, and how (README, Closing a robot's loops)."""
+    """Return which loops the measured source closes, and how (docs/following_loops.md)."""
     return (
         ParameterSpec('loops', LoopsSource.PARAMETERS.value,
                       'parameters: the four-bar of the geometry parameters; robot_description: '

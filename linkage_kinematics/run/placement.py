@@ -6,34 +6,16 @@ Where the node's process runs: the ``cpu_affinity`` parameter (as ros2_control's
 
 On one CPU the executor's timer thread and the thread running the callbacks wake each other
 without crossing CPUs, and the bag writer process, on the other CPUs, cannot delay either
-(docs/benchmarks.md, section 3). No ROS.
+(docs/benchmarks.md, "The node against a minimal hand-written publisher"). No ROS.
 """
 
 from __future__ import annotations
 
-from collections.abc import Set
 import os
 
 from linkage_kinematics.run.configuration import ConfigurationError
 from linkage_kinematics.run.limits import NO_CPU_AFFINITY
-
-
-def set_process_affinity(pid: int, cpus: Set[int]) -> None:
-    """
-    Let every thread of process ``pid`` run only on ``cpus``.
-
-    Threads it starts later inherit their starter's CPUs. A process that has ended meanwhile is
-    left alone: whoever waits for it learns how it ended.
-    """
-    try:
-        threads = os.listdir(f'/proc/{pid}/task')
-    except FileNotFoundError:
-        return
-    for thread in threads:
-        try:
-            os.sched_setaffinity(int(thread), cpus)
-        except ProcessLookupError:
-            pass  # the thread ended meanwhile
+from linkage_kinematics.shared.affinity import set_process_affinity
 
 
 class CpuPlacement:

@@ -34,7 +34,7 @@ import math
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, PlanarLoop
-from linkage_kinematics.model.loop_urdf import Constraint, LoopError, Robot, tree_path
+from linkage_kinematics.loops.description import Constraint, LoopError, Robot
 from linkage_kinematics.model.urdf_reader import JointType, MOVABLE_TYPES, ROTATING_TYPES
 import numpy as np
 
@@ -94,11 +94,10 @@ def _lean(direction: np.ndarray, normal: np.ndarray, along: bool) -> float:
     return abs(float(direction @ normal))
 
 
-def _moving_path(robot: Robot, constraint: Constraint,
-                 where: str) -> list[tuple[JointType, str, bool]]:
+def _moving_path(constraint: Constraint, where: str) -> list[tuple[JointType, str, bool]]:
     if constraint.parent.link == constraint.child.link:
         raise LoopError(f'{where}: joins link {constraint.parent.link!r} to itself')
-    path = tree_path(robot, constraint.parent.link, constraint.child.link)
+    path = constraint.path
     free = [joint.name for joint, _ in path
             if joint.joint_type in (JointType.FLOATING, JointType.PLANAR)]
     if free:
@@ -166,7 +165,7 @@ def derive_loop(robot: Robot, constraint: Constraint) -> Loop:
     if constraint.constraint_type != 'revolute':
         raise LoopError(f'{where}: type {constraint.constraint_type!r} is not supported: only a '
                         'revolute constraint (a pin) closes a planar loop')
-    moving = _moving_path(robot, constraint, where)
+    moving = _moving_path(constraint, where)
     normal = _normal(robot, constraint, moving, where)
     first, second = plane_basis(normal)
 

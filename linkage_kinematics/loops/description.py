@@ -4,8 +4,9 @@
 """
 A lab's URDF read for its kinematic loops: the tree at the zero pose and its ``<constraint>``s.
 
-The links and joints are those ``urdf_reader`` reads with ROS's own Python URDF parser
-(``urdf_parser_py``, the urdfdom_py package), so the joints mean what they mean to ROS. A
+The links and joints are those ``urdf_reader`` read with ROS's own Python URDF parser
+(``urdf_parser_py``, the urdfdom_py package), so the joints mean what they mean to ROS; the
+parsed ``UrdfTree`` is handed in, never the text (a description is parsed once). A
 ``<constraint>`` is the cut joint of a closed loop as proposed for URDF (urdfdom PR #264,
 urdfdom_headers PR #108), a direct child of ``<robot>``::
 
@@ -15,9 +16,9 @@ urdfdom_headers PR #108), a direct child of ``<robot>``::
     </constraint>
 
 The parser does not know the element (nor does urdfdom), so the constraints are read here from
-the XML tree the parser read. Every link's world pose at the zero pose (every joint at 0) is
-kept, in float64 as a URDF reader computes it. Pure: numpy, urdf_parser_py and lxml, no ROS
-graph.
+the XML tree the parser read, each with the tree path between its two links: the loop it closes.
+Every link's world pose at the zero pose (every joint at 0) is kept, in float64 as a URDF reader
+computes it. Pure: numpy and lxml, no ROS graph.
 """
 
 from __future__ import annotations
@@ -25,13 +26,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.model.urdf_reader import (
-    JointType,
-    read_urdf,
-    UrdfError,
-    UrdfTree,
-    Vector,
-)
+from linkage_kinematics.model.urdf_reader import JointType, UrdfTree, Vector
 import lxml.etree
 import numpy as np
 
@@ -76,29 +71,31 @@ class ConstraintFrame:
 
 @dataclass(frozen=True)
 class Constraint:
-    """A ``<constraint>`` as written: its name, type and the two sides."""
+    """
+    A ``<constraint>`` as written: its name, type and the two sides, and the loop it closes.
+
+    ``path``: the tree joints from the parent side's link to the child side's, in order, each
+    with whether the path crosses it from its parent to its child (``True``) or back.
+    """
 
     name: str
     constraint_type: str
     parent: ConstraintFrame
     child: ConstraintFrame
+    path: tuple[tuple[TreeJoint, bool], ...]
 
 
 @dataclass(frozen=True)
 class Robot:
-    """A URDF's tree at the zero pose, its constraints, and the link above each link."""
+    """A URDF's tree at the zero pose and its constraints."""
 
     name: str
     root: str
     joints: dict[str, TreeJoint]
-    # link → the joint whose child it is (the root has none)
-    joint_above: dict[str, TreeJoint]
     links: dict[str, Pose]
     constraints: tuple[Constraint, ...]
     # one line for each <constraint> that cannot be read (its name, and why)
     constraint_problems: tuple[str, ...]
-    # what urdf_parser_py said about the text, other than that it does not know <constraint>
-    parser_messages: tuple[str, ...]
 
 
 def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
@@ -185,8 +182,9 @@ def _constraint_side(element: lxml.etree._Element, side: str, links: dict[str, P
     return ConstraintFrame(link, frame, axis)
 
 
-def _constraints(root: lxml.etree._Element,
-                 links: dict[str, Pose]) -> tuple[tuple[Constraint, ...], tuple[str, ...]]:
+def _constraints(root: lxml.etree._Element, links: dict[str, Pose],
+                 joint_above: dict[str, TreeJoint]
+                 ) -> tuple[tuple[Constraint, ...], tuple[str, ...]]:
     """Return the constraints that can be read, and one line for each that cannot."""
     constraints, problems = [], []
     names: set[str] = set()
@@ -199,44 +197,41 @@ def _constraints(root: lxml.etree._Element,
             if name in names:
                 raise LoopError(f'{where}: the name is used twice')
             names.add(name)
-            constraints.append(Constraint(
-                name, element.get('type', ''), _constraint_side(element, 'parent', links, where),
-                _constraint_side(element, 'child', links, where)))
+            parent = _constraint_side(element, 'parent', links, where)
+            child = _constraint_side(element, 'child', links, where)
+            constraints.append(Constraint(name, element.get('type', ''), parent, child,
+                                          _tree_path(joint_above, parent.link, child.link)))
         except LoopError as error:
             problems.append(str(error))
     return tuple(constraints), tuple(problems)
 
 
-def read_robot(urdf: str) -> Robot:
+def read_robot(tree: UrdfTree) -> Robot:
     """
-    Read a URDF's tree at the zero pose and its ``<constraint>`` elements.
+    Return a parsed URDF's tree at the zero pose and its ``<constraint>`` elements.
 
-    Raises LoopError, naming the element, for a text that is not a URDF robot or joints that do
-    not form a tree (urdf_reader's refusals); a constraint that names an unknown link or holds
-    a malformed number is one line of ``constraint_problems``.
+    A constraint that names an unknown link or holds a malformed number is one line of
+    ``constraint_problems``.
     """
-    try:
-        tree = read_urdf(urdf)
-    except UrdfError as error:
-        raise LoopError(str(error)) from None
     joints, links = _tree_joints(tree)
-    constraints, problems = _constraints(tree.element, links)
-    return Robot(tree.name, tree.root_link, joints,
-                 {joint.child: joint for joint in joints.values()}, links, constraints, problems,
-                 tree.parser_messages)
+    constraints, problems = _constraints(
+        tree.element, links, {joint.child: joint for joint in joints.values()})
+    return Robot(tree.name, tree.root_link, joints, links, constraints, problems)
 
 
-def tree_path(robot: Robot, start: str, end: str) -> list[tuple[TreeJoint, bool]]:
+def _tree_path(joint_above: dict[str, TreeJoint], start: str,
+               end: str) -> tuple[tuple[TreeJoint, bool], ...]:
     """
     Return the joints on the tree path from link ``start`` to link ``end``, in order.
 
-    Each with whether the path crosses it from its parent to its child (``True``) or from its
-    child to its parent.
+    ``joint_above``: link → the joint whose child it is (the root has none). Each joint with
+    whether the path crosses it from its parent to its child (``True``) or from its child to its
+    parent.
     """
     def up(link: str) -> list[TreeJoint]:
         path = []
-        while link in robot.joint_above:
-            joint = robot.joint_above[link]
+        while link in joint_above:
+            joint = joint_above[link]
             path.append(joint)
             link = joint.parent
         return path
@@ -245,4 +240,4 @@ def tree_path(robot: Robot, start: str, end: str) -> list[tuple[TreeJoint, bool]
     shared = {joint.name for joint in start_side} & {joint.name for joint in end_side}
     rising = [(joint, False) for joint in start_side if joint.name not in shared]
     falling = [(joint, True) for joint in end_side if joint.name not in shared]
-    return rising + falling[::-1]
+    return tuple(rising + falling[::-1])

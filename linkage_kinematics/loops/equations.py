@@ -1,0 +1,542 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The closure equations of a set of loops: residuals, their exact Jacobian and its rate.
+
+Each closure's residual is written in its loop's base frame (``tree.Loop``), where no joint
+above the loop enters, between its parent side's frame a and its child side's frame b:
+
+* BALL: p_a − p_b (3 rows, m);
+* PIN: p_a − p_b, then u₁·n_a and u₂·n_a (2 rows), n_a the pin axis on side a and u₁, u₂ two
+  unit vectors perpendicular to side b's axis, fixed on side b: zero where the axes are aligned;
+* WELD: p_a − p_b, then e = log(R_aᵀ·R_b) (3 rows, rad), the rotation error by the log map of
+  SO(3), not the skew part of R_aᵀ·R_b, which also vanishes where the frames are turned by π;
+* DISTANCE (a ball closure whose rod is reduced, ``Rod``): (|x − P|² − L²)/(2L) (1 row, m), x
+  the ball on the other side, P the rod's universal-joint centre, L the rod's length from P to
+  its ball.
+
+Columns: the coordinates that move the loops. A turn about the unit world axis ω through the
+point o moves a point p at ω × (p − o) per unit of its value, a slide along ω at ω; the frames
+turn at ω. The rows' derivatives follow exactly: for a pin ∂(u·n_a)/∂q = ±ω·(n_a × u), for a
+weld ∂e/∂q = J⁻¹(e)·R_aᵀ·(±ω) (``spatial.log_rate_matrix``). ``jacobian_rate`` is J̇ for joint
+rates q̇, the derivative of each column along the motion (J̇·q̇ is the rows' acceleration at
+q̈ = 0); for a weld's rotation rows it is J⁻¹(e)·d(R_aᵀ·ω)/dt, exact where e and ė vanish (an
+assembled pose moving as the loops allow), which is where it is used.
+
+Plain floats throughout (``spatial``): this is the per-sample path. Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Iterator, Mapping, Sequence
+from dataclasses import dataclass
+import enum
+import math
+
+from linkage_kinematics.loops.closures import Closure, ClosureKind
+from linkage_kinematics.loops.frames import Frames, Motion, Program
+from linkage_kinematics.loops.spatial import (
+    add,
+    apply,
+    apply_transposed,
+    cross,
+    dot,
+    IDENTITY,
+    log_rate_matrix,
+    log_rotation,
+    multiply,
+    norm,
+    perpendicular_pair,
+    Rotation,
+    scale,
+    subtract,
+    transpose,
+    Vector,
+)
+from linkage_kinematics.loops.tree import KinematicTree, Loop, MotionKind, Pose, unit_axis
+
+# Two universal-joint axes meet where their lines pass within this fraction of the rod's length
+# of each other (an exporter's printed digits leave some 1e-7), and are not parallel.
+CONCURRENT_TOLERANCE = 1e-9
+
+
+class RowKind(enum.Enum):
+    """The unit of a residual row: a length (m) or an angle (rad)."""
+
+    LENGTH = 'm'
+    ANGLE = 'rad'
+
+
+class _Form(enum.Enum):
+    BALL = 3
+    PIN = 5
+    WELD = 6
+    DISTANCE = 1
+
+
+@dataclass(frozen=True)
+class Rod:
+    """
+    A ball closure's rod: a body hung from a universal joint, its ball at L from the joint.
+
+    The joint's two turns have axes that meet at P. The closure is |x − P| = L; the two angles
+    follow from x.
+
+    Frames: the socket is the moving frame above the joint; ``first``/``second`` the joint's
+    steps, ``origins`` their fixed rotations, ``axes`` their unit axes; ``center`` is P in the
+    socket frame, ``rod`` the vector from P to the ball in the rod's frame.
+    """
+
+    closure: str
+    side: int  # 0: the closure's parent side is the rod, 1: its child side
+    socket: int
+    steps: tuple[int, int]
+    coordinates: tuple[int, int]
+    origins: tuple[Rotation, Rotation]
+    axes: tuple[Vector, Vector]
+    center: Vector
+    rod: Vector
+    length: float
+
+
+def universal_rod(tree: KinematicTree, loop: Loop, side: int) -> Rod | None:
+    """
+    Return the rod of a ball closure's ``side`` if it hangs from a universal joint, else None.
+
+    The side's path must end in two plain turns (no mimic) whose axes meet, the side's frame on
+    the second one's body, and the ball away from the meeting point.
+    """
+    path = loop.paths[side]
+    frame, offset = loop.sides[side]
+    if loop.closure.kind is not ClosureKind.BALL or len(path) < 2 or frame != path[-1] + 1:
+        return None
+    first, second = tree.steps[path[-2]], tree.steps[path[-1]]
+    if (second.parent != path[-2] + 1 or first.coordinate == second.coordinate
+            or any(step.kind is not MotionKind.TURN or step.multiplier != 1.0
+                   or step.offset != 0.0 for step in (first, second))):
+        return None
+    # both lines in the socket frame, at the first turn's zero (P is on its axis: it stays)
+    o1, d1 = first.origin.position, apply(first.origin.rotation, first.axis)
+    turned = first.origin.rotation
+    o2 = add(o1, apply(turned, second.origin.position))
+    rod_rotation = multiply(turned, second.origin.rotation)
+    d2 = apply(rod_rotation, second.axis)
+    normal = cross(d1, d2)
+    if norm(normal) < 1e-6:
+        return None
+    # closest points of the two lines: o1 + s·d1 and o2 + t·d2
+    gap = subtract(o2, o1)
+    square = dot(normal, normal)
+    s = dot(cross(gap, d2), normal) / square
+    t = dot(cross(gap, d1), normal) / square
+    on_first, on_second = add(o1, scale(s, d1)), add(o2, scale(t, d2))
+    center = scale(0.5, add(on_first, on_second))
+    rod = subtract(offset.position, apply_transposed(rod_rotation, subtract(center, o2)))
+    length = norm(rod)
+    if length == 0.0 or norm(subtract(on_first, on_second)) > CONCURRENT_TOLERANCE * length:
+        return None
+    return Rod(loop.closure.name, side, first.parent, (path[-2], path[-1]),
+               (first.coordinate, second.coordinate),
+               (first.origin.rotation, second.origin.rotation), (first.axis, second.axis),
+               center, rod, length)
+
+
+@dataclass
+class Evaluation:
+    """The frames of every loop program at one configuration, and the residual there."""
+
+    values: list[float]
+    frames: list[Frames]
+    residual: list[float]
+    # each closure's two points (a distance's: x, then P), as the residual found them
+    points: list[tuple[Vector, Vector]]
+
+
+class LoopEquations:
+    """
+    The residuals of a set of closures and their exact Jacobian (module docstring).
+
+    Values are given per coordinate in ``coordinates`` order (indices of the tree's
+    coordinates). ``rods`` names the ball closures whose rods are reduced to a distance.
+    """
+
+    def __init__(self, tree: KinematicTree, closures: Sequence[Closure],
+                 rods: Mapping[str, Rod] | None = None) -> None:
+        rods = dict(rods or {})
+        loops = [tree.loop(closure) for closure in closures]
+        paths = []
+        for loop in loops:
+            rod = rods.get(loop.closure.name)
+            trimmed = list(loop.paths)
+            if rod is not None:
+                trimmed[rod.side] = tuple(step for step in trimmed[rod.side]
+                                          if step not in rod.steps)
+            paths.append(trimmed)
+        self.coordinates: tuple[int, ...] = tuple(sorted(
+            {tree.steps[step].coordinate for sides in paths for path in sides for step in path}))
+        self.names = tuple(tree.coordinates[i].name for i in self.coordinates)
+        column = {coordinate: i for i, coordinate in enumerate(self.coordinates)}
+        bases = sorted({loop.base for loop in loops})
+        # per base frame, one program: the steps below it that the loops need, in tree order
+        # (a rod's socket is on its side's path, which keeps the steps above the rod)
+        self._programs: list[Program] = []
+        # tree step → (program, place in it)
+        self.places: dict[int, tuple[int, int]] = {}
+        slots = []
+        for base in bases:
+            needed = sorted({step for loop, sides in zip(loops, paths) if loop.base == base
+                             for path in sides for step in path})
+            slot = {base: 0} | {step + 1: place + 1 for place, step in enumerate(needed)}
+            self.places |= {step: (len(self._programs), place)
+                            for place, step in enumerate(needed)}
+            self._programs.append(Program([tree.steps[step] for step in needed], slot, column))
+            slots.append(slot)
+        self._closures = []
+        kinds: list[RowKind] = []
+        self.closure_rows: list[tuple[str, int, int]] = []
+        for loop, sides in zip(loops, paths):
+            program = bases.index(loop.base)
+            record = _closure_record(tree, loop, sides, rods.get(loop.closure.name),
+                                     slots[program], column, program)
+            self.closure_rows.append((loop.closure.name, len(kinds), record[0].value))
+            kinds += _row_kinds(record[0])
+            self._closures.append(record)
+        self.row_kinds = tuple(kinds)
+        self.rows = len(kinds)
+
+    def evaluate(self, values: Sequence[float], previous: Evaluation | None = None,
+                 changed: Collection[int] | None = None) -> Evaluation:
+        """
+        Return the frames and the residual at coordinate ``values``.
+
+        Given the ``previous`` evaluation and the columns ``changed`` since, only the frames
+        those move are posed again.
+        """
+        if previous is None:
+            frames = [program.run(values) for program in self._programs]
+        else:
+            frames = [program.run(values, old, changed) if program.columns & changed else old
+                      for program, old in zip(self._programs, previous.frames)]
+        evaluation = Evaluation(list(values), frames, [], [])
+        residual, points = evaluation.residual, evaluation.points
+        for record in self._closures:
+            pair = (_side_point(record[2], evaluation), _side_point(record[3], evaluation))
+            points.append(pair)
+            residual += _residual(record, evaluation, pair)
+        return evaluation
+
+    def residual(self, values: Sequence[float]) -> list[float]:
+        """Return the residual rows at coordinate ``values``."""
+        return self.evaluate(values).residual
+
+    def jacobian(self, evaluation: Evaluation,
+                 columns: Collection[int] | None = None) -> list[list[float]]:
+        """
+        Return ∂(residual)/∂(coordinates) at an evaluation, one list per row.
+
+        Only the ``columns`` asked for are computed (the others left 0); all by default.
+        """
+        width = len(self.coordinates)
+        rows: list[list[float]] = []
+        for record, pair in zip(self._closures, evaluation.points):
+            rows += _jacobian_rows(record, evaluation, pair, width, columns)
+        return rows
+
+    def jacobian_rate(self, evaluation: Evaluation,
+                      rates: Sequence[float]) -> list[list[float]]:
+        """Return J̇ for coordinate ``rates`` at an evaluation (module docstring), per row."""
+        motion = Motion(self._programs, evaluation.frames, evaluation.values, rates)
+        width = len(self.coordinates)
+        rows: list[list[float]] = []
+        for record in self._closures:
+            rows += _rate_rows(record, evaluation, motion, width)
+        return rows
+
+    def gaps(self, evaluation: Evaluation) -> list[tuple[float, float | None]]:
+        """
+        Return per closure how far it is open: its frames' origins (m) and angle (rad).
+
+        The angle is a pin's axes', a weld's frames'; None for a ball.
+        """
+        gaps = []
+        for record in self._closures:
+            form = record[0]
+            gap = norm(subtract(_side_point(record[2], evaluation),
+                                _side_point(record[3], evaluation)))
+            angle = None
+            if form is _Form.DISTANCE:
+                gap = abs(gap - record[4])
+            elif form is _Form.PIN:
+                n_a = apply(_frame_rotation(record[2], evaluation), record[4])
+                n_b = apply(_frame_rotation(record[3], evaluation), record[5])
+                angle = math.atan2(norm(cross(n_a, n_b)), dot(n_a, n_b))
+            elif form is _Form.WELD:
+                turn = multiply(transpose(_side_rotation(record[2], evaluation)),
+                                _side_rotation(record[3], evaluation))
+                angle = norm(log_rotation(turn))
+            gaps.append((gap, angle))
+        return gaps
+
+    def point(self, closure: int, side: int, evaluation: Evaluation) -> Vector:
+        """
+        Return a closure side's point in its loop's base frame.
+
+        For a closure reduced to a distance, side 0 is the ball x on the other side and side 1
+        the rod's centre P.
+        """
+        return evaluation.points[closure][side]
+
+    def relative_motion(self, closure: int, evaluation: Evaluation,
+                        rates: Sequence[float]) -> tuple[Vector, Vector]:
+        """
+        Return how fast a closure's side-0 point moves from its side-1 point, and how fast.
+
+        The second: how fast side 1's moving frame turns (both in the base frame), for
+        coordinate ``rates``; a rod's socket's spin.
+        """
+        record = self._closures[closure]
+        vx = vy = vz = sx = sy = sz = 0.0
+        for side, point, sign in ((record[2], evaluation.points[closure][0], 1.0),
+                                  (record[3], evaluation.points[closure][1], -1.0)):
+            px, py, pz = point
+            _, _, axes, origins = evaluation.frames[side[0]]
+            for place, col, multiplier, turn in side[4]:
+                rate = sign * multiplier * rates[col]
+                if rate == 0.0:
+                    continue
+                wx, wy, wz = axes[place]
+                if not turn:
+                    vx, vy, vz = vx + rate * wx, vy + rate * wy, vz + rate * wz
+                    continue
+                ox, oy, oz = origins[place]
+                rx, ry, rz = px - ox, py - oy, pz - oz
+                vx += rate * (wy * rz - wz * ry)
+                vy += rate * (wz * rx - wx * rz)
+                vz += rate * (wx * ry - wy * rx)
+                if sign < 0.0:
+                    sx, sy, sz = sx - rate * wx, sy - rate * wy, sz - rate * wz
+        return (vx, vy, vz), (sx, sy, sz)
+
+    def socket(self, closure: int) -> tuple[int, int]:
+        """Return the program and slot of a closure's side-1 moving frame (a rod's socket)."""
+        return self._closures[closure][3][0], self._closures[closure][3][1]
+
+    def step_axis(self, step: int, evaluation: Evaluation) -> tuple[Vector, Vector]:
+        """Return a tree step's world axis and joint origin (its loop's base frame)."""
+        program, place = self.places[step]
+        frames = evaluation.frames[program]
+        return frames[2][place], frames[3][place]
+
+
+def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[int]],
+                    rod: Rod | None, slot: Mapping[int, int], column: Mapping[int, int],
+                    program: int) -> tuple:
+    """
+    Return what the rows of one closure need: (form, steps, side a, side b, extra…).
+
+    A side is (program, slot, offset rotation, offset position, its steps as (step slot − 1,
+    column, multiplier, turn)); steps lists both sides' with their sign (+1 side a, −1 side b).
+    """
+    def side(index: int) -> tuple:
+        frame, offset = loop.sides[index]
+        if rod is not None and rod.side == index:
+            frame, offset = rod.socket, Pose(IDENTITY, rod.center)
+        steps = tuple((slot[step + 1] - 1, column[tree.steps[step].coordinate],
+                       tree.steps[step].multiplier, tree.steps[step].kind is MotionKind.TURN)
+                      for step in paths[index])
+        return (program, slot[frame], offset.rotation, offset.position, steps)
+
+    a, b = side(0), side(1)
+    closure = loop.closure
+    if rod is not None:  # x on the other side, P on the rod's
+        x, center = (b, a) if rod.side == 0 else (a, b)
+        return (_Form.DISTANCE, None, x, center, rod.length)
+    if closure.kind is ClosureKind.BALL:
+        return (_Form.BALL, None, a, b)
+    if closure.kind is ClosureKind.WELD:
+        return (_Form.WELD, None, a, b)
+    n_a = unit_axis(closure.parent)
+    n_b = unit_axis(closure.child)
+    # the axes in their moving frames; u₁, u₂ perpendicular to side b's, fixed on side b
+    n_a = apply(a[2], n_a)
+    n_b = apply(b[2], n_b)
+    u1, u2 = perpendicular_pair(n_b)
+    return (_Form.PIN, None, a, b, n_a, n_b, u1, u2)
+
+
+def _row_kinds(form: _Form) -> list[RowKind]:
+    if form is _Form.DISTANCE:
+        return [RowKind.LENGTH]
+    return [RowKind.LENGTH] * 3 + [RowKind.ANGLE] * (form.value - 3)
+
+
+def _side_point(side: tuple, evaluation: Evaluation) -> Vector:
+    program, slot, _, shift, _ = side
+    rotations, positions = evaluation.frames[program][:2]
+    r, p = rotations[slot], positions[slot]
+    x, y, z = shift
+    return (p[0] + r[0] * x + r[1] * y + r[2] * z, p[1] + r[3] * x + r[4] * y + r[5] * z,
+            p[2] + r[6] * x + r[7] * y + r[8] * z)
+
+
+def _frame_rotation(side: tuple, evaluation: Evaluation) -> Rotation:
+    return evaluation.frames[side[0]][0][side[1]]
+
+
+def _side_rotation(side: tuple, evaluation: Evaluation) -> Rotation:
+    return multiply(_frame_rotation(side, evaluation), side[2])
+
+
+def _point_rate(side: tuple, evaluation: Evaluation, motion: Motion) -> Vector:
+    return motion.point(side[0], side[1], evaluation.frames[side[0]][1],
+                        _side_point(side, evaluation))
+
+
+def _residual(record: tuple, evaluation: Evaluation,
+              points: tuple[Vector, Vector]) -> list[float]:
+    form, _, a, b = record[:4]
+    p_a, p_b = points
+    dx, dy, dz = p_a[0] - p_b[0], p_a[1] - p_b[1], p_a[2] - p_b[2]
+    if form is _Form.DISTANCE:
+        length = record[4]
+        return [(dx * dx + dy * dy + dz * dz - length * length) / (2.0 * length)]
+    rows = [dx, dy, dz]
+    if form is _Form.PIN:
+        n_a = apply(_frame_rotation(a, evaluation), record[4])
+        r_b = _frame_rotation(b, evaluation)
+        rows += [dot(apply(r_b, record[6]), n_a), dot(apply(r_b, record[7]), n_a)]
+    elif form is _Form.WELD:
+        rows += log_rotation(multiply(transpose(_side_rotation(a, evaluation)),
+                                      _side_rotation(b, evaluation)))
+    return rows
+
+
+def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, Vector],
+                   width: int, columns: Collection[int] | None) -> list[list[float]]:
+    form, _, a, b = record[:4]
+    p_a, p_b = points
+    if form is _Form.DISTANCE:
+        # ∂/∂q of (|d|² − L²)/(2L) = d·(screw at x − screw at P)/L, d·(ω × (p − o)) written as
+        # ω·((p − o) × d)
+        length = record[4]
+        dx, dy, dz = ((p_a[0] - p_b[0]) / length, (p_a[1] - p_b[1]) / length,
+                      (p_a[2] - p_b[2]) / length)
+        row = [0.0] * width
+        for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+            _, _, axes, origins = evaluation.frames[side[0]]
+            for place, col, multiplier, turn in side[4]:
+                if columns is not None and col not in columns:
+                    continue
+                wx, wy, wz = axes[place]
+                if turn:
+                    ox, oy, oz = origins[place]
+                    rx, ry, rz = px - ox, py - oy, pz - oz
+                    row[col] += sign * multiplier * (wx * (ry * dz - rz * dy)
+                                                     + wy * (rz * dx - rx * dz)
+                                                     + wz * (rx * dy - ry * dx))
+                else:
+                    row[col] += sign * multiplier * (wx * dx + wy * dy + wz * dz)
+        return [row]
+    rows = [[0.0] * width for _ in range(form.value)]
+    row_x, row_y, row_z = rows[0], rows[1], rows[2]
+    if form is _Form.PIN:
+        n_a = apply(_frame_rotation(a, evaluation), record[4])
+        r_b = _frame_rotation(b, evaluation)
+        normals = (cross(n_a, apply(r_b, record[6])), cross(n_a, apply(r_b, record[7])))
+    elif form is _Form.WELD:
+        r_a = _side_rotation(a, evaluation)
+        e = log_rotation(multiply(transpose(r_a), _side_rotation(b, evaluation)))
+        rate = log_rate_matrix(e)
+    for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+        _, _, axes, origins = evaluation.frames[side[0]]
+        for place, col, multiplier, turn in side[4]:
+            if columns is not None and col not in columns:
+                continue
+            factor = sign * multiplier
+            wx, wy, wz = w = axes[place]
+            if not turn:
+                row_x[col] += factor * wx
+                row_y[col] += factor * wy
+                row_z[col] += factor * wz
+                continue
+            ox, oy, oz = origins[place]
+            rx, ry, rz = px - ox, py - oy, pz - oz
+            row_x[col] += factor * (wy * rz - wz * ry)
+            row_y[col] += factor * (wz * rx - wx * rz)
+            row_z[col] += factor * (wx * ry - wy * rx)
+            if form is _Form.PIN:
+                rows[3][col] += factor * dot(w, normals[0])
+                rows[4][col] += factor * dot(w, normals[1])
+            elif form is _Form.WELD:
+                ex, ey, ez = apply(rate, apply_transposed(r_a, scale(-factor, w)))
+                rows[3][col] += ex
+                rows[4][col] += ey
+                rows[5][col] += ez
+    return rows
+
+
+def _screw(frames: Frames, place: int, turn: bool, point: Vector) -> Vector:
+    """Return how a step moves ``point`` per unit of its value."""
+    w = frames[2][place]
+    return cross(w, subtract(point, frames[3][place])) if turn else w
+
+
+def _rate_rows(record: tuple, evaluation: Evaluation, motion: Motion,
+               width: int) -> list[list[float]]:
+    form, _, a, b = record[:4]
+    p_a, p_b = _side_point(a, evaluation), _side_point(b, evaluation)
+    v_a, v_b = _point_rate(a, evaluation, motion), _point_rate(b, evaluation, motion)
+
+    def screw_rates(side: tuple, point: Vector, velocity: Vector) -> Iterator[tuple]:
+        frames = evaluation.frames[side[0]]
+        for place, col, multiplier, turn in side[4]:
+            w, o = frames[2][place], frames[3][place]
+            yield (place, col, multiplier, turn, w, _screw(frames, place, turn, point),
+                   motion.screw_rate(side[0], place, turn, w, o, point, velocity))
+
+    if form is _Form.DISTANCE:
+        length = record[4]
+        d, d_rate = subtract(p_a, p_b), subtract(v_a, v_b)
+        row = [0.0] * width
+        for side, point, velocity, sign in ((a, p_a, v_a, 1.0), (b, p_b, v_b, -1.0)):
+            moves = screw_rates(side, point, velocity)
+            for _, col, multiplier, _, _, screw, screw_rate in moves:
+                row[col] += sign * multiplier * (dot(d_rate, screw)
+                                                 + dot(d, screw_rate)) / length
+        return [row]
+    rows = [[0.0] * width for _ in range(form.value)]
+    spin_a, spin_b = motion.spins[a[0]][a[1]], motion.spins[b[0]][b[1]]
+    if form is _Form.PIN:
+        n_a = apply(_frame_rotation(a, evaluation), record[4])
+        r_b = _frame_rotation(b, evaluation)
+        pairs = []
+        for u_local in (record[6], record[7]):
+            u = apply(r_b, u_local)
+            pairs.append((cross(n_a, u), add(cross(cross(spin_a, n_a), u),
+                                             cross(n_a, cross(spin_b, u)))))
+    elif form is _Form.WELD:
+        r_a = _side_rotation(a, evaluation)
+        rate = log_rate_matrix(log_rotation(multiply(transpose(r_a),
+                                                     _side_rotation(b, evaluation))))
+    for side, point, velocity, sign in ((a, p_a, v_a, 1.0), (b, p_b, v_b, -1.0)):
+        moves = screw_rates(side, point, velocity)
+        for place, col, multiplier, turn, w, _, screw_rate in moves:
+            factor = sign * multiplier
+            for row, component in zip(rows, screw_rate):
+                row[col] += factor * component
+            if not turn:
+                continue
+            w_rate = motion.axis_rates[side[0]][place]
+            if form is _Form.PIN:
+                for row, (normal, normal_rate) in zip(rows[3:], pairs):
+                    row[col] += factor * (dot(w_rate, normal) + dot(w, normal_rate))
+            elif form is _Form.WELD:
+                # d(R_aᵀ·v)/dt = R_aᵀ·(v̇ − Ω_a × v), v = −factor·ω
+                v, v_rate = scale(-factor, w), scale(-factor, w_rate)
+                ex, ey, ez = apply(rate, apply_transposed(r_a, subtract(v_rate,
+                                                                        cross(spin_a, v))))
+                rows[3][col] += ex
+                rows[4][col] += ey
+                rows[5][col] += ez
+    return rows

@@ -1,0 +1,159 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The measured source of ``loops:=robot_description``: a robot's loops closed message by message.
+
+``RobotLoopsFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
+positions, velocities), takes the measured joints in through the measured modes' one
+``intake.Intake`` and closes every ``<constraint>`` loop of the robot's URDF from them
+(``plan.RobotLoops.plan``, ``solver.LoopSolver``). It returns a ``LoopSample``, the passive loop
+joints' positions and velocities (URDF units, rad or m), or a ``LoopDrop``, why the message was
+dropped and which loops it concerned. A measured joint without a velocity gets the intake's
+estimate (the backward difference over the header stamps, 0 for a first sample). A revolute
+measured joint is unwrapped across turns, as the four-bar's driver is, and ``measured.max_jump``
+(rad) applies to it; a prismatic one's length (m) has no such bound. No ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
+from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
+from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+
+
+@dataclass(frozen=True)
+class LoopDrop:
+    """A dropped message: why, the loops it concerned (none: every loop) and the detail."""
+
+    reason: DropReason
+    constraints: tuple[str, ...]
+    detail: str
+
+
+@dataclass
+class LoopSample:
+    """
+    The passive loop joints at one message, in solve order, and what came with them.
+
+    ``joints`` holds every measured and solved loop joint's position (for /tf);
+    ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
+    loop's known joint value (URDF units), by constraint. A value, not frozen: a frozen
+    dataclass's seven ``object.__setattr__`` cost four times its plain ``__init__`` per sample.
+    """
+
+    stamp_ns: int
+    names: tuple[str, ...]
+    positions: tuple[float, ...]
+    velocities: tuple[float, ...]
+    joints: dict[str, float]
+    estimates: dict[str, Estimate]
+    known_values: dict[str, float]
+
+
+class RobotLoopsFollower:
+    """
+    Follows the measured joints of one robot description; ``restart`` forgets the motion.
+
+    Construction raises LoopError (one line per problem, naming the joints or constraints)
+    when ``measured`` is given and cannot close the loops; with ``measured`` empty the loop
+    joints the first message carries are planned then (``follow`` raises LoopError then).
+    """
+
+    def __init__(self, loops: RobotLoops, measured: Sequence[str],
+                 branches: Mapping[str, int], max_jump: float) -> None:
+        self.loops = loops
+        self._max_jump = max_jump
+        self._branches = dict(branches)
+        self.loop_joints = frozenset(name for loop in loops.loops for name in loop.names)
+        self.solver: LoopSolver | None = None
+        self._intake: Intake | None = None
+        if measured:
+            self._plan(tuple(measured))
+
+    @property
+    def plan(self) -> LoopPlan | None:
+        """Return the loops in solve order, None until the measured joints are known."""
+        return None if self.solver is None else self.solver.plan
+
+    @property
+    def max_jump(self) -> float:
+        """Return how far (rad) a revolute measured joint may move from one sample to the next."""
+        return self._max_jump
+
+    @max_jump.setter
+    def max_jump(self, value: float) -> None:
+        self._max_jump = value
+        if self._intake is not None:
+            self._intake.max_jump = value
+
+    def _plan(self, measured: tuple[str, ...]) -> None:
+        plan = self.loops.plan(measured, self._branches)
+        self.solver = LoopSolver(plan)
+        # resolved once per plan rather than per message: the revolute measured joints (the
+        # intake unwraps them), each loop's constraint and known joint, the loops each feeds
+        revolute = {planned.known.name for planned in plan.loops
+                    if planned.measured and planned.known.kind is JointKind.REVOLUTE}
+        self._intake = Intake(plan.measured, revolute, self._max_jump, DropReason.NO_JOINT)
+        self._known = tuple((planned.loop.constraint, planned.known.name)
+                            for planned in plan.loops)
+        self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
+                                   if planned.known.name == name) for name in measured}
+        self._passive = plan.passive  # the solved joints' names, in the order solve gives them
+
+    def restart(self) -> None:
+        """Forget the motion: the next valid message starts it again on the planned branches."""
+        if self.solver is not None:
+            self._intake.restart()
+            self.solver.reset()
+
+    def _loops_of(self, names: Sequence[str]) -> tuple[str, ...]:
+        """Return the loops whose known joint is one of the measured joints ``names``."""
+        return tuple(constraint for name in names for constraint in self._feeds[name])
+
+    def follow(self, stamp_ns: int, names: Sequence[str], positions: Sequence[float],
+               velocities: Sequence[float]) -> LoopSample | LoopDrop | None:
+        """
+        Return the passive loop joints at one message, or why it was dropped.
+
+        None for a message that carries none of the measured joints (with none given, none of
+        the loop joints), e.g. this node's own output heard back: ignored, not counted.
+        """
+        if self.solver is None:
+            carried = tuple(name for name in names if name in self.loop_joints)
+            if not carried:
+                return None
+            self._plan(carried)
+        taken = self._intake.take(stamp_ns, names, positions, velocities)
+        if taken.__class__ is not tuple:
+            return None if taken is None else LoopDrop(taken.reason,
+                                                       self._loops_of(taken.joints),
+                                                       taken.detail)
+        _, values, rates, estimates = taken
+        measured = self.solver.plan.measured
+        measured_values = dict(zip(measured, values))
+        try:
+            solved, solved_rates = self.solver.solve(measured_values, dict(zip(measured, rates)))
+        except LoopSampleError as error:
+            return LoopDrop(DropReason.JOINTS_UNREACHABLE,
+                            () if error.constraint is None else (error.constraint,), str(error))
+        self._intake.keep(stamp_ns, values)
+        joints = {**measured_values, **solved}
+        return LoopSample(
+            stamp_ns, self._passive, tuple(solved.values()), tuple(solved_rates.values()),
+            joints, dict(zip(measured, estimates)),
+            {constraint: joints[known] for constraint, known in self._known})
+
+
+def dead_point_distances(plan: LoopPlan,
+                         known_values: Mapping[str, float]) -> dict[str, float | None]:
+    """Return each loop's distance (rad or m) from its known joint to its nearest dead point."""
+    return {
+        planned.loop.constraint: known_joint_range(
+            planned.loop.planar, planned.known.index).dead_point_distance(
+                planned.known.sign * known_values[planned.loop.constraint])
+        for planned in plan.loops if planned.loop.constraint in known_values}
