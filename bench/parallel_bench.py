@@ -4,7 +4,8 @@
 """
 Section parallel: closing parallel robots' loops per sample, against the peers (issue 29 item 8).
 
-On the same models (bench/parallel_models.py) and the same motions of their actuated joints,
+On the same models (bench/parallel_models.py: Gepetto/example-parallel-robots' and the
+package's humanoid ankle) and the same motions of their actuated joints,
 every follower (bench/parallel_peers.py, and the package's own when it lands: ``ours``) closes
 the loops sample after sample, warm started from its previous answer. Per model and follower:
 the worst position error (rad or m) of the determined coordinates against the reference, the
@@ -17,7 +18,9 @@ model, the assembled pose every follower starts from and, per actuated joint k (
 order), q_k(i) = centre_k + amplitude·sin(2π·(k + 1)·i/N) over N samples: sample 0 is the
 assembled pose, every joint moves at its own frequency, N = 500 (``--quick``: the first 100
 of them). The amplitude is the largest of 0.2, 0.1, 0.05, ... (rad; a tenth of it in m for a
-prismatic joint) along which Gauss–Newton closes every sample.
+prismatic joint) along which Gauss–Newton closes every sample. The assembled pose is Pinocchio's
+(``parallel_peers.assemble``), not the package's, so that no follower starts from its own
+assembly.
 
 Two slots wait for helper C1's branch (issue 29 items 3–4 and the 50-digit reference in test/):
 
@@ -42,7 +45,7 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 if __name__ == '__main__':
     sys.path[1:1] = [str(ROOT), str(ROOT / 'test')]
 
-from parallel_models import example_model, EXAMPLE_MODELS, ParallelModel  # noqa: E402
+from parallel_models import MODELS, ParallelModel, section_model  # noqa: E402
 from timing import format_error, markdown_table  # noqa: E402
 
 TRAJECTORIES = ROOT / 'bench' / 'parallel_trajectories.json'
@@ -145,7 +148,7 @@ def load_trajectories() -> dict[str, Trajectory]:
 
 
 def run(quick: bool, repetitions: int,
-        models: Sequence[str] = EXAMPLE_MODELS) -> tuple[list[Row], dict[str, str]]:
+        models: Sequence[str] = MODELS) -> tuple[list[Row], dict[str, str]]:
     """
     Follow every stored model's trajectory with every follower; return the rows and notes.
 
@@ -158,7 +161,7 @@ def run(quick: bool, repetitions: int,
     rows: list[Row] = []
     notes: dict[str, str] = {}
     for name in models:
-        model = example_model(name)
+        model = section_model(name)
         trajectory = trajectories.get(name)
         if trajectory is None:
             left_out = json.loads(TRAJECTORIES.read_text())['left_out']
@@ -267,18 +270,22 @@ def plot(rows: Sequence[Row], path: str) -> None:
     plt.close(figure)
 
 
-def write_trajectories(models: Sequence[str] = EXAMPLE_MODELS) -> dict[str, str]:
+def write_trajectories(models: Sequence[str] = MODELS) -> dict[str, str]:
     """
-    Assemble each model, choose its amplitude, and store its trajectory (module text).
+    Assemble each of ``models``, choose its amplitude, and store its trajectory (module text).
 
-    Returns why a model was left out. The assembly is Pinocchio's (parallel_peers.assemble)
-    until loops.assembly lands.
+    The stored entries of the other models are kept as they are. Returns why a model was left
+    out. The assembly is Pinocchio's (parallel_peers.assemble): no follower starts from its own.
     """
     from parallel_peers import assemble, idle_coordinates
 
-    stored, left_out = {}, {}
+    stored = json.loads(TRAJECTORIES.read_text()) if TRAJECTORIES.exists() else {
+        'samples': SAMPLES, 'models': {}, 'left_out': {}}
+    left_out = {}
     for name in models:
-        model = example_model(name)
+        stored['models'].pop(name, None)
+        stored['left_out'].pop(name, None)
+        model = section_model(name)
         pose, residual = assemble(model)
         if residual > ASSEMBLED:
             left_out[name] = (f'no assembly found: Levenberg–Marquardt from the zero pose stops '
@@ -290,13 +297,15 @@ def write_trajectories(models: Sequence[str] = EXAMPLE_MODELS) -> dict[str, str]
         for amplitude in AMPLITUDES:
             trajectory = Trajectory(name, pose, amplitude, prismatic, idle)
             if _closes(model, trajectory):
-                stored[name] = {'pose': pose, 'amplitude': amplitude,
-                                'prismatic': list(prismatic), 'idle': list(idle)}
+                stored['models'][name] = {'pose': pose, 'amplitude': amplitude,
+                                          'prismatic': list(prismatic), 'idle': list(idle)}
                 break
         else:
-            left_out[name] = f'the reference fails even at an amplitude of {AMPLITUDES[-1]}'
-    TRAJECTORIES.write_text(json.dumps({'samples': SAMPLES, 'models': stored,
-                                        'left_out': left_out}, indent=1) + '\n')
+            left_out[name] = f'Gauss–Newton fails even at an amplitude of {AMPLITUDES[-1]}'
+    stored['left_out'].update(left_out)
+    stored['models'] = {name: stored['models'][name] for name in MODELS
+                        if name in stored['models']}
+    TRAJECTORIES.write_text(json.dumps(stored, indent=1) + '\n')
     return left_out
 
 
@@ -319,13 +328,18 @@ def _closes(model: ParallelModel, trajectory: Trajectory) -> bool:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--write', action='store_true',
-                        help=f'assemble the models and write {TRAJECTORIES.name}')
+                        help=f'assemble the models and write their entries of {TRAJECTORIES.name}')
+    parser.add_argument('models', nargs='*', metavar='MODEL',
+                        help=f'the models to write (default: all of {", ".join(MODELS)})')
     arguments = parser.parse_args()
+    unknown = sorted(set(arguments.models) - set(MODELS))
+    if unknown:
+        parser.error(f'not models of the section: {", ".join(unknown)}')
     import peers
 
     peers.activate(install=True)
     if arguments.write:
-        for name, reason in write_trajectories().items():
+        for name, reason in write_trajectories(arguments.models or MODELS).items():
             print(f'{name}: {reason}')
     return 0
 

@@ -14,13 +14,18 @@ same tree:
   named as ``JointOverride.coordinates`` names them (``ankle_Z``, ``ankle_Y``), joined by
   massless links; ``FIXED`` is a fixed joint (the Gepetto loader freezes it at 0);
 * each side of a closure is a frame of its own: a massless link on a fixed joint at the side's
-  ``xyz``/``rpy`` from its link, named ``<closure>/parent`` and ``<closure>/child``.
+  ``xyz``/``rpy`` from its link, named ``<closure>/parent`` and ``<closure>/child``;
+* a continuous joint is a revolute joint without limits (Pinocchio reads a continuous joint as
+  two coordinates, the cosine and sine of its angle).
 
 So a peer's closure is always between two named frames (a weld: they coincide; a ball: their
 origins do), and its coordinates are the URDF's moving joints by name. A pin closure (five
 equations) is not among the peers' closure kinds and is refused by name here, as are mimic,
-continuous, floating and planar joints, which the example models do not have and the peers'
-parsers read differently from ROS.
+floating and planar joints, which the section's models do not have and the peers' parsers read
+differently from ROS.
+
+The models (``MODELS``): Gepetto/example-parallel-robots' (``example_model``) and the package's
+humanoid ankle (urdf/humanoid_ankle.urdf, its two ``<constraint>`` balls, the motors measured).
 """
 
 from __future__ import annotations
@@ -37,10 +42,15 @@ import lxml.etree
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 EXAMPLE_FOLDER = ROOT / 'test' / 'models' / 'example_parallel_robots'
 # Gepetto/example-parallel-robots' models (test/models/example_parallel_robots/README.md), in
-# the order of that table. C1's humanoid ankle joins them when it lands (issue 29 item 7).
+# the order of that table.
 EXAMPLE_MODELS = ('5bar_linkage', 'robot_delta', 'cassie_like', 'digit_like', 'kangaroo_like',
                   'battobot_6d', 'wl16_like', 'disney_like')
-# Far beyond any turn of a joint the overrides make (their URDF joint's limits no longer hold).
+ANKLE = 'humanoid_ankle'
+ANKLE_URDF = ROOT / 'urdf' / 'humanoid_ankle.urdf'
+ANKLE_MOTORS = ('motor_left', 'motor_right')
+MODELS = (ANKLE, *EXAMPLE_MODELS)
+# Far beyond any turn of a joint the overrides or a continuous joint make (the URDF
+# joint's limits no longer hold; a continuous joint has none).
 OVERRIDE_LIMIT = 1e3
 
 
@@ -90,6 +100,13 @@ def example_model(name: str) -> ParallelModel:
                           (folder / 'robot.yaml').read_text())
 
 
+def section_model(name: str) -> ParallelModel:
+    """Return the section's model ``name`` (``MODELS``)."""
+    if name == ANKLE:
+        return parallel_model(ANKLE, ANKLE_URDF.read_text(encoding='utf-8'), None, ANKLE_MOTORS)
+    return example_model(name)
+
+
 def parallel_model(name: str, urdf: str, closure_file: str | None = None,
                    actuated: tuple[str, ...] | None = None) -> ParallelModel:
     """
@@ -108,10 +125,12 @@ def parallel_model(name: str, urdf: str, closure_file: str | None = None,
     robot = copy.deepcopy(tree.element)
     for joint in tree.joints.values():
         if joint.mimic is not None or joint.joint_type not in (
-                JointType.FIXED, JointType.REVOLUTE, JointType.PRISMATIC):
+                JointType.FIXED, JointType.REVOLUTE, JointType.CONTINUOUS, JointType.PRISMATIC):
             what = 'a mimic joint' if joint.mimic is not None else joint.joint_type.value
             raise ModelError(f'{name}: joint {joint.name!r} is {what}, which the peers '
                              'read otherwise than ROS')
+        if joint.joint_type is JointType.CONTINUOUS:
+            _unlimited(robot.find(f"joint[@name='{joint.name}']"))
     for joint, override in description.overrides.items():
         _write_override(robot, joint, override)
     closures = []
@@ -160,6 +179,15 @@ def _write_override(robot: lxml.etree._Element, name: str, override: JointOverri
             robot.insert(position, lxml.etree.Element('link', name=link))
             position += 1
         parent = link
+
+
+def _unlimited(joint: lxml.etree._Element) -> None:
+    """Make a continuous joint a revolute one that no limit holds (see the module's text)."""
+    joint.set('type', 'revolute')
+    for element in joint.findall('limit'):
+        joint.remove(element)
+    lxml.etree.SubElement(joint, 'limit', lower=f'{-OVERRIDE_LIMIT}', upper=f'{OVERRIDE_LIMIT}',
+                          effort='0', velocity='0')
 
 
 def _side_frame(robot: lxml.etree._Element, frame: str, side: ClosureSide) -> str:

@@ -21,7 +21,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'bench'))
 
 import parallel_models  # noqa: E402, I100
-from parallel_models import example_model, EXAMPLE_MODELS, ModelError, parallel_model  # noqa
+from parallel_models import (  # noqa: E402
+    example_model, EXAMPLE_MODELS, ModelError, MODELS, parallel_model, section_model)
 import peers  # noqa: E402
 
 ROD = """<robot name="rods">
@@ -120,7 +121,7 @@ def peer_modules():
 
 
 @needs_peers
-@pytest.mark.parametrize('name', EXAMPLE_MODELS)
+@pytest.mark.parametrize('name', MODELS)
 def test_each_adapter_closes_the_first_sample_of_each_model(peer_modules, name: str) -> None:
     parallel_peers, parallel_bench = peer_modules
     trajectory = parallel_bench.load_trajectories().get(name)
@@ -130,7 +131,7 @@ def test_each_adapter_closes_the_first_sample_of_each_model(peer_modules, name: 
         _, residual = parallel_peers.assemble(example_model(name))
         assert 0.07 < residual < 0.09
         return
-    model = example_model(name)
+    model = section_model(name)
     tree = parallel_peers.PinocchioTree(model)
     first = trajectory.samples(model, parallel_bench.SAMPLES)[0]
     followers = [parallel_peers.PinocchioGaussNewton(model),
