@@ -5,13 +5,15 @@
 Section parallel: closing parallel robots' loops per sample, against the peers (issue 29 item 8).
 
 On the same models (bench/parallel_models.py: Gepetto/example-parallel-robots' and the
-package's humanoid ankle) and the same motions of their actuated joints,
-every follower (bench/parallel_peers.py, and the package's own when it lands: ``ours``) closes
-the loops sample after sample, warm started from its previous answer. Per model and follower:
-the worst position error (rad or m) of the determined coordinates against the reference, the
-largest difference of the idle coordinates (whose value is a convention: the reference holds
-them at the assembled pose), the median and p90 time per sample, and the samples the follower
-itself did not close (its own verdict, or a non-finite answer).
+package's humanoid ankle) and the same motions of their actuated joints, every follower (the
+package's own, bench/parallel_ours.py, and the peers, bench/parallel_peers.py) closes the loops
+sample after sample, warm started from its previous answer. Per model and follower: the worst
+position error (rad or m) of the determined coordinates against the 50-digit reference
+(bench/parallel_reference.py, at every ``EVERY``-th sample), the largest difference of the idle
+coordinates (whose value is a convention: the reference holds them at the assembled pose, as
+the package does), the median and p90 time per sample, and the samples the follower itself did
+not close (its own verdict: the package's refusals, a peer's convergence test; or a non-finite
+answer).
 
 Trajectories (``TRAJECTORIES``, written by ``python bench/parallel_bench.py --write``): per
 model, the assembled pose every follower starts from and, per actuated joint k (in name_mot
@@ -20,13 +22,11 @@ assembled pose, every joint moves at its own frequency, N = 500 (``--quick``: th
 of them). The amplitude is the largest of 0.2, 0.1, 0.05, ... (rad; a tenth of it in m for a
 prismatic joint) along which Gauss–Newton closes every sample. The assembled pose is Pinocchio's
 (``parallel_peers.assemble``), not the package's, so that no follower starts from its own
-assembly.
+assembly; the package plans its groups there (loops.newton.plan_group), which moves the pose
+by rounding only (below 2e-14).
 
-Two slots wait for helper C1's branch (issue 29 items 3–4 and the 50-digit reference in test/):
-
-* ``reference``: today PROVISIONAL, Pinocchio's Gauss–Newton iterated to stagnation (float64:
-  errors below ~1e-14 mean nothing against it);
-* ``ours_follower``: today None (no row), the package's own closure once loops.newton lands.
+Errors are taken at every ``EVERY``-th sample (``QUICK_EVERY``-th with ``--quick``): the
+50-digit reference takes 0.1 to 7 s a sample on these models.
 """
 
 from __future__ import annotations
@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import json
 import math
 import pathlib
+import re
 import statistics
 import sys
 import time
@@ -59,8 +60,10 @@ PRISMATIC_SCALE = 0.1
 RUNS = 3
 # A model whose best assembly leaves more than this (m or rad) is reported, not followed.
 ASSEMBLED = 1e-12
-REFERENCE_LABEL = ('PROVISIONAL reference: Pinocchio Gauss–Newton to stagnation in float64 '
-                   "(stand-in for C1's 50-digit reference)")
+# The samples the 50-digit reference closes: every EVERY-th (20 of 500; 10 of 100 with --quick).
+EVERY = 25
+QUICK_EVERY = 10
+EPSILON = sys.float_info.epsilon
 # Errors of 0 are drawn at this height on the log plot.
 PLOT_FLOOR = 1e-17
 
@@ -94,41 +97,59 @@ class Row:
     samples: int
     error: float
     idle_difference: float
-    median_time: float
+    median_time: float  # NaN: the follower refused to start
     p90_time: float
     failures: int
-    note: str = ''
 
 
-def reference(model: ParallelModel, trajectory: Trajectory,
-              samples: Sequence[Sequence[float]]) -> list[tuple[float, ...]]:
+def reference_every(quick: bool) -> int:
+    """Return k: the reference closes every k-th sample (module text)."""
+    return QUICK_EVERY if quick else EVERY
+
+
+def reference(model: ParallelModel, trajectory: Trajectory, samples: Sequence[Sequence[float]],
+              every: int) -> tuple[dict[int, tuple], list[str]]:
     """
-    Return the reference's answer to every sample, in ``model.coordinates``' order.
+    Return the 50-digit reference's answer to every ``every``-th sample, and notes on it.
 
-    PROVISIONAL (REFERENCE_LABEL): Pinocchio's Gauss–Newton, 30 minimum-norm steps per sample,
-    in float64. The slot for C1's 50-digit reference (test/closure_reference.py in its branch:
-    ``Reference(urdf, closures, overrides).solve(known, guess, unknown)``, idle freedoms held at
-    the assembled pose): the same samples from ``trajectory.pose``, its answers as mpf (the
-    errors are taken in mpmath), or every k-th sample if 500 take too long.
+    Answers by sample index, every coordinate in ``model.coordinates``' order (the solved ones
+    mpf); bench/parallel_reference.py says how. Its start at each sample is Pinocchio's
+    Gauss–Newton continued over every sample from the trajectory's pose (30 steps, to
+    stagnation). The notes: samples it left out, and groups the actuated joints do not
+    determine (their free motions' held value is the reference's convention only).
     """
     from parallel_peers import PinocchioGaussNewton
+    from parallel_reference import ReferencePath
 
-    follower = PinocchioGaussNewton(model, tolerance=0.0, iterations=30)
-    follower.start(trajectory.pose)
-    return [follower.follow(sample).positions for sample in samples]
+    path = ReferencePath(model, trajectory.pose)
+    continuation = PinocchioGaussNewton(model, tolerance=0.0, iterations=30)
+    continuation.start(trajectory.pose)
+    answers = {}
+    for index, sample in enumerate(samples):
+        guess = continuation.follow(sample).positions
+        if index % every == 0:
+            answer = path.solve(sample, guess)
+            if answer is not None:
+                answers[index] = answer
+    taken = range(0, len(samples), every)
+    notes = []
+    if path.undetermined:
+        notes.append('its actuated joints leave free motions that move other joints (the '
+                     "package's structure, in group(s) " + ', '.join(path.undetermined) + '): '
+                     "the pose is not determined, and each follower's error is its distance "
+                     "from the reference's convention, those motions held at the assembled "
+                     'pose')
+    if len(answers) < len(taken):
+        notes.append(f'the reference left out {len(taken) - len(answers)} of its {len(taken)} '
+                     "samples (no closure on Gauss–Newton's assembly there)")
+    return answers, notes
 
 
 def ours_follower(model: ParallelModel):
-    """
-    Return the package's own follower of ``model``, or None while it has none (no row).
+    """Return the package's own follower of ``model`` (bench/parallel_ours.py)."""
+    from parallel_ours import PackageClosure
 
-    The slot for the package's spatial closure (helper C1: loops.tree, structure, newton): a
-    ``parallel_peers.Follower`` whose ``start`` takes the trajectory's assembled pose (every
-    coordinate by name) and whose ``follow`` closes a sample of ``model.actuated`` and returns
-    every coordinate in ``model.coordinates``' order, built from ``model.source_urdf`` and
-    ``model.closure_file`` as the node reads them (not from the peers' rewritten URDF).
-    """
-    return None
+    return PackageClosure(model)
 
 
 def peer_followers(model: ParallelModel) -> list[object]:
@@ -147,31 +168,44 @@ def load_trajectories() -> dict[str, Trajectory]:
             for name, entry in stored['models'].items()}
 
 
-def run(quick: bool, repetitions: int,
-        models: Sequence[str] = MODELS) -> tuple[list[Row], dict[str, str]]:
+def run(quick: bool, repetitions: int, models: Sequence[str] = MODELS
+        ) -> tuple[list[Row], dict[str, list[str]]]:
     """
     Follow every stored model's trajectory with every follower; return the rows and notes.
 
     Times: each follower runs the whole trajectory ``repetitions`` times (at most RUNS), the
     followers of a model round-robin (each from the assembled pose again); median and p90 over
-    all samples of all runs. Errors and failures: the first run.
+    all samples of all runs. Errors and failures: the first run. Notes by model: why it was left
+    out, what the reference says of it, the package's largest conditioning κ (its floor κ·ε) or
+    why it refused to start.
     """
+    from parallel_ours import StartRefused
+
     trajectories = load_trajectories()
     count = QUICK_SAMPLES if quick else SAMPLES
+    every = reference_every(quick)
     rows: list[Row] = []
-    notes: dict[str, str] = {}
+    notes: dict[str, list[str]] = {}
     for name in models:
         model = section_model(name)
         trajectory = trajectories.get(name)
         if trajectory is None:
             left_out = json.loads(TRAJECTORIES.read_text())['left_out']
-            notes[name] = 'left out: ' + left_out.get(name, f'not in {TRAJECTORIES.name}')
+            notes[name] = ['left out: ' + left_out.get(name, f'not in {TRAJECTORIES.name}')]
             continue
         # --quick follows the start of the same motion: the spacing of samples the stored
         # amplitude was checked at
         samples = trajectory.samples(model, SAMPLES)[:count]
-        exact = reference(model, trajectory, samples)
-        followers = [follower for follower in (ours_follower(model), *peer_followers(model))
+        exact, notes[name] = reference(model, trajectory, samples, every)
+        ours = ours_follower(model)
+        try:
+            ours.start(trajectory.pose)
+        except StartRefused as refused:
+            rows.append(Row(model.name, ours.label, len(samples), math.nan, math.nan, math.nan,
+                            math.nan, len(samples)))
+            notes[name].append(f'the package refuses to start: {_elided(str(refused))}')
+            ours = None
+        followers = [follower for follower in (ours, *peer_followers(model))
                      if follower is not None]
         answers = {}
         times: dict[int, list[float]] = {index: [] for index in range(len(followers))}
@@ -182,10 +216,21 @@ def run(quick: bool, repetitions: int,
                 times[index] += run_times
                 if repetition == 0:
                     answers[index] = run_answers
+                    if follower is ours:
+                        conditioning = ours.conditioning
+        if ours is not None:
+            notes[name].append(f"the package's largest conditioning κ = {conditioning:.3g}: "
+                               f'its floor κ·ε = {conditioning * EPSILON:.1e}')
         for index, follower in enumerate(followers):
-            rows.append(_row(model, trajectory, follower.label, answers[index], exact,
-                             times[index]))
+            rows.append(follower_row(model, trajectory, follower.label, answers[index],
+                                     exact, times[index]))
     return rows, notes
+
+
+def _elided(problem: str) -> str:
+    """Return a plan's problem line with its long lists of joints counted, for the notes."""
+    return re.sub(r'\[([^\]]{60,})\]',
+                  lambda match: f'[{match.group(1).count(",") + 1} names]', problem)
 
 
 def _follow(follow: Callable, samples: Sequence[Sequence[float]]) -> tuple[list, list[float]]:
@@ -199,19 +244,21 @@ def _follow(follow: Callable, samples: Sequence[Sequence[float]]) -> tuple[list,
     return answers, times
 
 
-def _row(model: ParallelModel, trajectory: Trajectory, label: str, answers: list,
-         exact: list[tuple[float, ...]], times: list[float]) -> Row:
+def follower_row(model: ParallelModel, trajectory: Trajectory, label: str, answers: list,
+                 exact: dict[int, tuple], times: list[float]) -> Row:
+    """Return a follower's row: errors at the reference's samples, failures over all."""
     prismatic = set(trajectory.prismatic)
     idle = set(trajectory.idle)
     error = idle_difference = 0.0
     failures = 0
-    for answer, expected in zip(answers, exact):
-        if not answer.converged or not all(map(math.isfinite, answer.positions)):
+    for index, answer in enumerate(answers):
+        finite = all(map(math.isfinite, answer.positions))
+        if not answer.converged or not finite:
             failures += 1
-        if not all(map(math.isfinite, answer.positions)):
+        if not finite or index not in exact:
             continue
-        for name, value, wanted in zip(model.coordinates, answer.positions, expected):
-            # taken in the reference's type (mpf for a 50-digit one), then rounded
+        for name, value, wanted in zip(model.coordinates, answer.positions, exact[index]):
+            # taken in the reference's type (mpf for a solved joint), then rounded
             difference = float(value - wanted)
             if name not in prismatic:
                 difference = math.remainder(difference, 2.0 * math.pi)
@@ -224,18 +271,20 @@ def _row(model: ParallelModel, trajectory: Trajectory, label: str, answers: list
                statistics.median(times), deciles[8], failures)
 
 
-def table(rows: Sequence[Row], notes: dict[str, str]) -> str:
+def table(rows: Sequence[Row], notes: dict[str, list[str]], every: int) -> str:
     """Return the section's markdown: one row per model and follower, then the notes."""
     header = ['model', 'follower', 'worst error (rad, m)', 'idle coordinates: largest difference',
               'time / sample: median', 'p90', 'not closed (own verdict)']
     lines = markdown_table(header, [
-        [row.model, row.follower, format_error(row.error),
-         format_error(row.idle_difference) if row.idle_difference else '–',
-         f'{row.median_time * 1e6:.1f} µs', f'{row.p90_time * 1e6:.1f} µs',
+        [row.model, row.follower,
+         '–' if math.isnan(row.error) else format_error(row.error),
+         format_error(row.idle_difference) if row.idle_difference > 0.0 else '–',
+         '–' if math.isnan(row.median_time) else f'{row.median_time * 1e6:.1f} µs',
+         '–' if math.isnan(row.p90_time) else f'{row.p90_time * 1e6:.1f} µs',
          f'{row.failures} of {row.samples}'] for row in rows])
-    extra = [f'- {model}: {note}' for model, note in notes.items()]
-    return '\n'.join([f'Errors against the {REFERENCE_LABEL}.', '', lines,
-                      *([''] + extra if extra else [])])
+    extra = [f'- {model}: {note}' for model, texts in notes.items() for note in texts]
+    return '\n'.join([f'Errors against the 50-digit reference at every {every}-th sample; '
+                      'times over every sample.', '', lines, *([''] + extra if extra else [])])
 
 
 def plot(rows: Sequence[Row], path: str) -> None:
@@ -251,6 +300,8 @@ def plot(rows: Sequence[Row], path: str) -> None:
     colours = dict(zip(models, plt.get_cmap('tab10').colors))
     figure, axis = plt.subplots(figsize=(13, 6.5))
     for row in rows:
+        if math.isnan(row.median_time):
+            continue
         axis.loglog(row.median_time, max(row.error, PLOT_FLOOR), marker=markers[row.follower],
                     color=colours[row.model], markersize=8, linestyle='none',
                     markerfacecolor='none' if row.failures else colours[row.model])
@@ -263,8 +314,8 @@ def plot(rows: Sequence[Row], path: str) -> None:
     axis.set_ylabel('worst position error (rad, m)')
     axis.grid(True, which='major', alpha=0.4)
     axis.legend(fontsize=8, loc='upper left', bbox_to_anchor=(1.01, 1.0))
-    axis.set_title('Closing parallel robots per sample (lower left is better; hollow: some '
-                   'samples not closed)\nerrors against the ' + REFERENCE_LABEL, fontsize=9)
+    axis.set_title('Closing parallel robots per sample, errors against a 50-digit reference '
+                   '(lower left is better; hollow: some samples not closed)', fontsize=9)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)

@@ -163,11 +163,13 @@ def run_sections(arguments: argparse.Namespace, sections: Collection[str],
             import peers
 
             versions = peers.activate(install=True)
-            print('peers: ' + ', '.join(f'{name} {version}' for name, version in versions.items()))
             rows, notes = parallel_bench.run(arguments.quick, repetitions)
             parallel_bench.plot(rows, arguments.parallel_plot)
             print(f'plot written to {arguments.parallel_plot}')
-            parts = (parallel_bench.table(rows, notes),)
+            every = parallel_bench.reference_every(arguments.quick)
+            parts = ('Peers: ' + ', '.join(f'{name} {version}' for name, version in
+                                           versions.items()) + '.\n\n'
+                     + parallel_bench.table(rows, notes, every),)
         else:
             import node_bench
 
