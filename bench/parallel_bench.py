@@ -100,6 +100,9 @@ class Row:
     median_time: float  # NaN: the follower refused to start
     p90_time: float
     failures: int
+    # False where the actuated joints leave free motion: the error is then a distance from the
+    # reference's convention, and the plot leaves the row out
+    determined: bool = True
 
 
 def reference_every(quick: bool) -> int:
@@ -108,15 +111,16 @@ def reference_every(quick: bool) -> int:
 
 
 def reference(model: ParallelModel, trajectory: Trajectory, samples: Sequence[Sequence[float]],
-              every: int) -> tuple[dict[int, tuple], list[str]]:
+              every: int) -> tuple[dict[int, tuple], list[str], bool]:
     """
-    Return the 50-digit reference's answer to every ``every``-th sample, and notes on it.
+    Return the 50-digit reference's answer to every ``every``-th sample, notes, determinacy.
 
     Answers by sample index, every coordinate in ``model.coordinates``' order (the solved ones
     mpf); bench/parallel_reference.py says how. Its start at each sample is Pinocchio's
     Gauss–Newton continued over every sample from the trajectory's pose (30 steps, to
     stagnation). The notes: samples it left out, and groups the actuated joints do not
-    determine (their free motions' held value is the reference's convention only).
+    determine (their free motions' held value is the reference's convention only); the bool:
+    whether they determine every group.
     """
     from parallel_peers import PinocchioGaussNewton
     from parallel_reference import ReferencePath
@@ -142,7 +146,7 @@ def reference(model: ParallelModel, trajectory: Trajectory, samples: Sequence[Se
     if len(answers) < len(taken):
         notes.append(f'the reference left out {len(taken) - len(answers)} of its {len(taken)} '
                      "samples (no closure on Gauss–Newton's assembly there)")
-    return answers, notes
+    return answers, notes, not path.undetermined
 
 
 def ours_follower(model: ParallelModel):
@@ -196,13 +200,13 @@ def run(quick: bool, repetitions: int, models: Sequence[str] = MODELS
         # --quick follows the start of the same motion: the spacing of samples the stored
         # amplitude was checked at
         samples = trajectory.samples(model, SAMPLES)[:count]
-        exact, notes[name] = reference(model, trajectory, samples, every)
+        exact, notes[name], determined = reference(model, trajectory, samples, every)
         ours = ours_follower(model)
         try:
             ours.start(trajectory.pose)
         except StartRefused as refused:
             rows.append(Row(model.name, ours.label, len(samples), math.nan, math.nan, math.nan,
-                            math.nan, len(samples)))
+                            math.nan, len(samples), determined))
             notes[name].append(f'the package refuses to start: {_elided(str(refused))}')
             ours = None
         followers = [follower for follower in (ours, *peer_followers(model))
@@ -222,8 +226,10 @@ def run(quick: bool, repetitions: int, models: Sequence[str] = MODELS
             notes[name].append(f"the package's largest conditioning κ = {conditioning:.3g}: "
                                f'its floor κ·ε = {conditioning * EPSILON:.1e}')
         for index, follower in enumerate(followers):
-            rows.append(follower_row(model, trajectory, follower.label, answers[index],
-                                     exact, times[index]))
+            row = follower_row(model, trajectory, follower.label, answers[index], exact,
+                               times[index])
+            row.determined = determined
+            rows.append(row)
     return rows, notes
 
 
@@ -288,20 +294,24 @@ def table(rows: Sequence[Row], notes: dict[str, list[str]], every: int) -> str:
 
 
 def plot(rows: Sequence[Row], path: str) -> None:
-    """Draw median time per sample against worst error, log-log: one marker per follower, model."""
+    """
+    Draw median time per sample against worst error, log-log: one marker per follower, model.
+
+    Rows without figures (a follower that refused to start) and of models the actuated joints
+    do not determine (no error to draw) are left out.
+    """
     import matplotlib
 
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
 
+    rows = [row for row in rows if row.determined and not math.isnan(row.median_time)]
     followers = list(dict.fromkeys(row.follower for row in rows))
     models = list(dict.fromkeys(row.model for row in rows))
     markers = dict(zip(followers, 'os^Dv<>P'))
     colours = dict(zip(models, plt.get_cmap('tab10').colors))
     figure, axis = plt.subplots(figsize=(13, 6.5))
     for row in rows:
-        if math.isnan(row.median_time):
-            continue
         axis.loglog(row.median_time, max(row.error, PLOT_FLOOR), marker=markers[row.follower],
                     color=colours[row.model], markersize=8, linestyle='none',
                     markerfacecolor='none' if row.failures else colours[row.model])
