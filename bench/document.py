@@ -261,10 +261,10 @@ Today's figures. Every table and plot below comes from the `./dev bench` run its
 rewrites only its part. Earlier figures are in this file's git history
 (`git log -p docs/benchmarks.md`).
 
-<!-- not run: every section takes about 15 minutes (the memory run 10 of them) -->
+<!-- not run: every section takes about 25 minutes (the memory run 10, the parallel one 10) -->
 ```bash
 ./dev bench                        # every section, written here
-./dev bench --quick                # about 3 minutes: fewer angles, shorter runs
+./dev bench --quick                # about 7 minutes: fewer angles, shorter runs
 ./dev bench --only cost            # one section (kinematics, drive, tf, node, cost, measured,
                                    # loops, parallel, memory)
 ./dev bench --only node --no-document   # print only

@@ -48,7 +48,8 @@ DOMAIN_COUNT = 5
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true',
-                        help='fewer angles, shorter timings and node runs (about a minute)')
+                        help='fewer angles, shorter timings and node runs (about 7 minutes '
+                             'in all)')
     parser.add_argument('--repetitions', type=int, default=None,
                         help='timing repetitions per method (default 7, 5 with --quick)')
     parser.add_argument('--only', choices=SECTIONS, action='append',
