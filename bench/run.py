@@ -9,10 +9,13 @@ tf (one state's /tf bytes, prepared against the generic forward kinematics), nod
 tick, rates, jitter, latency and log size), cost (the node's CPU side by side with a minimal
 hand-written rclpy publisher, its highest sustained rate with the default placement and with
 cpu_affinity:=0), measured and loops (the measured source, and a URDF's four loops closed, each
-against a minimal hand-written rclpy relay) and memory (the node's resident memory over a long
-1 kHz run). Every section prints markdown tables, which the run writes into docs/benchmarks.md
-(bench/document.py); the kinematics section also draws docs/benchmark_speed_error.png, the cost
-section docs/benchmark_cost_rate.png.
+against a minimal hand-written rclpy relay), parallel (parallel robots' loops closed per sample
+by the package and beside it by toolbox-parallel-robots, Pinocchio with Gauss–Newton and PlaCo,
+which it installs on first use: bench/peers.py) and memory (the node's resident memory over a
+long 1 kHz run). Every section prints markdown tables, which the run writes into
+docs/benchmarks.md (bench/document.py); the kinematics section also draws
+docs/benchmark_speed_error.png, the cost section docs/benchmark_cost_rate.png, the parallel
+section docs/benchmark_parallel.png.
 """
 
 from __future__ import annotations
@@ -34,7 +37,8 @@ import document  # noqa: E402
 from ros_domains import domain_lease  # noqa: E402
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'memory')
+SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'parallel',
+            'memory')
 # The sections that run nodes, each kind of run on its own ROS_DOMAIN_ID: the first one and the
 # four after it (node_bench's DOMAIN_* offsets).
 ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'memory')
@@ -44,7 +48,8 @@ DOMAIN_COUNT = 5
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.strip().splitlines()[0])
     parser.add_argument('--quick', action='store_true',
-                        help='fewer angles, shorter timings and node runs (about a minute)')
+                        help='fewer angles, shorter timings and node runs (about 7 minutes '
+                             'in all)')
     parser.add_argument('--repetitions', type=int, default=None,
                         help='timing repetitions per method (default 7, 5 with --quick)')
     parser.add_argument('--only', choices=SECTIONS, action='append',
@@ -53,6 +58,8 @@ def main(argv: list[str] | None = None) -> int:
                         help='where to write the speed-against-error plot')
     parser.add_argument('--cost-plot', default=str(DOCS / 'benchmark_cost_rate.png'),
                         help='where to write the plot of CPU against timer rate')
+    parser.add_argument('--parallel-plot', default=str(DOCS / 'benchmark_parallel.png'),
+                        help="where to write the parallel section's time-against-error plot")
     parser.add_argument('--document', default=str(document.DOCUMENT),
                         help="the document the run's figures are written to (its sections "
                              'that did not run are kept)')
@@ -152,6 +159,18 @@ def run_sections(arguments: argparse.Namespace, sections: Collection[str],
 
             parts = (loops_bench.path_run(arguments.quick, repetitions),
                      loops_bench.run(arguments.quick, ros_domain))
+        elif key == 'parallel':
+            import parallel_bench
+            import peers
+
+            versions = peers.activate(install=True)
+            rows, notes = parallel_bench.run(arguments.quick, repetitions)
+            parallel_bench.plot(rows, arguments.parallel_plot)
+            print(f'plot written to {arguments.parallel_plot}')
+            every = parallel_bench.reference_every(arguments.quick)
+            parts = ('Peers: ' + ', '.join(f'{name} {version}' for name, version in
+                                           versions.items()) + '.\n\n'
+                     + parallel_bench.table(rows, notes, every),)
         else:
             import node_bench
 
