@@ -27,10 +27,11 @@ from pathlib import Path
 from closure_reference import Reference
 import closure_robots
 from linkage_kinematics.loops.closures import Closure, JointOverride
-from linkage_kinematics.loops.command import CommandGroup, RobotCommand
+from linkage_kinematics.loops.command import CommandGroup
 from linkage_kinematics.loops.encodings import read_closures
 from linkage_kinematics.loops.newton import plan_group, PlannedGroup
 from linkage_kinematics.loops.plan import find_loops
+from linkage_kinematics.loops.robot_command import RobotCommand
 from linkage_kinematics.loops.structure import closure_groups, ClosureGroup
 from linkage_kinematics.loops.transmission import Transmission
 from linkage_kinematics.loops.tree import KinematicTree

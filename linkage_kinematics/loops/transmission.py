@@ -248,21 +248,24 @@ class Transmission:
                               for i in columns]
         local = [float(values[i]) for i in columns]
         self._rows = independent_rows(scaled_jacobian(equations, tree, local, size))
-        self._row_scale = [1.0 / size if equations.row_kinds[row] is RowKind.LENGTH else 1.0
-                           for row in self._rows]
+        row_scale = [1.0 / size if equations.row_kinds[row] is RowKind.LENGTH else 1.0
+                     for row in self._rows]
         # U: every column but the actuators; U': every column but the outputs
         measured_unknown = [c for c in range(len(columns)) if c not in self._actuator_columns]
         command_unknown = [c for c in range(len(columns)) if c not in self._output_columns]
-        self._measured = (measured_unknown,
-                          _idle_rows(tree, structure, names, measured_unknown))
         command_idle = [row for subgroup, found in structures
                         for row in _idle_rows(tree, found, names, command_unknown)]
-        self._command = (command_unknown, command_idle)
-        for unknown, idle in (self._measured, self._command):
-            if len(self._rows) + len(idle) != len(unknown):
+        self._measured = _Square(measured_unknown,
+                                 _idle_rows(tree, structure, names, measured_unknown),
+                                 row_scale, self._column_scale)
+        self._command = _Square(command_unknown, command_idle, row_scale, self._column_scale)
+        for square in (self._measured, self._command):
+            if len(square.columns) != len(square.row_scale):
                 raise TransmissionError(
-                    f'group {self.name}: {len(self._rows)} independent rows and {len(idle)} '
-                    f'idle freedoms for {len(unknown)} unknowns')
+                    f'group {self.name}: {len(self._rows)} independent rows and '
+                    f'{len(square.idle)} idle freedoms for {len(square.columns)} unknowns')
+        # the actuators' places among U'
+        self._actuator_places = [command_unknown.index(c) for c in self._actuator_columns]
         # where each column's value comes from: (0, place among the actuators) or (1, place
         # among the measured direction's solved joints)
         solved = list(structure.solved)
@@ -280,34 +283,22 @@ class Transmission:
         jacobian = self.equations.jacobian(self.equations.evaluate(local))
         return [jacobian[row] for row in self._rows]
 
-    def _command_inverse(self, jacobian: Sequence[Sequence[float]]
-                         ) -> tuple[list[list[float]], float, float]:
-        """Return A'⁻¹, det A' and κ(A'); κ = inf where A' is singular."""
-        matrix = _square(jacobian, *self._command)
-        found = inverse(matrix)
-        if found is None:
-            return [], 0.0, math.inf
-        inverse_matrix, det = found
-        scales = [self._column_scale[c] for c in self._command[0]]
-        rows = self._row_scale + [1.0] * len(self._command[1])
-        return inverse_matrix, det, condition(matrix, inverse_matrix, rows, scales)
-
     def _ratio(self, jacobian: Sequence[Sequence[float]],
                inverse_matrix: Sequence[Sequence[float]]) -> tuple[tuple[float, ...], ...]:
         """Return M = ∂m/∂o: the actuators' rows of −A'⁻¹·[J_R,o; 0]."""
-        unknown = self._command[0]
         count = len(self._rows)
+        outputs = self._output_columns
         ratio = []
-        for column in self._actuator_columns:
-            line = inverse_matrix[unknown.index(column)][:count]
-            ratio.append(tuple(-math.fsum([a * row[o] for a, row in zip(line, jacobian)])
-                               for o in self._output_columns))
+        for place in self._actuator_places:
+            line = inverse_matrix[place]
+            ratio.append(tuple(-math.fsum([line[k] * jacobian[k][o] for k in range(count)])
+                               for o in outputs))
         return tuple(ratio)
 
     def ratio(self, local: Sequence[float]) -> tuple[tuple[float, ...], ...]:
         """Return M = ∂m/∂o at a pose (over ``columns``); TransmissionSingular near one."""
         jacobian = self._jacobian(local)
-        inverse_matrix, _, conditioning = self._command_inverse(jacobian)
+        inverse_matrix, _, conditioning = self._command.factor(jacobian)
         if not conditioning <= CONDITION_LIMIT:
             raise TransmissionSingular(self.name, conditioning)
         return self._ratio(jacobian, inverse_matrix)
@@ -336,30 +327,55 @@ class Transmission:
     def linearize(self, local: Sequence[float]) -> Linearization:
         """Return both directions' systems at a pose (over ``columns``), singular or not."""
         jacobian = self._jacobian(local)
-        inverse_matrix, det, conditioning = self._command_inverse(jacobian)
-        matrix = _square(jacobian, *self._measured)
-        found = inverse(matrix)
-        if found is None:
-            measured_det, measured_conditioning = 0.0, math.inf
-        else:
-            scales = [self._column_scale[c] for c in self._measured[0]]
-            rows = self._row_scale + [1.0] * len(self._measured[1])
-            measured_det = found[1]
-            measured_conditioning = condition(matrix, found[0], rows, scales)
+        inverse_matrix, det, conditioning = self._command.factor(jacobian)
+        _, measured_det, measured_conditioning = self._measured.factor(jacobian)
         ratio = (self._ratio(jacobian, inverse_matrix) if inverse_matrix
                  else tuple((math.inf,) * len(self.outputs) for _ in self.actuators))
         return Linearization(ratio, _sign(measured_det), measured_conditioning, _sign(det),
                              conditioning)
 
 
+class _Square:
+    """One direction's square system A = [J_R,U; Nᵀ] and its scales (module docstring)."""
+
+    def __init__(self, columns: list[int], idle: list[list[float]], row_scale: list[float],
+                 column_scale: list[float]) -> None:
+        self.columns = columns
+        self.idle = idle
+        self.row_scale = row_scale + [1.0] * len(idle)
+        self.column_scale = [column_scale[c] for c in columns]
+
+    def factor(self, jacobian: Sequence[Sequence[float]]
+               ) -> tuple[list[list[float]], float, float]:
+        """
+        Return A⁻¹, det A and κ₁ of A with rows and columns dimensionless.
+
+        κ = inf and no inverse where A is exactly singular. A 1×1 or 2×2 A (a planar loop, the
+        ankle's legs) is done inline: ``linear.condition``'s general loops cost more there than
+        the rest of the per-sample algebra.
+        """
+        columns = self.columns
+        matrix = [[row[c] for c in columns] for row in jacobian] + self.idle
+        found = inverse(matrix)
+        if found is None or found[1] == 0.0:
+            return [], 0.0, math.inf
+        inverse_matrix, det = found
+        rows, scales = self.row_scale, self.column_scale
+        if len(columns) == 1:
+            return inverse_matrix, det, 1.0
+        if len(columns) == 2:
+            (a, b), (c, d) = matrix
+            (r0, r1), (s0, s1) = rows, scales
+            norm = max((abs(a) * r0 + abs(c) * r1) * s0, (abs(b) * r0 + abs(d) * r1) * s1)
+            (p, q), (u, v) = inverse_matrix
+            norm_inverse = max((abs(p) / s0 + abs(u) / s1) / r0,
+                               (abs(q) / s0 + abs(v) / s1) / r1)
+            return inverse_matrix, det, norm * norm_inverse
+        return inverse_matrix, det, condition(matrix, inverse_matrix, rows, scales)
+
+
 def _sign(value: float) -> int:
     return 1 if value > 0.0 else -1 if value < 0.0 else 0
-
-
-def _square(jacobian: Sequence[Sequence[float]], columns: Sequence[int],
-            idle: Sequence[Sequence[float]]) -> list[list[float]]:
-    """Return [J_R,U; Nᵀ]: the chosen rows' ``columns``, then the idle rows."""
-    return [[row[c] for c in columns] for row in jacobian] + [list(row) for row in idle]
 
 
 def _idle_rows(tree: KinematicTree, structure: GroupStructure, names: Sequence[str],
