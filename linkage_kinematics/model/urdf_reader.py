@@ -16,9 +16,9 @@ Each joint comes with urdfdom's defaults filled in (origin 0, axis (1, 0, 0), mi
 and offset 0, a ``<limit>``'s lower and upper 0), its origin's rotation also as urdfdom keeps it
 (a quaternion) and its axis made unit as KDL makes it. As urdfdom, a revolute or prismatic joint
 without a ``<limit>`` is refused (its effort and velocity are required attributes); a continuous
-joint may have one, whose lower and upper bound nothing. The parsed XML tree is kept for the elements urdf_parser_py does not read
-(the ``<constraint>`` and ``<loop_joint>`` elements that close loops, read in ``loops``). Pure:
-urdf_parser_py and lxml, no ROS graph.
+joint may have one, whose lower and upper bound nothing. The parsed XML tree is kept for the
+elements urdf_parser_py does not read (the ``<constraint>`` and ``<loop_joint>`` elements that
+close loops, read in ``loops``). Pure: urdf_parser_py and lxml, no ROS graph.
 """
 
 from __future__ import annotations
@@ -57,6 +57,8 @@ class JointType(enum.Enum):
 ROTATING_TYPES = frozenset({JointType.REVOLUTE, JointType.CONTINUOUS})
 # kdl_parser gives floating and planar joints no degree of freedom: they stay at their origin.
 MOVABLE_TYPES = ROTATING_TYPES | {JointType.PRISMATIC}
+# the joints whose <limit> bounds their position; urdfdom requires one of them
+_BOUNDED_TYPES = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
 
 
 @dataclass(frozen=True)
@@ -114,11 +116,10 @@ class UrdfJoint:
         """
         Return (lower, upper) for a revolute or prismatic joint, None where nothing bounds it.
 
-        A continuous joint turns without bound whatever its ``<limit>`` says (urdfdom and
-        kdl_parser keep lower and upper, robot_state_publisher and MoveIt ignore them).
+        A continuous joint turns without bound whatever its ``<limit>`` says (the URDF
+        specification: "a continuous hinge joint ... has no upper and lower limits").
         """
-        if self.limit is None or self.joint_type not in (JointType.REVOLUTE,
-                                                          JointType.PRISMATIC):
+        if self.limit is None or self.joint_type not in _BOUNDED_TYPES:
             return None
         return (self.limit.lower, self.limit.upper)
 
@@ -344,7 +345,7 @@ def _joint(joint: urdf_parser.Joint, links: set[str]) -> UrdfJoint:
              0.0 if joint.limit.upper is None else joint.limit.upper,
              joint.limit.velocity, joint.limit.effort), f'{where} limit')
         limit = JointLimit(lower, upper, velocity, effort)
-    elif joint_type in (JointType.REVOLUTE, JointType.PRISMATIC):
+    elif joint_type in _BOUNDED_TYPES:
         raise UrdfError(f'{where}: a {joint_type.value} joint needs a <limit> (lower, upper, '
                         'effort, velocity)')
     return UrdfJoint(joint.name, joint_type, joint.parent, joint.child, xyz, rpy,
