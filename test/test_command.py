@@ -12,7 +12,9 @@ accelerations against central differences of the reference's velocities at 50 di
 1e-12 relative; actuator efforts against M⁻ᵀ·τ_o with the reference's M within 1e-12 relative,
 and the power balance to rounding; the round trip (the commanded actuators fed to the measured
 direction's own solver) returns the output joints within 1e-12. Then the refusals, each by
-reason, the state kept; continuation over far points; ``RobotCommand``'s names and arrays.
+reason, the state kept; continuation over far points; ``RobotCommand``'s names and arrays;
+idle freedoms and redundant rows (test/closure_robots.py's rod with two balls, collinear pins,
+planar weld, delta-like) held in both directions: the round trip within 1e-14.
 """
 
 from __future__ import annotations
@@ -20,13 +22,16 @@ from __future__ import annotations
 import math
 import sys
 
+import closure_robots
 from linkage_kinematics.loops.command import (
+    CommandGroup,
     CommandRefusal,
     CommandRefused,
     JointPoint,
 )
 from linkage_kinematics.loops.robot_command import RobotCommand
 from linkage_kinematics.loops.structure import GroupKind
+from linkage_kinematics.loops.transmission import Transmission
 from mpmath import mp, mpf
 import pytest
 import transmission_robots
@@ -298,3 +303,33 @@ def test_an_actuator_leaving_its_urdf_limit_refuses_the_point():
         assert refused.value.reason is CommandRefusal.LIMIT
         assert refused.value.detail.startswith(start)
         assert boom.position('boom_cylinder') == before
+
+
+@pytest.mark.parametrize('mechanism, outputs, start', [
+    ('rod_two_balls', ('rocker',), {'crank': 0.4}),  # the rod spins idle both ways
+    ('collinear_pins', ('p3',), None),  # the short link turns idle both ways
+    ('planar_weld', ('k4',), None),  # six rows of rank three
+    ('delta_like', ('elbow0_Y', 'elbow1_Y', 'elbow2_Y'), None),  # three idle spins
+])
+def test_idle_freedoms_and_redundant_rows_are_held_both_ways(mechanism, outputs, start):
+    """The round trip within 1e-14 and the power balance to rounding, M without idle motion."""
+    built = getattr(closure_robots, mechanism)()
+    planned = closure_robots.plan(built, start=start)
+    transmission = Transmission(planned.tree, planned.group, planned.structure, outputs,
+                                planned.assembly.values)
+    command = CommandGroup(planned.tree, transmission, planned.assembly.values)
+    measured = closure_robots.plan(built, start=start)
+    solved = measured.structure.solved
+    base = [command.position(name) for name in outputs]
+    for step in range(1, 101):
+        target = [b + 0.05 * math.sin(0.05 * step + k) for k, b in enumerate(base)]
+        rates = [0.01 * (k + 1) for k in range(len(outputs))]
+        efforts = [0.1] * len(outputs)
+        found = command.solve(target, rates, (), efforts).actuators
+        state = measured.solver.solve(list(found.positions), list(found.velocities))
+        for name, value, rate in zip(outputs, target, rates):
+            assert abs(state.positions[solved.index(name)] - value) <= 1e-14
+            assert abs(state.velocities[solved.index(name)] - rate) <= 1e-14
+        actuator_power = math.fsum(t * v for t, v in zip(found.efforts, found.velocities))
+        output_power = math.fsum(t * v for t, v in zip(efforts, rates))
+        assert abs(actuator_power - output_power) <= 8 * EPSILON * abs(output_power)
