@@ -22,6 +22,7 @@ import time
 
 from linkage_kinematics.model.robot_transforms import RobotTransforms
 from linkage_kinematics.model.urdf_reader import (
+    JointLimit,
     JointType,
     Mimic,
     quaternion_from_rpy,
@@ -32,6 +33,7 @@ import pytest
 from urdf_parser_py.xml_reflection import core as xml_reflection_core
 
 LINKS = '<link name="a"/><link name="b"/>'
+LIMIT = '<limit lower="-1" upper="1" effort="2" velocity="3"/>'
 
 
 def robot(body: str, name: str = ' name="r"') -> str:
@@ -78,10 +80,21 @@ def joint(extra: str = '', name: str = 'j', joint_type: str = 'fixed', parent: s
      "link 'c' inertial mass value: 'heavy' is not a number"),
     (robot('<joint name="j" type="fixed"><parent/><child link="b"/></joint>'),
      "joint 'j' parent: no link attribute"),
-    (robot(joint('<mimic joint="k"/>', joint_type='revolute')),
+    (robot(joint('<mimic joint="k"/>' + LIMIT, joint_type='revolute')),
      "joint 'j' mimics 'k', which is not a joint of the robot"),
     (robot(joint('<limit lower="0"/>', joint_type='revolute')),
      "joint 'j' limit: no effort attribute"),
+    (robot(joint('<limit effort="1"/>', joint_type='prismatic')),
+     "joint 'j' limit: no velocity attribute"),
+    (robot(joint('<limit lower="-1" upper="x" effort="1" velocity="1"/>',
+                 joint_type='revolute')), "joint 'j' limit upper: 'x' is not a number"),
+    (robot(joint('<limit upper="inf" effort="1" velocity="1"/>', joint_type='revolute')),
+     "joint 'j' limit: inf is not a finite number"),
+    # urdfdom: 'Joint [j] is of type REVOLUTE but it does not specify limits'
+    (robot(joint(joint_type='revolute')),
+     "joint 'j': a revolute joint needs a <limit> (lower, upper, effort, velocity)"),
+    (robot(joint(joint_type='prismatic')),
+     "joint 'j': a prismatic joint needs a <limit> (lower, upper, effort, velocity)"),
     (robot('<link name="c"/>' + joint(name='j1') + joint(name='j2', parent='c')),
      "link 'b' is the child of more than one joint ('j1', 'j2')"),
     (robot('<link name="c"/>' + joint(name='j1', parent='b', child='c')
@@ -103,9 +116,10 @@ def test_a_bad_urdf_is_one_line_naming_the_element(
 
 
 def test_urdfdoms_defaults_are_filled_in_and_every_number_is_a_float() -> None:
-    tree = read_urdf(robot('<link name="c"/><link name="d"/>' + joint(joint_type='revolute')
+    tree = read_urdf(robot('<link name="c"/><link name="d"/>'
+                           + joint('<limit effort="2" velocity="0"/>', joint_type='revolute')
                            + joint('<origin xyz="1 0 -0" rpy="0 0 1.5"/><axis xyz="0 3 4"/>'
-                                   '<mimic joint="j"/>', 'k', 'prismatic', 'b', 'c')
+                                   '<mimic joint="j"/>' + LIMIT, 'k', 'prismatic', 'b', 'c')
                            + joint('<mimic joint="k" multiplier="-2" offset="0.5"/>', 'm',
                                    'continuous', 'c', 'd')))
     assert (tree.name, tree.root_link, tree.links) == ('r', 'a', ('a', 'b', 'c', 'd'))
@@ -124,6 +138,23 @@ def test_urdfdoms_defaults_are_filled_in_and_every_number_is_a_float() -> None:
                               *one.axis))
     assert [(one.movable, one.revolute) for one in (j, k, m)] == [
         (True, True), (True, False), (True, True)]
+    # a <limit>'s lower and upper default to 0; a velocity or effort of 0 bounds nothing
+    assert (j.limit, j.position_limits, j.velocity_limit, j.effort_limit) == (
+        JointLimit(0.0, 0.0, 0.0, 2.0), (0.0, 0.0), None, 2.0)
+    assert (k.limit, k.position_limits, k.velocity_limit, k.effort_limit) == (
+        JointLimit(-1.0, 1.0, 3.0, 2.0), (-1.0, 1.0), 3.0, 2.0)
+    assert (m.limit, m.position_limits, m.velocity_limit, m.effort_limit) == (
+        None, None, None, None)
+
+
+def test_a_continuous_joints_limit_bounds_its_velocity_and_effort_not_its_position() -> None:
+    tree = read_urdf(robot(joint('<limit lower="-1" upper="1" effort="-5" velocity="7"/>',
+                                 joint_type='continuous')))
+    j = tree.joints['j']
+    assert (j.limit, j.position_limits, j.velocity_limit, j.effort_limit) == (
+        JointLimit(-1.0, 1.0, 7.0, -5.0), None, 7.0, None)
+    assert all(type(number) is float for number in (j.limit.lower, j.limit.upper,
+                                                    j.limit.velocity, j.limit.effort))
 
 
 def test_the_parsers_notes_are_kept_not_printed_and_its_hook_is_restored(

@@ -13,10 +13,12 @@ finite, a mimic's joint a joint of the robot. Whatever cannot be read is a ``Urd
 line naming the element and what is wrong.
 
 Each joint comes with urdfdom's defaults filled in (origin 0, axis (1, 0, 0), mimic multiplier 1
-and offset 0), its origin's rotation also as urdfdom keeps it (a quaternion) and its axis made
-unit as KDL makes it. The parsed XML tree is kept for the elements urdf_parser_py does not read
-(the ``<constraint>`` and ``<loop_joint>`` elements that close loops, read in ``loops``). Pure:
-urdf_parser_py and lxml, no ROS graph.
+and offset 0, a ``<limit>``'s lower and upper 0), its origin's rotation also as urdfdom keeps it
+(a quaternion) and its axis made unit as KDL makes it. As urdfdom, a revolute or prismatic joint
+without a ``<limit>`` is refused (its effort and velocity are required attributes); a continuous
+joint may have one, whose lower and upper bound nothing. The parsed XML tree is kept for the
+elements urdf_parser_py does not read (the ``<constraint>`` and ``<loop_joint>`` elements that
+close loops, read in ``loops``). Pure: urdf_parser_py and lxml, no ROS graph.
 """
 
 from __future__ import annotations
@@ -55,6 +57,8 @@ class JointType(enum.Enum):
 ROTATING_TYPES = frozenset({JointType.REVOLUTE, JointType.CONTINUOUS})
 # kdl_parser gives floating and planar joints no degree of freedom: they stay at their origin.
 MOVABLE_TYPES = ROTATING_TYPES | {JointType.PRISMATIC}
+# the joints whose <limit> bounds their position; urdfdom requires one of them
+_BOUNDED_TYPES = frozenset({JointType.REVOLUTE, JointType.PRISMATIC})
 
 
 @dataclass(frozen=True)
@@ -67,8 +71,26 @@ class Mimic:
 
 
 @dataclass(frozen=True)
+class JointLimit:
+    """
+    A joint's ``<limit>`` as urdfdom reads it: lower and upper (rad or m, 0 when not given).
+
+    ``velocity`` (rad/s or m/s) and ``effort`` (N·m or N) are required by urdfdom.
+    """
+
+    lower: float
+    upper: float
+    velocity: float
+    effort: float
+
+
+@dataclass(frozen=True)
 class UrdfJoint:
-    """A URDF joint: its links, origin (xyz; rpy, and as a quaternion), unit axis and mimic."""
+    """
+    A URDF joint: its links, origin (xyz; rpy, and as a quaternion), unit axis, mimic, limit.
+
+    ``limit`` is None where the joint has no ``<limit>`` (a fixed or continuous joint may not).
+    """
 
     name: str
     joint_type: JointType
@@ -79,6 +101,7 @@ class UrdfJoint:
     origin_rotation: Quaternion
     axis: Vector
     mimic: Mimic | None
+    limit: JointLimit | None = None
 
     @property
     def movable(self) -> bool:
@@ -87,6 +110,38 @@ class UrdfJoint:
     @property
     def revolute(self) -> bool:
         return self.joint_type in ROTATING_TYPES
+
+    @property
+    def position_limits(self) -> tuple[float, float] | None:
+        """
+        Return (lower, upper) for a revolute or prismatic joint, None where nothing bounds it.
+
+        A continuous joint turns without bound whatever its ``<limit>`` says (the URDF
+        specification: "a continuous hinge joint ... has no upper and lower limits").
+        """
+        if self.limit is None or self.joint_type not in _BOUNDED_TYPES:
+            return None
+        return (self.limit.lower, self.limit.upper)
+
+    @property
+    def velocity_limit(self) -> float | None:
+        """Return the largest |velocity|, None where none is given (no limit, or 0 in it)."""
+        return _bound(None if self.limit is None else self.limit.velocity)
+
+    @property
+    def effort_limit(self) -> float | None:
+        """Return the largest |effort|, None where none is given (no limit, or 0 in it)."""
+        return _bound(None if self.limit is None else self.limit.effort)
+
+
+def _bound(value: float | None) -> float | None:
+    """
+    Return a velocity or effort limit that bounds something, else None.
+
+    URDFs write 0 where their author has no such limit (the attributes are required), and a
+    limit of 0 would forbid every motion of the joint; a negative one bounds nothing either.
+    """
+    return value if value is not None and value > 0.0 else None
 
 
 @dataclass(frozen=True)
@@ -282,8 +337,19 @@ def _joint(joint: urdf_parser.Joint, links: set[str]) -> UrdfJoint:
             (1.0 if joint.mimic.multiplier is None else joint.mimic.multiplier,
              0.0 if joint.mimic.offset is None else joint.mimic.offset), f'{where} mimic')
         mimic = Mimic(joint.mimic.joint, multiplier, offset)
+    limit = None
+    if joint.limit is not None:
+        # urdf_parser_py refuses a <limit> without effort or velocity, as urdfdom does
+        lower, upper, velocity, effort = _numbers(
+            (0.0 if joint.limit.lower is None else joint.limit.lower,
+             0.0 if joint.limit.upper is None else joint.limit.upper,
+             joint.limit.velocity, joint.limit.effort), f'{where} limit')
+        limit = JointLimit(lower, upper, velocity, effort)
+    elif joint_type in _BOUNDED_TYPES:
+        raise UrdfError(f'{where}: a {joint_type.value} joint needs a <limit> (lower, upper, '
+                        'effort, velocity)')
     return UrdfJoint(joint.name, joint_type, joint.parent, joint.child, xyz, rpy,
-                     quaternion_from_rpy(*rpy), axis, mimic)
+                     quaternion_from_rpy(*rpy), axis, mimic, limit)
 
 
 def _unique(kind: str, names: list[str]) -> None:

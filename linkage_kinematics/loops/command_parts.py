@@ -1,0 +1,226 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+One command group (a group the output joints known make) solved by the method it has.
+
+``command_part`` picks, from the structure as ``structure.classify`` recognises it:
+
+* ``PlanarPart``: planar one-degree-of-freedom loops from the output joint, in closed form by
+  the planar ``solver.LoopSolver`` (the measured direction's own solver, bit for bit), its
+  branch at the zero pose the one whose motion reaches the assembled pose;
+* ``LegPart``: one crank–rod–ball leg's inverse (``closed_forms.LegPositions``); where only the
+  actuators are asked, the crank alone from the closed form, without the rod's angles and the
+  solver's rates (a quarter of the cost: the forward-command relay's case);
+* ``NewtonPart``: ``newton.GroupSolver`` (Newton, or the five-bar's closed form it dispatches
+  to).
+
+Each part: ``positions`` (the lean path: at least the joints the transmission's equations
+need, written into a whole-tree value list), ``solve`` (every solved joint's position and
+velocity), ``accelerations`` (``newton.Derivatives``, after ``solve``), ``restore`` (back to a
+pose). Each raises ``newton.SampleRefused``. Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+import math
+
+from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
+from linkage_kinematics.loops.assembly import Assembly
+from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
+from linkage_kinematics.loops.equations import LoopEquations
+from linkage_kinematics.loops.newton import (
+    Derivatives,
+    GroupSolver,
+    PlanError,
+    Refusal,
+    SampleRefused,
+)
+from linkage_kinematics.loops.plan import RobotLoops
+from linkage_kinematics.loops.planar import Loop
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.structure import (
+    classify,
+    ClosureGroup,
+    GroupKind,
+    GroupStructure,
+    reducible_rods,
+)
+from linkage_kinematics.loops.tree import KinematicTree, MotionKind
+
+# A planar chain's closed form must reproduce the assembled pose to this (rad, or m ÷ size).
+SAME_POSE = 1e-9
+
+
+class NewtonPart:
+    """A command group solved by ``GroupSolver``."""
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 values: Sequence[float], kind: GroupKind) -> None:
+        assembly = Assembly(group.name, tuple(values), (), (), 0, 0)
+        self.solver = GroupSolver(tree, group, structure, assembly, kind)
+        self.kind = kind
+        self.columns = [tree.index[name] for name in structure.solved]
+        self.known = [tree.index[name] for name in structure.known]
+
+    def positions(self, values: list[float]) -> None:
+        """Write the solved joints for the known ones in ``values`` (whole tree) into it."""
+        known = [values[c] for c in self.known]
+        state = self.solver.solve(known, [0.0] * len(known))
+        for column, value in zip(self.columns, state.positions):
+            values[column] = value
+
+    def solve(self, values: list[float],
+              rates: Sequence[float]) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """Return the solved joints' positions and velocities (``rates``: the known ones')."""
+        state = self.solver.solve([values[c] for c in self.known], rates)
+        return state.positions, state.velocities
+
+    def accelerations(self, rates: Sequence[float],
+                      accelerations: Sequence[float]) -> tuple[float, ...]:
+        """Return the solved joints' accelerations at the last ``solve``."""
+        return self.solver.derivatives.accelerations(rates, accelerations)
+
+    def restore(self, values: Sequence[float]) -> None:
+        """Start again at a pose (whole tree)."""
+        self.solver.reset(values)
+
+
+class LegPart(NewtonPart):
+    """A crank–rod–ball leg: the crank alone in closed form where only actuators are asked."""
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 values: Sequence[float]) -> None:
+        super().__init__(tree, group, structure, values, GroupKind.LEG_INVERSE)
+        rods = reducible_rods(tree, group, structure)
+        self.equations = LoopEquations(tree, group.closures, rods)
+        self.closed_form = LegPositions(tree, group, self.equations, next(iter(rods.values())))
+        self.closed_form.reset([values[i] for i in self.equations.coordinates])
+        self.crank = self.equations.coordinates[self.closed_form.column]
+        # the solver's pose is not the last one after a lean step: put it there before solving
+        self.behind = False
+
+    def positions(self, values: list[float]) -> None:
+        """Write the crank for the known joints in ``values`` (whole tree) into it."""
+        local = [values[i] for i in self.equations.coordinates]
+        try:
+            self.closed_form.move(local, self.closed_form.branch)
+        except OutOfReach as error:
+            raise SampleRefused(self.solver.name, Refusal.UNREACHABLE, str(error)) from None
+        values[self.crank] = local[self.closed_form.column]
+        self.behind = True
+
+    def solve(self, values: list[float],
+              rates: Sequence[float]) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """Return the solved joints' positions and velocities (``rates``: the known ones')."""
+        if self.behind:
+            self.solver.reset(values)
+            self.behind = False
+        return super().solve(values, rates)
+
+
+class PlanarPart:
+    """A command group of planar one-degree-of-freedom loops, closed by ``LoopSolver``."""
+
+    def __init__(self, tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 loops: Sequence[Loop], values: Sequence[float]) -> None:
+        self.kind = GroupKind.PLANAR_LOOPS
+        self.names = structure.solved
+        self.known_names = structure.known
+        self.columns = [tree.index[name] for name in structure.solved]
+        self.known = [tree.index[name] for name in structure.known]
+        robot = RobotLoops('', frozenset(name for loop in loops for name in loop.names),
+                           tuple(loops), ())
+        # the branch at the zero pose whose motion reaches the assembled pose, loop by loop
+        branches = {}
+        for planned in robot.plan(self.known_names).loops:
+            coordinates = (0.0,) + tuple(joint.sign * float(values[tree.index[joint.name]])
+                                         for joint in planned.loop.joints)
+            known = planned.known
+            here = branch_of(planned.loop.planar, known.index, coordinates)
+            branches[planned.loop.constraint] = driven_loop(
+                planned.loop.planar, known.index).continued_branch(
+                    coordinates[known.index], here, 0.0)
+        self.plan = robot.plan(self.known_names, branches)
+        self.derivatives = Derivatives(tree, group, structure, values)
+        self.restore(values)
+        found = list(values)
+        self.positions(found)
+        for name, column in zip(self.names, self.columns):
+            scale = (structure.size if tree.coordinates[column].kind is MotionKind.SLIDE
+                     else 1.0)
+            # a whole turn apart is the same pose
+            if abs(_turned(found[column], values[column], tree, column)
+                   - values[column]) > SAME_POSE * scale:
+                raise PlanError(f'group {group.name}: the planar closed form does not find '
+                                f'the assembled pose ({name})')
+
+    def _closed(self, values: Sequence[float], rates: Sequence[float]) -> tuple[dict, dict]:
+        known = [values[c] for c in self.known]
+        try:
+            return self.solver.solve(dict(zip(self.known_names, known)),
+                                     dict(zip(self.known_names, rates)))
+        except LoopSampleError as error:
+            raise SampleRefused(error.constraint or '', Refusal.UNREACHABLE,
+                                str(error)) from None
+
+    def positions(self, values: list[float]) -> None:
+        """Write the solved joints for the known ones in ``values`` (whole tree) into it."""
+        positions, _ = self._closed(values, [0.0] * len(self.known))
+        for name, column in zip(self.names, self.columns):
+            values[column] = positions[name]
+
+    def solve(self, values: list[float],
+              rates: Sequence[float]) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """Return the solved joints' positions and velocities (``rates``: the known ones')."""
+        positions, velocities = self._closed(values, rates)
+        found = tuple(positions[name] for name in self.names)
+        speeds = tuple(velocities[name] for name in self.names)
+        self.derivatives.last = (list(found), list(speeds), [values[c] for c in self.known])
+        return found, speeds
+
+    def accelerations(self, rates: Sequence[float],
+                      accelerations: Sequence[float]) -> tuple[float, ...]:
+        """Return the solved joints' accelerations at the last ``solve``."""
+        return self.derivatives.accelerations(rates, accelerations)
+
+    def restore(self, values: Sequence[float]) -> None:
+        """Start the closed form afresh and take it to the known joints' ``values``."""
+        self.solver = LoopSolver(self.plan)
+        self._closed(values, [0.0] * len(self.known))
+
+
+def _turned(value: float, near: float, tree: KinematicTree, column: int) -> float:
+    """Return a turn's ``value`` moved by whole turns to within π of ``near``."""
+    if tree.coordinates[column].kind is not MotionKind.TURN:
+        return value
+    return near + math.remainder(value - near, 2.0 * math.pi)
+
+
+def command_part(tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
+                 values: Sequence[float], loops: Sequence[Loop]
+                 ) -> NewtonPart | PlanarPart:
+    """
+    Return the part that solves a command group (module docstring).
+
+    ``loops``: the robot's planar loops (``plan.find_loops``); a planar group whose loops are
+    not among them (written other than by ``<constraint>``), or whose closed form cannot be
+    planned from this pose, goes to Newton. PlanError where the assembled pose is a singular
+    configuration of the group.
+    """
+    kind = classify(tree, group, structure, values)
+    by_name = {loop.constraint: loop for loop in loops}
+    if kind is GroupKind.PLANAR_LOOPS:
+        if all(closure.name in by_name and all(name in tree.index
+                                               for name in by_name[closure.name].names)
+               for closure in group.closures):
+            try:
+                return PlanarPart(tree, group, structure,
+                                  [by_name[closure.name] for closure in group.closures], values)
+            except ValueError:  # no closed-form plan or branch from this pose
+                pass
+        return NewtonPart(tree, group, structure, values, GroupKind.NEWTON)
+    if kind is GroupKind.LEG_INVERSE:
+        return LegPart(tree, group, structure, values)
+    return NewtonPart(tree, group, structure, values, kind)

@@ -1,0 +1,204 @@
+# Copyright 2026 linkage_kinematics maintainers
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A robot's command direction with names: what the relay to the actuators' controllers converts.
+
+A point names joints (a ``JointTrajectory``'s ``joint_names``, a forward command's declared
+order) and carries positions, velocities, accelerations and efforts for them
+(``command.JointPoint``). The URDF's joints outside the loops pass through unchanged; every group
+whose output joints it names is converted (``command.CommandGroup``, the lean path: actuators
+only), its actuators following the joints passed through. Refused whole (``CommandRefused``,
+reason ``JOINTS``), one line listing every problem: a name the URDF does not have, a loop joint
+that is not an output joint (an actuator or passive joint: command the outputs), a group's
+output joints given in part, a name given twice, an array neither empty nor one value per
+joint, accelerations without velocities, loop outputs without positions; and NaN or inf
+anywhere (``NOT_FINITE``). A trajectory's points are converted in order, continuing from the
+last accepted point, and refused whole, naming the first point refused: the groups are then as
+before it. A forward command is a trajectory of one point. Pure: no ROS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection, Sequence
+from dataclasses import dataclass
+import math
+
+from linkage_kinematics.loops.command import (
+    CommandGroup,
+    CommandRefusal,
+    CommandRefused,
+    CommandState,
+    JointPoint,
+)
+
+# lists of names whose conversion is kept
+LAYOUTS = 64
+
+
+class RobotCommand:
+    """
+    A robot's command direction with names (module docstring).
+
+    ``groups``: every group's ``CommandGroup``; ``joints``: every joint name of the URDF. The
+    output names of a point are the joints passed through (in the order given), then the
+    actuators of every group whose outputs it names (groups in order).
+    """
+
+    def __init__(self, groups: Sequence[CommandGroup], joints: Collection[str]) -> None:
+        self.groups = tuple(groups)
+        self.joints = frozenset(joints)
+        self._owner: dict[str, int] = {}
+        self._loop_joints: dict[str, str] = {}
+        self._layouts: dict[tuple[str, ...], _Layout | CommandRefused] = {}
+        for number, group in enumerate(self.groups):
+            for name in group.outputs:
+                self._owner[name] = number
+            for name in (*group.actuators, *group.passive):
+                self._loop_joints[name] = group.name
+
+    def reset(self) -> None:
+        """Start every group again from its assembled pose."""
+        for group in self.groups:
+            group.reset()
+
+    def names(self, names: Sequence[str]) -> tuple[str, ...]:
+        """Return the joint names a point given for ``names`` is converted to."""
+        return self._layout(names).names
+
+    def _layout(self, names: Sequence[str]) -> _Layout:
+        """Return how a point for ``names`` is converted (kept per list of names); or refuse."""
+        key = tuple(names)
+        layout = self._layouts.get(key)
+        if layout is None:
+            layout = self._split(key)
+            if len(self._layouts) >= LAYOUTS:  # a relay has a few lists; a stream of others
+                self._layouts.clear()
+            self._layouts[key] = layout
+        if isinstance(layout, CommandRefused):
+            raise layout
+        return layout
+
+    def _split(self, names: tuple[str, ...]) -> _Layout | CommandRefused:
+        """Return the groups commanded and the joints passed through, or the refusal."""
+        problems = []
+        twice = sorted({name for name in names if names.count(name) > 1})
+        if twice:
+            problems.append(f'joints named twice: {twice}')
+        passing = []
+        given: dict[int, int] = {}
+        for name in dict.fromkeys(names):  # each name once, in order
+            if name in self._owner:
+                number = self._owner[name]
+                given[number] = given.get(number, 0) + 1
+            elif name in self._loop_joints:
+                problems.append(f'joint {name!r} is solved by group {self._loop_joints[name]}: '
+                                'command its output joints')
+            elif name not in self.joints:
+                problems.append(f'joint {name!r} is not a joint of the robot')
+            else:
+                passing.append(name)
+        for number, count in given.items():
+            group = self.groups[number]
+            if count != len(group.outputs):
+                missing = [name for name in group.outputs if name not in names]
+                problems.append(f'group {group.name} needs all its output joints '
+                                f'{list(group.outputs)}; {missing} missing')
+        if problems:
+            return CommandRefused(CommandRefusal.JOINTS, '; '.join(problems))
+        commanded = tuple(sorted(given))
+        return _Layout(
+            tuple(passing) + tuple(name for number in commanded
+                                   for name in self.groups[number].actuators),
+            commanded, tuple(names.index(name) for name in passing),
+            tuple(tuple(names.index(name) for name in self.groups[number].outputs)
+                  for number in commanded))
+
+    def _check(self, names: Sequence[str], point: JointPoint, commanded: bool) -> None:
+        for what, array in (('positions', point.positions), ('velocities', point.velocities),
+                            ('accelerations', point.accelerations), ('effort', point.efforts)):
+            if array and len(array) != len(names):
+                raise CommandRefused(CommandRefusal.JOINTS, f'{len(array)} {what} for '
+                                     f'{len(names)} joints')
+            if not all(map(math.isfinite, array)):
+                name, value = next((n, v) for n, v in zip(names, array)
+                                   if not math.isfinite(v))
+                raise CommandRefused(CommandRefusal.NOT_FINITE,
+                                     f'joint {name!r}: {what} {value!r}')
+        if commanded and not point.positions:
+            raise CommandRefused(CommandRefusal.JOINTS, "the loops' output joints need "
+                                 'positions')
+        if point.accelerations and not point.velocities:
+            raise CommandRefused(CommandRefusal.JOINTS, 'accelerations without velocities')
+
+    def convert(self, names: Sequence[str], point: JointPoint) -> JointPoint:
+        """
+        Return the point for ``self.names(names)``: passed-through joints, then actuators.
+
+        A forward command (one point): CommandRefused whole, every group's state as it was.
+        """
+        layout = self._layout(names)
+        self._check(names, point, bool(layout.commanded))
+        states = [self.groups[number].state() for number in layout.commanded]
+        try:
+            return self._point(layout, point)
+        except CommandRefused:
+            self._restore(layout, states)
+            raise
+
+    def trajectory(self, names: Sequence[str],
+                   points: Sequence[JointPoint]) -> tuple[JointPoint, ...]:
+        """
+        Return every point converted, in order, for ``self.names(names)``.
+
+        CommandRefused whole, naming the first point refused (0-based); the groups' states are
+        then as before the trajectory.
+        """
+        layout = self._layout(names)
+        for number, point in enumerate(points):
+            try:
+                self._check(names, point, bool(layout.commanded))
+            except CommandRefused as refusal:
+                raise _at_point(refusal, number) from None
+        states = [self.groups[number].state() for number in layout.commanded]
+        converted = []
+        for number, point in enumerate(points):
+            try:
+                converted.append(self._point(layout, point))
+            except CommandRefused as refusal:
+                self._restore(layout, states)
+                raise _at_point(refusal, number) from None
+        return tuple(converted)
+
+    def _restore(self, layout: _Layout, states: Sequence[CommandState]) -> None:
+        """Put the groups a point moved back where they were."""
+        for number, state in zip(layout.commanded, states):
+            if self.groups[number].state() is not state:
+                self.groups[number].restore(state)
+
+    def _point(self, layout: _Layout, point: JointPoint) -> JointPoint:
+        arrays = (point.positions, point.velocities, point.accelerations, point.efforts)
+        out = [[array[place] for place in layout.passing] if array else [] for array in arrays]
+        for number, places in zip(layout.commanded, layout.outputs):
+            found = self.groups[number].solve(
+                *([array[place] for place in places] if array else [] for array in arrays)
+            ).actuators
+            for target, array in zip(out, (found.positions, found.velocities,
+                                           found.accelerations, found.efforts)):
+                target += array
+        return JointPoint(*(tuple(array) for array in out))
+
+
+@dataclass(frozen=True)
+class _Layout:
+    """How a point for one list of names is converted: out names, groups, places."""
+
+    names: tuple[str, ...]
+    commanded: tuple[int, ...]
+    passing: tuple[int, ...]
+    outputs: tuple[tuple[int, ...], ...]
+
+
+def _at_point(refusal: CommandRefused, number: int) -> CommandRefused:
+    """Return the refusal with the point's number before its detail."""
+    return CommandRefused(refusal.reason, f'point {number}: {refusal.detail}')
