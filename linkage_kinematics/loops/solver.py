@@ -97,6 +97,7 @@ class GroupStep:
             raise LoopSampleError(f'group {plan.name}: at the first sample: {planned.problem}',
                                   plan.name, Refusal.SINGULAR)
         self.assembly, self.solver, self.fresh = planned.assembly, planned.solver, False
+        self.state = None  # the new solver's, once it has solved a sample
         return planned.solver
 
     def solve(self, values: Sequence[float], rates: Sequence[float]) -> GroupState:

@@ -61,6 +61,9 @@ ROBOT_DESCRIPTION_QOS = QoSProfile(
 MEASURED_QOS = QoSProfile(depth=100)
 MEASURED_TOPIC = 'measured_joint_states'
 ROBOT_DESCRIPTION_TOPIC = 'robot_description'
+# The closure file's text, logged beside the description (latched as it is), never published:
+# the parameter robot_description_closures holds it.
+CLOSURES_TOPIC = 'robot_description_closures'
 
 
 class StartupError(Exception):
@@ -112,6 +115,7 @@ class NodeOutputs:
         # loops robot_description: the input and the lab's description are logged too
         self.input_topic = node.resolve_topic_name(MEASURED_TOPIC)
         self.description_topic = node.resolve_topic_name(ROBOT_DESCRIPTION_TOPIC)
+        self.closures_topic = node.resolve_topic_name(CLOSURES_TOPIC)
         self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
         self._prepared_for: RunConfiguration | None = None
@@ -142,6 +146,8 @@ class NodeOutputs:
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         if self.config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
             topics.append((self.description_topic, String, ROBOT_DESCRIPTION_QOS, None))
+            if self.config.loops.robot_description_closures:
+                topics.append((self.closures_topic, String, ROBOT_DESCRIPTION_QOS, None))
             # Heard on the topic the node publishes to, the input goes to that topic's record.
             if self.input_topic != self._publishers.joint_states.topic_name:
                 topics.append((self.input_topic, JointState, MEASURED_QOS, None))
@@ -253,11 +259,17 @@ class NodeOutputs:
         """Log one input message's bytes as received, at its stamp."""
         self._record(self.input_topic, data, stamp_ns)
 
-    def record_robot(self, urdf: str, transforms: messages.RobotStateTransforms,
+    def record_robot(self, urdf: str, closures: str, transforms: messages.RobotStateTransforms,
                      stamp_ns: int) -> None:
-        """Log a lab's description and its /tf_static; its /tf goes with each state (record_tf)."""
+        """
+        Log a lab's description, its closure file ('': none) and its /tf_static.
+
+        Its /tf goes with each state (record_tf).
+        """
         self._robot_transforms = transforms
         self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
+        if closures:
+            self._record(self.closures_topic, encode_cdr(String(data=closures)), stamp_ns)
         self._record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
 
     def record_tf(self, positions: Sequence[float], stamp_ns: int) -> None:
