@@ -82,13 +82,13 @@ class GroupPlan:
     One closure group of the plan: what it knows and solves, and how.
 
     ``loops``: a group of planar loops, its loops in solve order (closed in closed form by
-    ``solver.LoopSolver``); empty for every other group, which ``zero`` plans: assembled at the
-    zero pose with its joints free (the checker's assembly; the node assembles again at its
-    first sample, from there, with the measured joints held), analysed, classified and given a
-    solver (``newton.PlannedGroup``). ``known`` and ``solved`` name coordinates of the tree, in
-    the order the group takes and gives them; ``hidden`` the solved coordinates of joints the
-    closure file overrides (solved, never published: they are no URDF joints). ``seed``: the
-    ``assemblies`` start values of its joints.
+    ``solver.LoopSolver``; ``zero`` None); every other group has none, and ``zero`` plans it:
+    assembled at the zero pose with its joints free (the checker's assembly; the node assembles
+    again at its first sample, from there, with the measured joints held), analysed, classified
+    and given a solver (``newton.PlannedGroup``). ``known`` and ``solved`` name coordinates of
+    the tree, in the order the group takes and gives them; ``hidden`` the solved coordinates of
+    joints the closure file overrides (solved, never published: they are no URDF joints).
+    ``seed``: the ``assemblies`` start values of its joints.
     """
 
     group: ClosureGroup
@@ -107,7 +107,7 @@ class GroupPlan:
     @property
     def kind(self) -> GroupKind:
         """Return how the group's positions are solved."""
-        if self.loops:
+        if self.zero is None:
             return GroupKind.PLANAR_LOOPS
         # a planar loop the planar closed forms do not take (two prismatic joints): Newton
         return (GroupKind.NEWTON if self.zero.kind is GroupKind.PLANAR_LOOPS
@@ -125,8 +125,8 @@ class LoopPlan:
     The robot's loops in solve order for one set of measured joints, and what to warn about.
 
     ``loops``: the planar loops in solve order (of every planar group); ``groups``: every
-    closure group, the planar ones first, then the general closure's (``GroupPlan.loops``
-    empty), in solve order. ``problems``: what ``RobotLoops.survey`` found wrong (a plan from
+    closure group, the planar ones first, then the general closure's (``GroupPlan.zero`` set),
+    in solve order. ``problems``: what ``RobotLoops.survey`` found wrong (a plan from
     ``RobotLoops.plan`` has none).
     """
 
@@ -136,11 +136,12 @@ class LoopPlan:
     groups: tuple[GroupPlan, ...] = ()
     tree: KinematicTree | None = None
     problems: tuple[str, ...] = ()
+    unassembled: tuple[str, ...] = ()
 
     @property
     def general(self) -> tuple[GroupPlan, ...]:
         """Return the groups the general closure solves (not planar loops), in solve order."""
-        return tuple(group for group in self.groups if not group.loops)
+        return tuple(group for group in self.groups if group.zero is not None)
 
     @property
     def passive(self) -> tuple[str, ...]:
@@ -277,9 +278,9 @@ class RobotLoops:
                      for name, value in branches.items() if value not in BRANCHES]
         ordered, ordering_problems = _order(loops, measured, branches)
         problems += ordering_problems
-        general, general_problems = self._general(
+        general, unassembled, general_problems = self._general(
             [group for group in groups if group not in planar_groups], dict(assemblies or {}))
-        problems += general_problems
+        problems += unassembled + general_problems
         planned = tuple(
             GroupPlan(group, tuple(tree.coordinates[i].name for i in group.known),
                       tuple(joint.name for item in ordered
@@ -291,13 +292,17 @@ class RobotLoops:
         warnings = (zero_pose_warnings(loops) + mimic_warnings(loops, measured)
                     + self.warnings)
         return LoopPlan(tuple(ordered), tuple(measured), warnings, planned, tree,
-                        tuple(problems))
+                        tuple(problems), tuple(unassembled))
 
     def _general(self, groups: Sequence[ClosureGroup], seeds: dict[str, float]
-                 ) -> tuple[tuple[GroupPlan, ...], list[str]]:
-        """Return the general closure's groups planned at the zero pose, and their problems."""
+                 ) -> tuple[tuple[GroupPlan, ...], list[str], list[str]]:
+        """
+        Return the general closure's groups planned at the zero pose, and their problems.
+
+        One line for each group that does not assemble, then the others' problems.
+        """
         tree = self.tree
-        plans, problems = [], []
+        plans, unassembled, problems = [], [], []
         seeded: set[str] = set()
         start = [0.0] * len(tree.names)
         for group in groups:
@@ -307,7 +312,7 @@ class RobotLoops:
             try:
                 zero = plan_group(tree, group, start, seed, hold_known=False)
             except AssemblyError as error:
-                problems.append(f'{error}: it cannot be assembled as given')
+                unassembled.append(f'{error}: it cannot be assembled as given')
                 continue
             if zero.problem is not None:
                 problems.append(zero.problem)
@@ -318,7 +323,7 @@ class RobotLoops:
         problems += [f'loops.assemblies: {name!r} is not a joint a closure group solves by the '
                      'general closure (a planar loop takes loops.branches)'
                      for name in seeds if name not in seeded]
-        return tuple(plans), problems
+        return tuple(plans), unassembled, problems
 
 
 def _order(loops: Sequence[Loop], measured: Sequence[str],

@@ -249,7 +249,7 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
         'measured joints': ('not known yet' if plan is None else ', '.join(plan.measured)),
         'passive joints': ('not known yet' if plan is None else ', '.join(plan.passive)),
         'closure groups': ('not known yet' if plan is None else ', '.join(
-            f'{group.name} ({"planar loops" if group.loops else "general closure"})'
+            f'{group.name} ({"planar loops" if group.zero is None else "general closure"})'
             for group in plan.groups)),
         **health.sample_values(inputs.now_ns),
     }
