@@ -23,7 +23,7 @@ import math
 from typing import Any, Protocol
 
 from linkage_kinematics.loops.assembly import ClosureGap
-from linkage_kinematics.loops.closures import ClosureError
+from linkage_kinematics.loops.closures import ClosureError, Encoding
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import LoopDrop, RobotLoopsFollower
 from linkage_kinematics.loops.intake import DropReason
@@ -230,9 +230,15 @@ class RobotLoopsSubscription(MeasuredInput):
         self._outputs.record_robot(robot.urdf, robot.closures, robot.transforms,
                                    self._host.now_ns())
         loops = robot.follower.loops
+        # by encoding, as each names its closures: constraints a, b; closures (closure file) c
+        written: dict[Encoding, list[str]] = {}
+        for closure in loops.closures:
+            written.setdefault(closure.encoding, []).append(closure.name)
         self._host.get_logger().info(
-            f'closing the loops of robot {loops.robot_name!r}: constraints '
-            + ', '.join(closure.name for closure in loops.closures))
+            f'closing the loops of robot {loops.robot_name!r}: ' + '; '.join(
+                f'{encoding.word}s ' + ('(closure file) ' if encoding is Encoding.CLOSURE_FILE
+                                        else '') + ', '.join(names)
+                for encoding, names in written.items()))
         if robot.follower.plan is not None:
             self._planned()
 
