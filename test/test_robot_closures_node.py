@@ -24,6 +24,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 import math
 from pathlib import Path
+import re
 import tempfile
 from typing import Any
 import xml.etree.ElementTree as ElementTree
@@ -41,6 +42,7 @@ from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
 from test_robot_loops import loop_node, LoopNode, values
 import urchin
+import yaml
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 ANKLE = REPOSITORY / 'urdf' / 'humanoid_ankle.urdf'
@@ -301,3 +303,39 @@ def closed_residual(reference: Reference, known: dict[str, float], unknown: list
             for index, name in enumerate(unknown):
                 values[name] -= step[index]
         return max(abs(row) for row in reference.residual(values))
+
+
+def documented_ankle_sample() -> tuple[dict[str, float], dict[str, float], dict, dict]:
+    """
+    Return the humanoid ankle's sample in docs/following_loops.md and the echo it shows.
+
+    The motors' positions and velocities of its ``ros2 topic pub``, and the names, positions
+    and velocities of the ``text`` block after it.
+    """
+    text = (REPOSITORY / 'docs' / 'following_loops.md').read_text(encoding='utf-8')
+    start = text.index('### The humanoid ankle from its URDF')
+    section = text[start:text.index('\n## ', start)]
+    published = re.search(r'"\{name: \[(.*?)\], position: \[(.*?)\], velocity: \[(.*?)\]\}"',
+                          section)
+    names = [name.strip() for name in published.group(1).split(',')]
+    positions = [float(value) for value in published.group(2).split(',')]
+    velocities = [float(value) for value in published.group(3).split(',')]
+    echo = yaml.safe_load(re.search(r'```text\n(.*?)```', section, re.DOTALL).group(1))
+    return (dict(zip(names, positions)), dict(zip(names, velocities)),
+            dict(zip(echo['name'], echo['position'])), dict(zip(echo['name'], echo['velocity'])))
+
+
+def test_the_documented_ankle_sample_is_what_the_node_publishes(context, nodes, tmp_path):
+    """The motors of the document's ros2 topic pub in, its echo's pitch, roll and rods out."""
+    measured, rates, positions, velocities = documented_ankle_sample()
+    assert list(positions)[:2] == ['ankle_pitch', 'ankle_roll']
+    parameters = {'robot_description': ANKLE.read_text(encoding='utf-8'),
+                  'loops.measured_joints': list(measured), 'log.enabled': False}
+    with loop_node(context, nodes, tmp_path, parameters) as node:
+        node.send(START_NS, list(measured), list(measured.values()), list(rates.values()))
+        assert nodes.interrupt(node.process) == 0
+        node.listener.drain()
+    (message,) = node.outputs
+    assert list(message.name) == list(positions)
+    assert list(message.position) == pytest.approx(list(positions.values()), abs=TOLERANCE)
+    assert list(message.velocity) == pytest.approx(list(velocities.values()), abs=TOLERANCE)
