@@ -40,7 +40,7 @@ import numpy as np
 import pytest
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import get_typestore, Stores
-from test_robot_loops import loop_node, LoopNode, values
+from test_robot_loops import loop_node, LoopNode, matrix, values
 import urchin
 import yaml
 
@@ -236,12 +236,40 @@ def test_every_answer_closes_the_loops_by_urchins_forward_kinematics(
     frames = file_frames(name) if encoding == 'closure file' else side_frames(urdf)
     assert worst_gap(urdf, frames, answered) < TOLERANCE
     (bag,) = (tmp_path / 'bags').iterdir()
+    assert_tf_poses_the_whole_robot(bag, urdf, answered)
     recorded = recorded_texts(bag)
     # -p folds the URDF's line breaks into spaces (a YAML single-quoted scalar); a literal
     # block keeps the closure file's
     assert [' '.join(text.split()) for text in recorded['/robot_description']] == [
         ' '.join(urdf.split())]
     assert recorded.get('/robot_description_closures', [None]) == [closures]
+
+
+def assert_tf_poses_the_whole_robot(bag: Path, urdf: str, answered: list[dict[str, float]]
+                                    ) -> None:
+    """One /tf per answer; /tf_static and the last /tf put every link where urchin does."""
+    static, tf = [], []
+    with Reader(bag) as reader:
+        for connection, _, raw in reader.messages():
+            if connection.topic in ('/tf', '/tf_static'):
+                message = TYPESTORE.deserialize_cdr(raw, connection.msgtype)
+                (tf if connection.topic == '/tf' else static).append(message)
+    assert len(tf) == len(answered) and len(static) == 1
+    transforms = {item.child_frame_id: item
+                  for item in static[0].transforms + tf[-1].transforms}
+    poses: dict[str, np.ndarray] = {}
+
+    def pose(link: str) -> np.ndarray:
+        if link not in transforms:
+            return np.eye(4)  # the root
+        if link not in poses:
+            item = transforms[link]
+            poses[link] = pose(item.header.frame_id) @ matrix(item.transform)
+        return poses[link]
+
+    expected = urchin_robot(urdf).link_fk(cfg=answered[-1], use_names=True)
+    assert max(float(np.max(np.abs(pose(link) - world))) for link, world in expected.items()
+               ) < TOLERANCE
 
 
 def recorded_texts(bag: Path) -> dict[str, list[str]]:
