@@ -86,6 +86,17 @@ class Publishers(NamedTuple):
         return tuple(publisher for publisher in self if publisher is not None)
 
 
+def _loops_topics(outputs: NodeOutputs, joint_states: str) -> list[tuple]:
+    """Return what loops robot_description logs beyond what it publishes: description, input."""
+    topics = [(outputs.description_topic, String, ROBOT_DESCRIPTION_QOS, None)]
+    if outputs.config.loops.robot_description_closures:
+        topics.append((outputs.closures_topic, String, ROBOT_DESCRIPTION_QOS, None))
+    # Heard on the topic the node publishes to, the input goes to that topic's record.
+    if outputs.input_topic != joint_states:
+        topics.append((outputs.input_topic, JointState, MEASURED_QOS, None))
+    return topics
+
+
 class NodeOutputs:
     """
     The node's publishers, the encoders of its per-state messages, and its recorder.
@@ -145,12 +156,7 @@ class NodeOutputs:
         topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         if self.config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
-            topics.append((self.description_topic, String, ROBOT_DESCRIPTION_QOS, None))
-            if self.config.loops.robot_description_closures:
-                topics.append((self.closures_topic, String, ROBOT_DESCRIPTION_QOS, None))
-            # Heard on the topic the node publishes to, the input goes to that topic's record.
-            if self.input_topic != self._publishers.joint_states.topic_name:
-                topics.append((self.input_topic, JointState, MEASURED_QOS, None))
+            topics += _loops_topics(self, self._publishers.joint_states.topic_name)
         try:
             return Recorder(
                 self.config.logging.folder, topics=topics, metadata=metadata, cpus=cpus,
@@ -261,11 +267,7 @@ class NodeOutputs:
 
     def record_robot(self, urdf: str, closures: str, transforms: messages.RobotStateTransforms,
                      stamp_ns: int) -> None:
-        """
-        Log a lab's description, its closure file ('': none) and its /tf_static.
-
-        Its /tf goes with each state (record_tf).
-        """
+        """Log a lab's description, closure file ('': none) and /tf_static (/tf: record_tf)."""
         self._robot_transforms = transforms
         self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
         if closures:
