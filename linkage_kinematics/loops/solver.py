@@ -63,7 +63,7 @@ class GroupStep:
     joints held at the sample) from its zero-pose assembly, which ``loops.assemblies`` seeds:
     the assembly nearest it at those measured values. Then its ``GroupSolver`` continues it.
     ``places``: where its known joints are among the sample's values; ``published``: where the
-    published joints are among the solver's ``solved``. After a sample: ``assembly`` (the
+    published joints are among the solver's ``solved`` (None: all of them). After a sample: ``assembly`` (the
     motion's), ``solver`` and ``state`` (the last solved sample's).
     """
 
@@ -72,7 +72,9 @@ class GroupStep:
         self.tree = tree
         self.places = tuple(places)
         solved = plan.solved
-        self.published = tuple(solved.index(name) for name in plan.published)
+        # None: every solved joint is published, in order (no joint the closure file overrides)
+        self.published = (None if not plan.hidden
+                          else tuple(solved.index(name) for name in plan.published))
         self.assembly: Assembly | None = None
         self.solver: GroupSolver | None = None
         self.state: GroupState | None = None
@@ -216,10 +218,15 @@ class LoopSolver:
         for group in self.groups:
             # Measured joints only are known to a group: its outputs go after every planar one.
             state = group.solve(values, rates)
-            positions_out, velocities_out = state.positions, state.velocities
-            for index in group.published:
-                values.append(positions_out[index])
-                rates.append(velocities_out[index])
+            published = group.published
+            if published is None:
+                values.extend(state.positions)
+                rates.extend(state.velocities)
+            else:
+                positions_out, velocities_out = state.positions, state.velocities
+                for index in published:
+                    values.append(positions_out[index])
+                    rates.append(velocities_out[index])
         self._known_values, self._branches = known_values, branches
         self._previous = values[solved:]
         return (dict(zip(self._passive, self._previous)),
