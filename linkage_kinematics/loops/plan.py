@@ -281,14 +281,7 @@ class RobotLoops:
         general, unassembled, general_problems = self._general(
             [group for group in groups if group not in planar_groups], dict(assemblies or {}))
         problems += unassembled + general_problems
-        planned = tuple(
-            GroupPlan(group, tuple(tree.coordinates[i].name for i in group.known),
-                      tuple(joint.name for item in ordered
-                            if item.loop.constraint in {c.name for c in group.closures}
-                            for joint in item.passive),
-                      tuple(item for item in ordered
-                            if item.loop.constraint in {c.name for c in group.closures}))
-            for group in planar_groups) + general
+        planned = tuple(_planar_group(tree, group, ordered) for group in planar_groups) + general
         warnings = (zero_pose_warnings(loops) + mimic_warnings(loops, measured)
                     + self.warnings)
         return LoopPlan(tuple(ordered), tuple(measured), warnings, planned, tree,
@@ -324,6 +317,15 @@ class RobotLoops:
                      'general closure (a planar loop takes loops.branches)'
                      for name in seeds if name not in seeded]
         return tuple(plans), unassembled, problems
+
+
+def _planar_group(tree: KinematicTree, group: ClosureGroup,
+                  ordered: Sequence[PlannedLoop]) -> GroupPlan:
+    """Return a group of planar loops: its measured joints, and its loops in solve order."""
+    names = {closure.name for closure in group.closures}
+    loops = tuple(item for item in ordered if item.loop.constraint in names)
+    return GroupPlan(group, tuple(tree.coordinates[i].name for i in group.known),
+                     tuple(joint.name for item in loops for joint in item.passive), loops)
 
 
 def _order(loops: Sequence[Loop], measured: Sequence[str],

@@ -63,8 +63,8 @@ class GroupStep:
     joints held at the sample) from its zero-pose assembly, which ``loops.assemblies`` seeds:
     the assembly nearest it at those measured values. Then its ``GroupSolver`` continues it.
     ``places``: where its known joints are among the sample's values; ``published``: where the
-    published joints are among the solver's ``solved`` (None: all of them). After a sample: ``assembly`` (the
-    motion's), ``solver`` and ``state`` (the last solved sample's).
+    published joints are among the solver's ``solved`` (None: all of them). After a sample:
+    ``assembly`` (the motion's), ``solver`` and ``state`` (the last solved sample's).
     """
 
     def __init__(self, plan: GroupPlan, tree: KinematicTree, places: Sequence[int]) -> None:
