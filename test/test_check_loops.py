@@ -8,6 +8,7 @@ from __future__ import annotations
 from importlib.metadata import entry_points
 import math
 from pathlib import Path
+import re
 import subprocess
 import sys
 
@@ -123,11 +124,12 @@ def test_each_problem_is_one_line_and_exit_1(tmp_path: Path) -> None:
   </constraint>""")
     completed = run(write(tmp_path, urdf))
     assert completed.returncode == 1
+    # what cannot be read first (the encodings' readers), then what cannot be closed
     assert completed.stderr.splitlines() == [
+        f"{PROGRAM}: constraint 'pin2': type 'universal' is not supported: a constraint is "
+        "'revolute' (a pin), 'spherical' (a ball) or 'fixed' (a weld)",
         f"{PROGRAM}: constraint 'pin': its child_axis is not parallel to the loop normal "
         '(0, 0, 1) at the zero pose (90° off): the loop is not planar',
-        f"{PROGRAM}: constraint 'pin2': type 'universal' is not supported: only a revolute "
-        'constraint (a pin) closes a planar loop',
     ]
     assert completed.stdout.splitlines() == [
         "robot 'test_four_bar': 0 loop(s) to close, 2 constraint(s) refused"]
@@ -177,8 +179,134 @@ def test_unreadable_files_and_bad_usage_exit_2(tmp_path: Path) -> None:
     assert run('robot.urdf', '--measured').returncode == 2
 
 
-def test_text_that_is_not_a_urdf_exits_1(tmp_path: Path) -> None:
+def test_text_that_is_not_a_urdf_is_unreadable_input_and_exits_2(tmp_path: Path) -> None:
     completed = run('-', stdin='<robot name="x"><link name="a"></robot>')
-    assert completed.returncode == 1
+    assert completed.returncode == 2
     assert len(completed.stderr.splitlines()) == 1
     assert completed.stderr.startswith(f'{PROGRAM}: the URDF is not XML: ')
+
+
+# --- closure groups of the general closure -----------------------------------------------------
+
+ANKLE = Path(__file__).resolve().parent.parent / 'urdf' / 'humanoid_ankle.urdf'
+MODELS = Path(__file__).resolve().parent / 'models' / 'example_parallel_robots'
+
+
+def test_the_humanoid_ankle_is_one_group_of_two_balls_solved_from_its_motors() -> None:
+    completed = run(str(ANKLE), '--measured', 'motor_left', 'motor_right')
+    assert (completed.returncode, completed.stderr) == (0, '')
+    lines = completed.stdout.splitlines()
+    assert lines[:8] == [
+        "robot 'humanoid_ankle': 2 loop(s) to close",
+        "group 'ball_left+ball_right': 2 balls, 2 degree(s) of freedom (0 idle)",
+        "  closure 'ball_left' (ball, <constraint>): rod_left at (0, 0, -0.23) with foot at "
+        '(-0.065, 0.035, 0.02)',
+        "  closure 'ball_right' (ball, <constraint>): rod_right at (0, 0, -0.23) with foot at "
+        '(-0.065, -0.035, 0.02)',
+        '  joints: ankle_pitch, ankle_roll, motor_left, motor_right, rod_left_u1, rod_left_u2, '
+        'rod_right_u1, rod_right_u2',
+        '  known (measured): motor_left, motor_right',
+        '  solved: ankle_pitch, ankle_roll, rod_left_u1, rod_left_u2, rod_right_u1, rod_right_u2',
+        '  solved by: Newton on the closure equations with their exact Jacobian, to rounding']
+    # drawn assembled: the zero pose is the assembly, its residuals rounding
+    assert lines[9] == ('  assembled nearest the zero pose (from the zero pose): ankle_pitch '
+                        '0.000°, ankle_roll 0.000°, motor_left 0.000°, motor_right 0.000°, '
+                        'rod_left_u1 0.000°, rod_left_u2 0.000°, rod_right_u1 0.000°, '
+                        'rod_right_u2 0.000°')
+    for line in (lines[8], lines[10]):
+        assert max(float(gap) for gap in re.findall(r'ball_\w+ ([^ ]+) m', line)) < 1e-16
+    assert re.fullmatch(r'  conditioning at the assembled pose: \d\.\d+ \(orientation [+-]1\)',
+                        lines[11])
+    assert lines[13:] == [
+        '  idle freedoms: none',
+        '  overridden joints: none',
+        '  reachable from the assembly, each known joint with the other known joint held at its '
+        'assembled value (continued until refused):',
+        '    motor_left: a full turn',
+        '    motor_right: a full turn']
+
+
+def test_a_closure_file_names_the_known_joints_and_its_overrides_are_warned_about() -> None:
+    model = MODELS / 'battobot_6d'
+    completed = run(str(model / 'robot.urdf'), '--closures', str(model / 'robot.yaml'))
+    assert completed.returncode == 0, completed.stderr
+    lines = completed.stdout.splitlines()
+    knee = lines.index("group 'closedloop_knee_left_ACclosedloop_knee_left_B': 1 weld, 1 "
+                       'degree(s) of freedom (0 idle)')
+    assert lines[knee + 3] == '  known (measured): motor_knee_left'
+    assert ('  overridden joints: free_knee_left (UJOINT_YZ: free_knee_left_Y, free_knee_left_Z,'
+            ' solved, not published); transmission_knee_left (SPHERICAL: '
+            'transmission_knee_left_X, transmission_knee_left_Y, transmission_knee_left_Z, '
+            'solved, not published)') in lines
+    warnings = [line for line in completed.stderr.splitlines() if ': warning: ' in line]
+    assert len(warnings) == 12
+    assert (f"{PROGRAM}: warning: joint 'free_knee_left' is read as UJOINT_YZ by the closure "
+            'file: its coordinates free_knee_left_Y, free_knee_left_Z are solved but not '
+            'published (they are no URDF joints), so robot_state_publisher cannot pose link '
+            "'knee_assembly_6d_2_2' and the links below it; model it in the URDF as 2 revolute "
+            'joints to publish them') in warnings
+
+
+def test_a_five_bars_reach_ends_where_its_distal_links_stretch() -> None:
+    model = MODELS / '5bar_linkage'
+    completed = run(str(model / 'robot.urdf'), '--closures', str(model / 'robot.yaml'))
+    assert completed.returncode == 0, completed.stderr
+    lines = completed.stdout.splitlines()
+    assert ('  idle freedoms: closedloop1_A, closedloop1_B (each held at its assembled value)'
+            in lines)
+    (mot1,) = [line for line in lines if line.startswith('    mot1: ')]
+    low, high = (float(value) for value in re.findall(r'(-?\d+\.\d+)°', mot1))
+    assert low < -90.0 < 90.0 < high
+    # at both ends the known joint's next hair is out of reach, the mechanism stretched
+    assert mot1.count('no assembly reaches further (conditioning ') == 2
+    conditioning = [float(value) for value in re.findall(r'conditioning ([^ ]+) there', mot1)]
+    assert min(conditioning) > 1e4
+
+
+def test_groups_that_do_not_close_are_one_line_each_and_exit_1() -> None:
+    model = MODELS / 'kangaroo_like'
+    completed = run(str(model / 'robot.urdf'), '--closures', str(model / 'robot.yaml'))
+    assert completed.returncode == 1
+    problems = [line for line in completed.stderr.splitlines() if ': note: ' not in line]
+    assert len(problems) == 1
+    assert problems[0].startswith(f'{PROGRAM}: group closedloop0_BCclosedloop0_A+')
+    assert problems[0].endswith(' in 25 tries: it cannot be assembled as given')
+    # without measured joints a group is described, not refused for lack of them
+    disney = MODELS / 'disney_like'
+    text = (disney / 'robot.yaml').read_text().replace('name_mot', 'name_mot_unused')
+    described = run(str(disney / 'robot.urdf'), '--closures', '-', stdin=text)
+    assert described.returncode == 1  # the closure file's unknown key, and only that
+    assert [line for line in described.stderr.splitlines() if ': note: ' not in line] == [
+        f"{PROGRAM}: 'name_mot_unused': not a key of a closure file (closed_loop, type, "
+        'name_mot, joint_name, joint_type)']
+    assert "  known: none given (8 needed: --measured, or the closure file's name_mot)" in (
+        described.stdout.splitlines())
+
+
+def test_an_unreadable_closure_file_exits_2(tmp_path: Path) -> None:
+    missing = run(str(ANKLE), '--closures', str(tmp_path / 'absent.yaml'))
+    assert missing.returncode == 2
+    assert missing.stderr.startswith(f'{PROGRAM}: cannot read {tmp_path / "absent.yaml"}: ')
+    not_yaml = run(str(ANKLE), '--closures', '-', stdin='closed_loop: [a')
+    assert not_yaml.returncode == 2
+    assert not_yaml.stderr.startswith(f'{PROGRAM}: the closure file is not YAML: ')
+    assert len(not_yaml.stderr.splitlines()) == 1
+    assert run(str(ANKLE), '--assemblies', 'ankle_pitch').returncode == 2
+
+
+def test_an_assembly_seed_picks_the_other_assembly(tmp_path: Path) -> None:
+    model = MODELS / '5bar_linkage'
+    urdf, closures = str(model / 'robot.urdf'), str(model / 'robot.yaml')
+
+    def assembled(*extra: str) -> str:
+        completed = run(urdf, '--closures', closures, *extra)
+        assert completed.returncode == 0, completed.stderr
+        (line,) = [line for line in completed.stdout.splitlines()
+                   if line.startswith('  assembled nearest the zero pose')]
+        return line
+
+    drawn = assembled()
+    free1 = float(re.search(r'free1 (-?\d+\.\d+)°', drawn).group(1))
+    seeded = assembled('--assemblies', f'free1={-math.radians(free1) * 3:.6f}')
+    assert ', seeded free1 = ' in seeded
+    assert abs(float(re.search(r'free1 (-?\d+\.\d+)°', seeded).group(1)) - free1) > 1.0

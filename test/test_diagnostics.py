@@ -147,7 +147,10 @@ def test_each_measured_modes_drop_reasons_keep_their_texts_and_order() -> None:
         'with a stamp not newer than the last one used',
         'at joint values a loop cannot reach (or at a dead point)',
         'jumping further than measured.max_jump',
-        'whose bytes are not a well-formed JointState']
+        'whose bytes are not a well-formed JointState',
+        'at joint values no assembly of a closure group reaches',
+        'that would jump a closure group to another assembly',
+        'too near a singular configuration of a closure group']
     assert set(FOUR_BAR_DROPS) | set(LOOPS_DROPS) == set(DropReason)
     health = MeasuredHealth(0)
     health.drop(DropReason.JUMP)

@@ -62,7 +62,7 @@ class FakeOutputs:
     def record_input(self, data: bytes, stamp_ns: int) -> None:
         self.logged.append('input')
 
-    def record_robot(self, urdf, transforms, stamp_ns) -> None:
+    def record_robot(self, urdf, closures, transforms, stamp_ns) -> None:
         self.logged.append('robot')
 
     def record_tf(self, positions, stamp_ns) -> None:

@@ -20,6 +20,7 @@ from linkage_kinematics.kinematics.solver import CrankRates, solve
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.plan import find_loops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 import loop_reference
@@ -169,11 +170,35 @@ def test_depth_offsets_are_dropped() -> None:
 
 # --- refusals ------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize('kind', ['spherical', 'universal', 'prismatic'])
-def test_constraint_types_other_than_revolute_are_refused(kind: str) -> None:
+@pytest.mark.parametrize('kind', ['universal', 'prismatic'])
+def test_constraint_types_other_than_revolute_spherical_and_fixed_are_refused(kind: str) -> None:
     assert refusal(four_bar(constraint_type=kind)) == (
-        f"constraint 'pin': type '{kind}' is not supported: only a revolute constraint (a pin) "
-        'closes a planar loop')
+        f"constraint 'pin': type '{kind}' is not supported: a constraint is 'revolute' (a pin), "
+        "'spherical' (a ball) or 'fixed' (a weld)")
+
+
+def test_a_ball_closes_the_four_bar_as_its_pin_does_and_a_weld_makes_it_rigid() -> None:
+    """A ball in place of the pin: the general closure, the same joints as the planar loop's."""
+    ball = find_loops(read_urdf(four_bar(constraint_type='spherical')))
+    assert ball.problems == () and ball.loops == ()
+    (group,) = ball.plan(('crank_joint',)).groups
+    assert (group.kind, group.known, group.solved) == (
+        GroupKind.NEWTON, ('crank_joint',), ('coupler_joint', 'rocker_joint'))
+    assert (group.zero.structure.dof, group.zero.structure.idle) == (1, ())
+    balls = LoopSolver(ball.plan(('crank_joint',)))
+    pins = LoopSolver(find_loops(read_urdf(four_bar())).plan(('crank_joint',)))
+    for crank in np.linspace(-0.5, 0.5, 11):
+        positions, velocities = balls.solve({'crank_joint': crank}, {'crank_joint': 0.7})
+        expected, expected_rates = pins.solve({'crank_joint': crank}, {'crank_joint': 0.7})
+        assert positions == pytest.approx(expected, abs=TOLERANCE)
+        assert velocities == pytest.approx(expected_rates, abs=TOLERANCE)
+    weld = find_loops(read_urdf(four_bar(constraint_type='fixed')))
+    with pytest.raises(LoopError) as rigid:
+        weld.plan(('crank_joint',))
+    assert str(rigid.value) == (
+        "group pin (joints ['crank_joint', 'coupler_joint', 'rocker_joint']): 0 degrees of "
+        "freedom (0 idle), known ['crank_joint']: over-determined, 1 known joints for 0 "
+        'determining freedoms')
 
 
 def test_unknown_links_are_refused() -> None:
@@ -181,15 +206,23 @@ def test_unknown_links_are_refused() -> None:
         "constraint 'pin': child link 'rocket' is not a <link> of the robot")
 
 
-def test_loops_of_other_than_three_moving_joints_are_refused() -> None:
-    # a fixed joint on the path is rigid: two moving joints are left
-    assert refusal(four_bar(rocker_type='fixed')).startswith(
-        "constraint 'pin': the loop has 2 moving joints ['coupler_joint', 'crank_joint'], not 3")
+def test_pins_of_other_than_three_moving_joints_are_the_general_closures() -> None:
+    """Not a planar loop's: a pin of two moving joints is rigid, one of four may be idle."""
+    # a fixed joint on the path is rigid: two moving joints are left, and no motion
+    rigid = find_loops(read_urdf(four_bar(rocker_type='fixed')))
+    assert rigid.problems == () and rigid.loops == ()
+    with pytest.raises(LoopError, match=r"^group pin \(joints \['crank_joint', 'coupler_joint'\]"
+                                        r'\): 0 degrees of freedom \(0 idle\), known '
+                                        r"\['crank_joint'\]: over-determined"):
+        rigid.plan(('crank_joint',))
+    # a pin on the rocker's own axis: the tip turns with it, idle, held where it was assembled
     five_bar = four_bar(child_link='tip', extra="""
   <link name="tip"/>
   <joint name="tip_joint" type="revolute"><parent link="rocker"/><child link="tip"/>
     <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1" velocity="1"/></joint>""")
-    assert 'the loop has 4 moving joints' in refusal(five_bar)
+    (group,) = find_loops(read_urdf(five_bar)).plan(('crank_joint',)).groups
+    assert group.zero.structure.dof == 2
+    assert [idle.joints for idle in group.zero.structure.idle] == [('rocker_joint', 'tip_joint')]
 
 
 def test_fixed_joints_on_the_path_are_rigid() -> None:
@@ -227,12 +260,22 @@ def test_non_parallel_axes_are_refused() -> None:
         assert find_loops(read_urdf(four_bar(**axes))).problems == ()
 
 
-def test_prismatic_joints_must_slide_in_the_plane_and_be_alone() -> None:
+def test_a_prismatic_joint_must_slide_in_the_plane_and_two_are_the_general_closures() -> None:
     assert "joint 'rocker_joint' slides out of the plane" in refusal(
         four_bar(rocker_type='prismatic', rocker_axis='0.6 0 0.8'))
-    assert "2 prismatic joints ['crank_joint', 'rocker_joint']" in refusal(
-        four_bar(rocker_type='prismatic', crank_type='prismatic', rocker_axis='0 1 0',
-                 crank_axis='1 0 0'))
+    # a slide along x, a pin, a slide along y: the planar closed forms take one slide only (the
+    # crank's slide reaches -0.06 m, where the coupler lies along x)
+    urdf = four_bar(rocker_type='prismatic', crank_type='prismatic', rocker_axis='0 1 0',
+                    crank_axis='1 0 0')
+    loops = find_loops(read_urdf(urdf))
+    assert loops.problems == () and loops.loops == ()
+    plan = loops.plan(('crank_joint',))
+    assert [group.kind for group in plan.groups] == [GroupKind.NEWTON]
+    solver = LoopSolver(plan)
+    for crank in np.linspace(0.0, 0.3, 7):
+        positions, _ = solver.solve({'crank_joint': crank}, {'crank_joint': 0.0})
+        gaps = loop_reference.closure_residuals(urdf, {'crank_joint': crank, **positions})
+        assert gaps['pin'] < TOLERANCE
 
 
 def test_urdfs_that_are_no_tree_are_refused_before_their_loops_are_read() -> None:

@@ -102,7 +102,9 @@ ACCEPTED = {
     'loops': set(),
     'loops.measured_joints': set(),          # a list of strings
     'loops.branches': set(),
+    'loops.assemblies': set(),
     'robot_description': set(),              # any string, '' for the topic
+    'robot_description_closures': set(),     # any string, '' for none
     'autostart': set(),
 }
 # Valid in another context: C straight below O (the mechanism turned by −90°).

@@ -108,7 +108,8 @@ def values(status: Any) -> dict[str, str]:
 
 @contextmanager
 def loop_node(context, nodes: NodeProcesses, tmp_path: Path,
-              parameters: dict[str, Any] | None = None) -> Iterator[LoopNode]:
+              parameters: dict[str, Any] | None = None,
+              ros_arguments: Sequence[str] = ()) -> Iterator[LoopNode]:
     """Start a loops node (its bag under tmp_path/bags) and a listener beside it."""
     listener = Listener('loops_listener', context)
     listener.subscribe('/joint_states', JointState)
@@ -116,7 +117,8 @@ def loop_node(context, nodes: NodeProcesses, tmp_path: Path,
     log = tmp_path / 'node.log'
     process = nodes.start({'source': 'measured', 'loops': 'robot_description',
                            'measured.timeout': PROCESS_TIMEOUT,
-                           'log.folder': str(tmp_path / 'bags'), **(parameters or {})}, log)
+                           'log.folder': str(tmp_path / 'bags'), **(parameters or {})}, log,
+                          ros_arguments=ros_arguments)
     try:
         yield LoopNode(listener, process, log)
     finally:

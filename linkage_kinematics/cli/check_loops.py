@@ -2,16 +2,22 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-``linkage-check-loops``: what the package finds in a URDF's ``<constraint>`` loops.
+``linkage-check-loops``: what the package finds in a URDF's loops, and how it closes them.
 
 As urdfdom's ``check_urdf`` does for the tree: ``linkage-check-loops robot.urdf`` (``-`` reads
-standard input, so that ``xacro robot.urdf.xacro | linkage-check-loops -`` works) prints, for
-each constraint, its loop's joints and kind, the dimensions found at the zero pose, which joint
-is known (with ``--measured``) or could be, that joint's reachable range, dead points and change
-points, the assembly branch, and the closure residual at the zero pose. Angles are printed in
-degrees. Each problem is one line on standard error; the exit status is 0 without problems, 1
-for problems in the URDF (or with the measured joints), 2 for a usage error such as an
-unreadable file.
+standard input, so that ``xacro robot.urdf.xacro | linkage-check-loops -`` works; ``--closures
+robot.yaml`` adds a closure file) reads every closure as the node does (``loops.plan``) and
+prints, for each planar loop, its joints and kind, the dimensions found at the zero pose, which
+joint is known (with ``--measured``, else the closure file's actuated joints) or could be, that
+joint's reachable range, dead points and change points, the assembly branch, and the closure
+residual at the zero pose; for each other closure group (the general closure), its closures,
+joints, degrees of freedom, known and solved joints, how it is solved, its residual at the zero
+pose and at the pose it assembles nearest it, the conditioning and the distance to the nearest
+singular configuration there, its idle freedoms and overridden joints, and for one or two known
+joints each one's reachable interval with the other held (``loops.reach``). Angles are printed
+in degrees. Each problem is one line on standard error; the exit status is 0 without problems,
+1 for problems in the description (or with the measured joints), 2 for a usage error or input
+that cannot be read (a file, a text that is no URDF, a closure file that is not one).
 """
 
 from __future__ import annotations
@@ -23,16 +29,21 @@ import sys
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
+from linkage_kinematics.loops.assembly import ClosureGap
+from linkage_kinematics.loops.closures import ClosureError, ClosureSide
 from linkage_kinematics.loops.description import LoopError
+from linkage_kinematics.loops.newton import Refusal
 from linkage_kinematics.loops.plan import (
     find_loops,
+    GroupPlan,
     LoopPlan,
-    mimic_warnings,
     RobotLoops,
     zero_pose_branch,
-    zero_pose_warnings,
 )
 from linkage_kinematics.loops.planar import Loop, LoopJoint
+from linkage_kinematics.loops.reach import reach
+from linkage_kinematics.loops.structure import GroupKind
+from linkage_kinematics.loops.tree import KinematicTree, MotionKind
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 
 PROGRAM = 'linkage-check-loops'
@@ -40,15 +51,40 @@ EXIT_PROBLEMS = 1
 EXIT_USAGE = 2
 
 
+# The reach of the known joints is printed for groups of this many known joints at most.
+REACH_KNOWN = 2
+
+
+def _assembly_seed(text: str) -> tuple[str, float]:
+    """Return one ``--assemblies`` JOINT=VALUE."""
+    name, _, value = text.rpartition('=')
+    try:
+        number = float(value)
+    except ValueError:
+        number = math.nan
+    if not name or not math.isfinite(number):
+        raise argparse.ArgumentTypeError(f'{text!r} is not JOINT=VALUE (rad or m)')
+    return name, number
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROGRAM,
-        description="Check a URDF's <constraint> loops: the planar four-bar or slider loops "
-                    'the package can close, their dimensions, ranges and branches.')
+        description="Check a URDF's loop closures (<constraint>, <loop_joint>, a closure "
+                    'file): how the package closes them, their dimensions, degrees of '
+                    'freedom, assemblies and ranges.')
     parser.add_argument('urdf', help="the URDF file, or '-' for standard input")
+    parser.add_argument('--closures', metavar='FILE',
+                        help="the URDF's closure file (toolbox-parallel-robots' YAML), as the "
+                             "node's robot_description_closures")
     parser.add_argument('--measured', nargs='+', metavar='JOINT',
-                        help='the measured joints: each loop is then solved from one of them '
-                             'or from a joint an earlier loop solves')
+                        help="the measured joints (default: the closure file's name_mot): "
+                             'each planar loop is then solved from one of them or from a joint '
+                             'an earlier loop solves, each other group from those it holds')
+    parser.add_argument('--assemblies', nargs='+', metavar='JOINT=VALUE', type=_assembly_seed,
+                        default=[],
+                        help="start values of joints a closure group solves, as the node's "
+                             'loops.assemblies')
     return parser
 
 
@@ -131,14 +167,128 @@ def _loop_lines(loop: Loop) -> list[str]:
     return lines
 
 
-def report(loops: RobotLoops, plan: LoopPlan | None) -> list[str]:
-    """Return the printout for ``loops``, with each loop's known joint from ``plan`` if given."""
+def _angle_or_length(tree: KinematicTree, name: str, value: float) -> str:
+    """Return a coordinate's value for people: degrees for a turn, metres for a slide."""
+    if tree.coordinates[tree.index[name]].kind is MotionKind.TURN:
+        text = f'{math.degrees(value):.3f}°'
+    else:
+        text = f'{value:.6f} m'
+    # a value that rounds to zero from below (the rounding of a closed pose) is printed as 0
+    return text[1:] if text.startswith('-') and not text.strip('-0.°m ') else text
+
+
+def _gaps(gaps: Sequence[ClosureGap]) -> str:
+    return ', '.join(f'{gap.closure} {gap.position:.3g} m'
+                     + ('' if gap.angle is None else f' and {gap.angle:.3g} rad')
+                     for gap in gaps)
+
+
+def _side(side: ClosureSide) -> str:
+    return f'{side.link} at {_vector(side.xyz)}'
+
+
+# Why a known joint's reach ends, for people
+ENDS = {Refusal.UNREACHABLE: 'no assembly reaches further',
+        Refusal.SINGULAR: 'a singular configuration',
+        Refusal.ASSEMBLY_CHANGE: 'it would change assembly'}
+
+
+def _reach_lines(tree: KinematicTree, group: GroupPlan) -> list[str]:
+    """Return each known joint's interval, the others held at the assembly (loops.reach)."""
+    held = ('alone' if len(group.known) == 1
+            else 'with the other known joint held at its assembled value')
+    lines = [f'  reachable from the assembly, each known joint {held} (continued until '
+             'refused):']
+    for item in reach(tree, group.zero):
+        if item.full_turn:
+            lines.append(f'    {item.joint}: a full turn')
+            continue
+        ends = '; '.join(
+            f'{where} end: ' + ('none found' if end is None
+                                else f'{ENDS[end]} (conditioning {conditioning:.3g} there)')
+            for where, end, conditioning in zip(('low', 'high'), item.ends, item.conditioning))
+        lines.append(f'    {item.joint}: [{_angle_or_length(tree, item.joint, item.low)}, '
+                     f'{_angle_or_length(tree, item.joint, item.high)}] ({ends})')
+    return lines
+
+
+def _group_lines(tree: KinematicTree, group: GroupPlan, overrides: dict,
+                 known_given: bool) -> list[str]:
+    """Return a group of the general closure: what it is, how it assembles and is solved."""
+    zero = group.zero
+    structure = zero.structure
+    kinds: dict[str, int] = {}
+    for closure in group.group.closures:
+        kinds[closure.kind.value] = kinds.get(closure.kind.value, 0) + 1
+    counts = ', '.join(f'{count} {kind}{"s" if count > 1 else ""}'
+                       for kind, count in kinds.items())
+    how = ('Newton on the closure equations with their exact Jacobian, to rounding'
+           if group.kind is GroupKind.NEWTON else group.kind.value)
+    lines = [f'group {group.name!r}: {counts}, {structure.dof} degree(s) of freedom '
+             f'({len(structure.idle)} idle)']
+    lines += [f'  closure {closure.name!r} ({closure.kind.value}, {closure.encoding.value}): '
+              f'{_side(closure.parent)} with {_side(closure.child)}'
+              for closure in group.group.closures]
+    lines.append(f'  joints: {", ".join(structure.joints)}')
+    if known_given:
+        lines.append(f'  known (measured): {", ".join(group.known) or "none"}')
+    else:
+        lines.append(f'  known: none given ({structure.dof - len(structure.idle)} needed: '
+                     "--measured, or the closure file's name_mot)")
+    lines.append(f'  solved: {", ".join(group.solved)}')
+    if known_given:
+        lines.append(f'  solved by: {how}')
+    lines.append(f'  residual at the zero pose: {_gaps(zero.assembly.start_gaps)}')
+    values = dict(zip(tree.names, zero.assembly.values))
+    taken = ('from the zero pose' if zero.assembly.restart == 0
+             else f'from restart {zero.assembly.restart} about it')
+    lines.append(f'  assembled nearest the zero pose ({taken}'
+                 + (f', seeded {", ".join(f"{k} = {v:g}" for k, v in group.seed.items())}'
+                    if group.seed else '') + '): '
+                 + ', '.join(f'{name} {_angle_or_length(tree, name, values[name])}'
+                             for name in structure.joints))
+    lines.append(f'  residual at the assembled pose: {_gaps(zero.assembly.gaps)}')
+    if zero.solver is not None:
+        state = zero.solver.solve([values[name] for name in group.known],
+                                  [0.0] * len(group.known))
+        distance = zero.solver.derivatives.singular_distance([0.0] * len(group.known))
+        lines.append(f'  conditioning at the assembled pose: {state.conditioning:.3g} '
+                     f'(orientation {zero.solver.orientation:+d})')
+        lines.append(f'  nearest singular configuration: about {distance:.3g} from the '
+                     'assembled pose (in the known joints, rad or m)')
+    lines.append('  idle freedoms: ' + ('none' if not structure.idle else '; '.join(
+        ', '.join(idle.joints) for idle in structure.idle) + ' (each held at its assembled '
+        'value)'))
+    overridden = sorted({tree.coordinates[tree.index[name]].joint for name in group.hidden})
+    lines.append('  overridden joints: ' + ('none' if not overridden else '; '.join(
+        f'{joint} ({overrides[joint].name}: '
+        f'{", ".join(overrides[joint].coordinates(joint))}, solved, not published)'
+        for joint in overridden)))
+    if zero.solver is not None and 1 <= len(group.known) <= REACH_KNOWN:
+        lines += _reach_lines(tree, group)
+    return lines
+
+
+def report(loops: RobotLoops, plan: LoopPlan | None, survey: LoopPlan | None = None,
+           known_given: bool = True) -> list[str]:
+    """
+    Return the printout for ``loops``, with each loop's known joint from ``plan`` if given.
+
+    ``survey``: the plan as far as it goes (``RobotLoops.survey``), whose groups of the general
+    closure are printed after the planar loops; ``known_given``: whether the measured joints
+    are known (else the groups are described without them).
+    """
     refused = f', {len(loops.problems)} constraint(s) refused' if loops.problems else ''
-    lines = [f'robot {loops.robot_name!r}: {len(loops.loops)} loop(s) to close{refused}']
+    lines = [f'robot {loops.robot_name!r}: {len(loops.closures) or len(loops.loops)} loop(s) to '
+             f'close{refused}']
     planned = {item.loop.constraint: item for item in plan.loops} if plan is not None else {}
     solver_of = {joint.name: item.loop.constraint
                  for item in planned.values() for joint in item.passive}
+    general = survey.general if survey is not None else ()
+    in_general = {closure.name for group in general for closure in group.group.closures}
     for loop in loops.loops:
+        if loop.constraint in in_general:
+            continue  # closed with spatial closures: its group says so
         lines += _loop_lines(loop)
         item = planned.get(loop.constraint)
         if item is not None:
@@ -148,36 +298,40 @@ def report(loops: RobotLoops, plan: LoopPlan | None) -> list[str]:
         else:
             for joint in loop.joints:
                 lines += _known_lines(loop, joint, 'could be known', None)
+    for group in general:
+        lines += _group_lines(survey.tree, group, dict(loops.overrides), known_given)
     return lines
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run ``linkage-check-loops``; return the exit status."""
     arguments = _parser().parse_args(argv)
-    try:
-        text = _read(arguments.urdf)
-    except (OSError, UnicodeDecodeError) as error:
-        print(f'{PROGRAM}: cannot read {arguments.urdf}: {error}', file=sys.stderr)
-        return EXIT_USAGE
-    problems: list[str] = []
-    try:
-        loops = find_loops(read_urdf(text))
-    except UrdfError as error:
-        print(f'{PROGRAM}: {error}', file=sys.stderr)
-        return EXIT_PROBLEMS
-    problems += loops.problems
-    plan = None
-    if arguments.measured is not None:
+    texts = []
+    for path in (arguments.urdf, arguments.closures):
+        if path is None:
+            texts.append(None)
+            continue
         try:
-            plan = loops.plan(arguments.measured)
-        except LoopError as error:
-            problems += str(error).split('\n')
-    if not loops.loops and not loops.problems:
+            texts.append(_read(path))
+        except (OSError, UnicodeDecodeError) as error:
+            print(f'{PROGRAM}: cannot read {path}: {error}', file=sys.stderr)
+            return EXIT_USAGE
+    try:
+        loops = find_loops(read_urdf(texts[0]), texts[1])
+    except (UrdfError, ClosureError) as error:
+        print(f'{PROGRAM}: {error}', file=sys.stderr)
+        return EXIT_USAGE
+    problems = list(loops.problems)
+    measured = arguments.measured if arguments.measured is not None else loops.actuated
+    survey = loops.survey(measured or (), {}, dict(arguments.assemblies))
+    # nothing known: the loops and groups are described, not refused for lack of known joints
+    problems += survey.problems if measured else survey.unassembled
+    plan = survey if measured and not survey.problems else None
+    if not loops.closures and not loops.problems:
         print(f'robot {loops.robot_name!r}: no <constraint> elements, no loops to close')
     else:
-        print('\n'.join(report(loops, plan)))
-    warnings = (plan.warnings if plan is not None
-                else zero_pose_warnings(loops.loops) + mimic_warnings(loops.loops, ()))
+        print('\n'.join(report(loops, plan, survey, bool(measured))))
+    warnings = survey.warnings
     for message in loops.parser_messages:
         print(f'{PROGRAM}: note: urdf_parser_py: {message}', file=sys.stderr)
     for message in warnings:

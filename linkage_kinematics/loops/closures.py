@@ -53,6 +53,12 @@ class Encoding(enum.Enum):
     LOOP_JOINT = '<loop_joint>'
     CLOSURE_FILE = 'closure file'
 
+    @property
+    def word(self) -> str:
+        """Return the word a message names one of its closures by: its element, or 'closure'."""
+        return {Encoding.CONSTRAINT: 'constraint', Encoding.LOOP_JOINT: 'loop_joint',
+                Encoding.CLOSURE_FILE: 'closure'}[self]
+
 
 @dataclass(frozen=True)
 class ClosureSide:
@@ -83,6 +89,11 @@ class Closure:
     parent: ClosureSide
     child: ClosureSide
     encoding: Encoding
+
+    @property
+    def label(self) -> str:
+        """Return the closure as messages name it: ``constraint 'knee_pin'``, as it was written."""
+        return f'{self.encoding.word} {self.name!r}'
 
 
 class JointOverride(enum.Enum):

@@ -6,13 +6,16 @@ The measured source of ``loops:=robot_description``: a robot's loops closed mess
 
 ``RobotLoopsFollower.follow`` takes the fields of one ``sensor_msgs/JointState`` (stamp, names,
 positions, velocities), takes the measured joints in through the measured modes' one
-``intake.Intake`` and closes every ``<constraint>`` loop of the robot's URDF from them
-(``plan.RobotLoops.plan``, ``solver.LoopSolver``). It returns a ``LoopSample``, the passive loop
-joints' positions and velocities (URDF units, rad or m), or a ``LoopDrop``, why the message was
-dropped and which loops it concerned. A measured joint without a velocity gets the intake's
-estimate (the backward difference over the header stamps, 0 for a first sample). A revolute
-measured joint is unwrapped across turns, as the four-bar's driver is, and ``measured.max_jump``
-(rad) applies to it; a prismatic one's length (m) has no such bound. No ROS.
+``intake.Intake`` and closes every loop of the robot's description from them
+(``plan.RobotLoops.plan``, ``solver.LoopSolver``): planar loops and closure groups alike. It
+returns a ``LoopSample``, the passive joints' positions and velocities (URDF units, rad or m),
+or a ``LoopDrop``, why the message was dropped and which loops or groups it concerned. The
+measured joints are those given, else the closure file's actuated joints (``name_mot``), else
+the loop joints the first message carries. A measured joint without a velocity gets the
+intake's estimate (the backward difference over the header stamps, 0 for a first sample). A
+revolute measured joint is unwrapped across turns, as the four-bar's driver is, and
+``measured.max_jump`` (rad) applies to it; a prismatic one's length (m) has no such bound. No
+ROS.
 """
 
 from __future__ import annotations
@@ -22,13 +25,20 @@ from dataclasses import dataclass
 
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
+from linkage_kinematics.loops.newton import Refusal
 from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.tree import MotionKind
+
+# Why a closure group refused a sample, as the message's drop reason
+REFUSAL_DROPS = {Refusal.UNREACHABLE: DropReason.NO_ASSEMBLY,
+                 Refusal.ASSEMBLY_CHANGE: DropReason.ASSEMBLY_JUMP,
+                 Refusal.SINGULAR: DropReason.SINGULAR}
 
 
 @dataclass(frozen=True)
 class LoopDrop:
-    """A dropped message: why, the loops it concerned (none: every loop) and the detail."""
+    """A dropped message: why, the loops or groups it concerned (none: all) and the detail."""
 
     reason: DropReason
     constraints: tuple[str, ...]
@@ -38,9 +48,9 @@ class LoopDrop:
 @dataclass
 class LoopSample:
     """
-    The passive loop joints at one message, in solve order, and what came with them.
+    The passive joints at one message, in solve order, and what came with them.
 
-    ``joints`` holds every measured and solved loop joint's position (for /tf);
+    ``joints`` holds every measured and published solved joint's position (for /tf);
     ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
     loop's known joint value (URDF units), by constraint. A value, not frozen: a frozen
     dataclass's seven ``object.__setattr__`` cost four times its plain ``__init__`` per sample.
@@ -59,21 +69,30 @@ class RobotLoopsFollower:
     """
     Follows the measured joints of one robot description; ``restart`` forgets the motion.
 
-    Construction raises LoopError (one line per problem, naming the joints or constraints)
-    when ``measured`` is given and cannot close the loops; with ``measured`` empty the loop
-    joints the first message carries are planned then (``follow`` raises LoopError then).
+    Construction raises LoopError (one line per problem, naming the joints, closures or groups)
+    when the measured joints (``measured``, else the closure file's actuated ones) are known
+    and cannot close the loops; without them the loop joints the first message carries are
+    planned then (``follow`` raises LoopError then). ``assemblies``: joint → start value, to
+    assemble a group of the general closure nearer another assembly (``RobotLoops.plan``).
     """
 
     def __init__(self, loops: RobotLoops, measured: Sequence[str],
-                 branches: Mapping[str, int], max_jump: float) -> None:
+                 branches: Mapping[str, int], max_jump: float,
+                 assemblies: Mapping[str, float] | None = None) -> None:
         self.loops = loops
         self._max_jump = max_jump
         self._branches = dict(branches)
-        self.loop_joints = frozenset(name for loop in loops.loops for name in loop.names)
+        self._assemblies = dict(assemblies or {})
+        tree = loops.tree
+        self.loop_joints = frozenset(
+            [name for loop in loops.loops for name in loop.names]
+            + [tree.coordinates[index].name for closure in loops.closures
+               for index in tree.loop_coordinates(tree.loop(closure))])
         self.solver: LoopSolver | None = None
         self._intake: Intake | None = None
+        measured = tuple(measured) or loops.actuated or ()
         if measured:
-            self._plan(tuple(measured))
+            self._plan(measured)
 
     @property
     def plan(self) -> LoopPlan | None:
@@ -92,35 +111,41 @@ class RobotLoopsFollower:
             self._intake.max_jump = value
 
     def _plan(self, measured: tuple[str, ...]) -> None:
-        plan = self.loops.plan(measured, self._branches)
+        plan = self.loops.plan(measured, self._branches, self._assemblies)
         self.solver = LoopSolver(plan)
         # resolved once per plan rather than per message: the revolute measured joints (the
-        # intake unwraps them), each loop's constraint and known joint, the loops each feeds
+        # intake unwraps them), each loop's constraint and known joint, the loops and groups
+        # each feeds
+        tree = plan.tree
         revolute = {planned.known.name for planned in plan.loops
                     if planned.measured and planned.known.kind is JointKind.REVOLUTE}
+        revolute.update(name for group in plan.general for name in group.known
+                        if tree.coordinates[tree.index[name]].kind is MotionKind.TURN)
         self._intake = Intake(plan.measured, revolute, self._max_jump, DropReason.NO_JOINT)
         self._known = tuple((planned.loop.constraint, planned.known.name)
                             for planned in plan.loops)
         self._feeds = {name: tuple(planned.loop.constraint for planned in plan.loops
-                                   if planned.known.name == name) for name in measured}
+                                   if planned.known.name == name)
+                       + tuple(group.name for group in plan.general if name in group.known)
+                       for name in measured}
         self._passive = plan.passive  # the solved joints' names, in the order solve gives them
 
     def restart(self) -> None:
-        """Forget the motion: the next valid message starts it again on the planned branches."""
+        """Forget the motion: the next valid message starts it on the planned assemblies."""
         if self.solver is not None:
             self._intake.restart()
             self.solver.reset()
 
     def _loops_of(self, names: Sequence[str]) -> tuple[str, ...]:
-        """Return the loops whose known joint is one of the measured joints ``names``."""
+        """Return the loops and groups that know one of the measured joints ``names``."""
         return tuple(constraint for name in names for constraint in self._feeds[name])
 
     def follow(self, stamp_ns: int, names: Sequence[str], positions: Sequence[float],
                velocities: Sequence[float]) -> LoopSample | LoopDrop | None:
         """
-        Return the passive loop joints at one message, or why it was dropped.
+        Return the passive joints at one message, or why it was dropped.
 
-        None for a message that carries none of the measured joints (with none given, none of
+        None for a message that carries none of the measured joints (with none known, none of
         the loop joints), e.g. this node's own output heard back: ignored, not counted.
         """
         if self.solver is None:
@@ -139,7 +164,8 @@ class RobotLoopsFollower:
         try:
             solved, solved_rates = self.solver.solve(measured_values, dict(zip(measured, rates)))
         except LoopSampleError as error:
-            return LoopDrop(DropReason.JOINTS_UNREACHABLE,
+            return LoopDrop(DropReason.JOINTS_UNREACHABLE if error.refusal is None
+                            else REFUSAL_DROPS[error.refusal],
                             () if error.constraint is None else (error.constraint,), str(error))
         self._intake.keep(stamp_ns, values)
         joints = {**measured_values, **solved}

@@ -34,8 +34,10 @@ class DropReason(StrEnum):
 
     Where the two measured modes word a reason each its own way, each has its member: the
     four-bar's ``NO_DRIVER`` and ``DRIVER_UNREACHABLE``, the loops' ``NO_JOINT`` and
-    ``JOINTS_UNREACHABLE``. ``FOUR_BAR_DROPS`` and ``LOOPS_DROPS`` are the reasons each mode
-    counts, in the order its diagnostics list them.
+    ``JOINTS_UNREACHABLE``. A closure group of the general closure refuses a sample for one of
+    three reasons (``newton.Refusal``), each its own member: ``NO_ASSEMBLY``, ``ASSEMBLY_JUMP``,
+    ``SINGULAR``. ``FOUR_BAR_DROPS`` and ``LOOPS_DROPS`` are the reasons each mode counts, in
+    the order its diagnostics list them (the groups' last, after those bags already hold).
     """
 
     NO_DESCRIPTION = 'before the robot description was closed'
@@ -48,13 +50,17 @@ class DropReason(StrEnum):
     JOINTS_UNREACHABLE = 'at joint values a loop cannot reach (or at a dead point)'
     JUMP = 'jumping further than measured.max_jump'
     MALFORMED = 'whose bytes are not a well-formed JointState'
+    NO_ASSEMBLY = 'at joint values no assembly of a closure group reaches'
+    ASSEMBLY_JUMP = 'that would jump a closure group to another assembly'
+    SINGULAR = 'too near a singular configuration of a closure group'
 
 
 FOUR_BAR_DROPS = (DropReason.NO_DRIVER, DropReason.NON_FINITE, DropReason.STAMP_NOT_NEWER,
                   DropReason.DRIVER_UNREACHABLE, DropReason.JUMP, DropReason.MALFORMED)
 LOOPS_DROPS = (DropReason.NO_DESCRIPTION, DropReason.NOT_PLANNED, DropReason.NO_JOINT,
                DropReason.NON_FINITE, DropReason.STAMP_NOT_NEWER, DropReason.JOINTS_UNREACHABLE,
-               DropReason.JUMP, DropReason.MALFORMED)
+               DropReason.JUMP, DropReason.MALFORMED, DropReason.NO_ASSEMBLY,
+               DropReason.ASSEMBLY_JUMP, DropReason.SINGULAR)
 
 
 class Estimate(StrEnum):

@@ -5,14 +5,18 @@
 A plan's loops closed sample by sample: the measured joints in, every passive loop joint out.
 
 ``LoopSolver`` turns each sample of the measured joints' positions and velocities into every
-passive loop joint's, in URDF units (rad, m), loop by loop in the plan's order, keeping each loop
-on its assembly through change points and continuous joints continuous across turns. A sample a
-loop cannot be closed at is a ``LoopSampleError`` naming the loop. Pure: no ROS graph.
+passive joint's, in URDF units (rad, m), in the plan's order: the planar loops loop by loop in
+closed form, keeping each loop on its assembly through change points and continuous joints
+continuous across turns; then each group of the general closure (``GroupStep``), assembled at
+the motion's first sample nearest its zero-pose assembly with the measured joints held there,
+and continued from sample to sample by its ``newton.GroupSolver``. A sample that cannot be
+closed is a ``LoopSampleError`` naming the loop or group (and, for a group, its
+``newton.Refusal``). Pure: no ROS graph.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 import math
 
 from linkage_kinematics.kinematics.geometry import TWO_PI
@@ -24,46 +28,119 @@ from linkage_kinematics.kinematics.planar_loop import (
     UnreachableError,
 )
 from linkage_kinematics.kinematics.solver import unwrap_near
-from linkage_kinematics.loops.plan import LoopPlan
+from linkage_kinematics.loops.assembly import Assembly, AssemblyError
+from linkage_kinematics.loops.newton import (
+    GroupSolver,
+    GroupState,
+    plan_group,
+    Refusal,
+    SampleRefused,
+)
+from linkage_kinematics.loops.plan import GroupPlan, LoopPlan
+from linkage_kinematics.loops.tree import KinematicTree
 
 
 class LoopSampleError(ValueError):
     """
     A sample the loops cannot be closed at (a dead point, out of reach, a missing joint).
 
-    ``constraint`` names the loop that could not be closed (None: the sample itself is bad).
+    ``constraint`` names the loop or group that could not be closed (None: the sample itself is
+    bad); ``refusal`` says why a group of the general closure refused it (None for a loop).
     """
 
-    def __init__(self, message: str, constraint: str | None = None) -> None:
+    def __init__(self, message: str, constraint: str | None = None,
+                 refusal: Refusal | None = None) -> None:
         super().__init__(message)
         self.constraint = constraint
+        self.refusal = refusal
+
+
+class GroupStep:
+    """
+    One group of the general closure followed sample by sample; ``restart`` forgets the motion.
+
+    At a motion's first sample the group is assembled (``newton.plan_group``, the measured
+    joints held at the sample) from its zero-pose assembly, which ``loops.assemblies`` seeds:
+    the assembly nearest it at those measured values. Then its ``GroupSolver`` continues it.
+    ``places``: where its known joints are among the sample's values; ``published``: where the
+    published joints are among the solver's ``solved`` (None: all of them). After a sample:
+    ``assembly`` (the motion's), ``solver`` and ``state`` (the last solved sample's).
+    """
+
+    def __init__(self, plan: GroupPlan, tree: KinematicTree, places: Sequence[int]) -> None:
+        self.plan = plan
+        self.tree = tree
+        self.places = tuple(places)
+        solved = plan.solved
+        # None: every solved joint is published, in order (no joint the closure file overrides)
+        self.published = (None if not plan.hidden
+                          else tuple(solved.index(name) for name in plan.published))
+        self.assembly: Assembly | None = None
+        self.solver: GroupSolver | None = None
+        self.state: GroupState | None = None
+        self.fresh = True
+
+    def restart(self) -> None:
+        """Assemble again at the next sample, from the zero-pose assembly."""
+        self.fresh = True
+
+    def _assemble(self, known: Sequence[float]) -> GroupSolver:
+        """Assemble the group at the measured ``known`` values; LoopSampleError if it cannot."""
+        tree, plan = self.tree, self.plan
+        start = list(plan.zero.assembly.values)
+        for name, value in zip(plan.known, known):
+            start[tree.index[name]] = value
+        try:
+            planned = plan_group(tree, plan.group, start, hold_known=True)
+        except AssemblyError as error:
+            raise LoopSampleError(f'{error} at the first sample', plan.name,
+                                  Refusal.UNREACHABLE) from None
+        if planned.solver is None:
+            raise LoopSampleError(f'group {plan.name}: at the first sample: {planned.problem}',
+                                  plan.name, Refusal.SINGULAR)
+        self.assembly, self.solver, self.fresh = planned.assembly, planned.solver, False
+        self.state = None  # the new solver's, once it has solved a sample
+        return planned.solver
+
+    def solve(self, values: Sequence[float], rates: Sequence[float]) -> GroupState:
+        """Return the group's state at a sample (``values``, ``rates``: its measured joints')."""
+        places = self.places
+        known = [values[place] for place in places]
+        solver = self._assemble(known) if self.fresh else self.solver
+        try:
+            self.state = state = solver.solve(known, [rates[place] for place in places])
+        except SampleRefused as error:
+            raise LoopSampleError(str(error), self.plan.name, error.reason) from None
+        return state
 
 
 class LoopSolver:
     """
-    Closes a plan's loops sample by sample: measured joints in, passive loop joints out.
+    Closes a plan's loops sample by sample: measured joints in, passive joints out.
 
-    Each loop starts on its planned branch at the zero pose and follows the known joint's motion
-    from sample to sample (``DrivenLoop.continued_branch``), so that it stays on its assembly
-    through change points; revolute and continuous joints are kept within π of their previous
-    value (at first, of the zero pose), and a revolute known joint is followed across whole turns.
-    A refused sample leaves that state as it was.
+    Each planar loop starts on its planned branch at the zero pose and follows the known joint's
+    motion from sample to sample (``DrivenLoop.continued_branch``), so that it stays on its
+    assembly through change points; revolute and continuous joints are kept within π of their
+    previous value (at first, of the zero pose), and a revolute known joint is followed across
+    whole turns. A refused sample leaves that state as it was. Each group of the general closure
+    is a ``GroupStep`` (``groups``, in solve order), solved after the planar loops.
     """
 
     def __init__(self, plan: LoopPlan) -> None:
         self.plan = plan
         # A sample's joint values and rates are lists: the measured joints', then each passive
         # joint's as it is solved (plan.passive's order). Each loop's step, resolved once here
-        # rather than at every sample: its constraint, its known joint's name, place in those
-        # lists and sign, whether its branch flips with each whole turn of that joint (a
-        # revolute known joint meeting an odd number of change points per turn), the loop
-        # driven at that joint, and each passive joint's place among the passive joints, sign,
-        # index and revolute-ness.
+        # rather than at every sample: its closure's name and label, its known joint's name,
+        # place in those lists and sign, whether its branch flips with each whole turn of that
+        # joint (a revolute known joint meeting an odd number of change points per turn), the
+        # loop driven at that joint, and each passive joint's place among the passive joints,
+        # sign, index and revolute-ness.
         self._passive = plan.passive
         places = {name: place for place, name in enumerate(plan.measured + self._passive)}
         passive_places = {name: place for place, name in enumerate(self._passive)}
         self._steps = tuple(
-            (planned.loop.constraint, planned.known.name, places[planned.known.name],
+            (planned.loop.constraint, planned.loop.label, planned.known.name,
+             places[planned.known.name],
              planned.known.sign,
              planned.known.kind is JointKind.REVOLUTE and len(known_joint_range(
                  planned.loop.planar, planned.known.index).change_points) % 2 == 1,
@@ -71,23 +148,32 @@ class LoopSolver:
              tuple((passive_places[joint.name], joint.sign, joint.index,
                     joint.kind is JointKind.REVOLUTE) for joint in planned.passive))
             for planned in plan.loops)
+        measured_places = {name: place for place, name in enumerate(plan.measured)}
+        self.groups = tuple(GroupStep(group, plan.tree, [measured_places[name]
+                                                         for name in group.known])
+                            for group in plan.general)
         self.reset()
 
     def reset(self) -> None:
-        """Start again from the zero pose on the planned branches."""
+        """Start again from the zero pose on the planned branches (and assemblies)."""
         # each loop's known value and branch at the last sample, in solve order
         self._known_values = [0.0] * len(self.plan.loops)
         self._branches = [planned.branch for planned in self.plan.loops]
         self._previous = [0.0] * len(self._passive)  # in plan.passive's order
+        for group in self.groups:
+            group.restart()
 
     def solve(self, positions: Mapping[str, float],
               velocities: Mapping[str, float]) -> tuple[dict[str, float], dict[str, float]]:
         """
-        Return every passive loop joint's position and velocity (rad or m, rad/s or m/s).
+        Return every passive joint's position and velocity (rad or m, rad/s or m/s).
 
         From the measured joints' ``positions`` and ``velocities`` (by joint name, URDF units;
-        other names are ignored). Raises LoopSampleError, naming the constraint and the
-        joint, at a dead point, out of reach, or for a measured joint missing or not finite.
+        other names are ignored). Raises LoopSampleError, naming the closure or group and the
+        joint, at a dead point, out of reach, or for a measured joint missing or not finite, or
+        naming the group and its refusal. The planar loops' state is then as it was; a group
+        solved before the one that refused keeps its solution at the sample (a closed pose at
+        measured values, which its continuation goes on from).
         """
         values = []
         rates = []
@@ -107,7 +193,7 @@ class LoopSolver:
         previous = self._previous
         for step, last_value, last_branch in zip(self._steps, self._known_values,
                                                  self._branches):
-            constraint, known, place, sign, flips_with_turns, driven, passive = step
+            constraint, label, known, place, sign, flips_with_turns, driven, passive = step
             value = sign * values[place]
             try:
                 branch = driven.continued_branch(last_value, last_branch, value)
@@ -118,8 +204,8 @@ class LoopSolver:
                     branch = -branch
                 state = driven.solve(value, sign * rates[place], branch)
             except (DeadPointError, UnreachableError) as error:
-                raise LoopSampleError(f'constraint {constraint!r} at {known} = '
-                                      f'{values[place]:.9g}: {error}', constraint) from None
+                raise LoopSampleError(f'{label} at {known} = {values[place]:.9g}: {error}',
+                                      constraint) from None
             known_values.append(value)
             branches.append(state.branch)
             coordinates, state_rates = state.coordinates, state.rates
@@ -129,6 +215,18 @@ class LoopSolver:
                     position = unwrap_near(position, previous[passive_place])
                 values.append(position)
                 rates.append(joint_sign * state_rates[index])
+        for group in self.groups:
+            # Measured joints only are known to a group: its outputs go after every planar one.
+            state = group.solve(values, rates)
+            published = group.published
+            if published is None:
+                values.extend(state.positions)
+                rates.extend(state.velocities)
+            else:
+                positions_out, velocities_out = state.positions, state.velocities
+                for index in published:
+                    values.append(positions_out[index])
+                    rates.append(velocities_out[index])
         self._known_values, self._branches = known_values, branches
         self._previous = values[solved:]
         return (dict(zip(self._passive, self._previous)),

@@ -6,12 +6,13 @@ The measured source of ``loops:=robot_description``: every loop of a lab's URDF,
 
 ``RobotLoopsSubscription`` is a ``source.Source``: it reads the robot description (the parameter
 ``robot_description``, or the relative ``robot_description`` topic as robot_state_publisher
-publishes it), feeds each ``measured_joint_states`` message (``measured_input.MeasuredInput``)
-to a ``loops.follower`` ``RobotLoopsFollower`` and publishes the passive loop joints it solves
-on ``joint_states``, stamped as the input. The node publishes no URDF, ``linkage/state`` or
+publishes it) with its closure file (the parameter ``robot_description_closures``, for every
+description), feeds each ``measured_joint_states`` message (``measured_input.MeasuredInput``)
+to a ``loops.follower`` ``RobotLoopsFollower`` and publishes the passive joints it solves on
+``joint_states``, stamped as the input. The node publishes no URDF, ``linkage/state`` or
 markers of its own then: those describe its own four-bar. Its bag holds the input, the
-completed joint states, the description and the /tf robot_state_publisher would publish for the
-whole robot.
+completed joint states, the description and its closure file, and the /tf
+robot_state_publisher would publish for the whole robot.
 """
 
 from __future__ import annotations
@@ -21,10 +22,13 @@ from dataclasses import replace
 import math
 from typing import Any, Protocol
 
+from linkage_kinematics.loops.assembly import ClosureGap
+from linkage_kinematics.loops.closures import ClosureError, Encoding
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import LoopDrop, RobotLoopsFollower
 from linkage_kinematics.loops.intake import DropReason
-from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.loops.plan import GroupPlan, read_loops
+from linkage_kinematics.loops.solver import GroupStep
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 from linkage_kinematics.ros.measured_input import MeasuredInput
 from linkage_kinematics.ros.messages import RobotStateTransforms
@@ -49,18 +53,57 @@ class LoopsHost(SourceHost, Protocol):
         """Return the node's logger."""
 
 
+# What reading a description may refuse, each with its one line.
+DESCRIPTION_ERRORS = (LoopError, UrdfError, ClosureError)
+
+
 class ClosedRobot:
     """A robot description whose loops close: its follower and robot_state_publisher's TF."""
 
     def __init__(self, urdf: str, config: RunConfiguration) -> None:
-        """Read ``urdf``; LoopError or UrdfError, one line naming the problem, if it cannot."""
+        """
+        Read ``urdf`` and the configured closure file, if any.
+
+        LoopError, UrdfError or ClosureError, one line naming the problem, if they cannot be
+        closed.
+        """
         tree = read_urdf(urdf)  # once, for the loops and for robot_state_publisher's TF
         self.urdf = urdf
-        self.follower = RobotLoopsFollower(read_loops(tree), config.loops.measured_joints,
-                                           dict(config.loops.branches), config.measured.max_jump)
+        self.closures = config.loops.robot_description_closures
+        self.follower = RobotLoopsFollower(
+            read_loops(tree, self.closures or None), config.loops.measured_joints,
+            dict(config.loops.branches), config.measured.max_jump,
+            dict(config.loops.assemblies))
         self.transforms = RobotStateTransforms(tree, config.outputs.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
+
+
+def _gaps(gaps: Sequence[ClosureGap]) -> str:
+    """Return closures' gaps for people: per closure, metres and (if it has one) radians."""
+    return ', '.join(f'{gap.closure} {gap.position:.3g} m'
+                     + ('' if gap.angle is None else f' and {gap.angle:.3g} rad')
+                     for gap in gaps)
+
+
+def group_plan_line(group: GroupPlan) -> str:
+    """Return the log line of a planned group: how it is solved and how open its zero pose is."""
+    structure = group.zero.structure
+    return (f'group {group.name}: {structure.dof} degrees of freedom '
+            f'({len(structure.idle)} idle), known {", ".join(group.known)}, solving '
+            f'{", ".join(group.solved)} by {group.kind.value}; the zero pose is open by '
+            f'{_gaps(group.zero.assembly.start_gaps)}; it is assembled at the first sample, '
+            'nearest its zero-pose assembly (loops.assemblies picks another)')
+
+
+def assembly_line(step: GroupStep) -> str:
+    """Return the log line of a group's assembly at a motion's first sample."""
+    values = dict(zip(step.tree.names, step.assembly.values))
+    return (f'group {step.plan.name}: assembled at the first sample '
+            f'({", ".join(f"{name} = {values[name]:.6g}" for name in step.plan.known)}): '
+            f'{", ".join(f"{name} = {values[name]:.6g}" for name in step.plan.solved)}, '
+            f'orientation {step.solver.orientation:+d} (the sign of det A), closed to '
+            f'{_gaps(step.assembly.gaps)}')
 
 
 class TreePositions:
@@ -123,7 +166,7 @@ def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
         return None
     try:
         return ClosedRobot(config.loops.robot_description, config)
-    except (LoopError, UrdfError) as error:
+    except DESCRIPTION_ERRORS as error:
         raise StartupError('cannot close the loops of parameter robot_description: '
                            + str(error).replace('\n', '; ')) from None
 
@@ -184,22 +227,38 @@ class RobotLoopsSubscription(MeasuredInput):
         self._tree = TreePositions(robot.tree_joints, robot.follower.loop_joints,
                                    self._input_positions)
         self._following = False
-        self._outputs.record_robot(robot.urdf, robot.transforms, self._host.now_ns())
+        self._outputs.record_robot(robot.urdf, robot.closures, robot.transforms,
+                                   self._host.now_ns())
         loops = robot.follower.loops
+        # by encoding, as each names its closures: constraints a, b; closures (closure file) c
+        written: dict[Encoding, list[str]] = {}
+        for closure in loops.closures:
+            written.setdefault(closure.encoding, []).append(closure.name)
         self._host.get_logger().info(
-            f'closing the loops of robot {loops.robot_name!r}: constraints '
-            + ', '.join(loop.constraint for loop in loops.loops))
+            f'closing the loops of robot {loops.robot_name!r}: ' + '; '.join(
+                f'{encoding.word}s ' + ('(closure file) ' if encoding is Encoding.CLOSURE_FILE
+                                        else '') + ', '.join(names)
+                for encoding, names in written.items()))
         if robot.follower.plan is not None:
             self._planned()
 
     def _planned(self) -> None:
-        """Say which joints the loops are closed from, and warn of passive mimic joints."""
+        """Say which joints the loops are closed from, how, and what to be warned of."""
         plan = self._robot.follower.plan
         logger = self._host.get_logger()
         logger.info(f"measured joints {', '.join(plan.measured)}; publishing "
                     + ', '.join(plan.passive))
-        for warning in plan.warnings:  # zero poses not assembled, passive joints that mimic
+        for group in plan.general:
+            logger.info(group_plan_line(group))
+        # zero poses not assembled, passive joints that mimic, joints the closure file overrides
+        for warning in plan.warnings:
             logger.warning(warning)
+
+    def _assembled(self) -> None:
+        """Say which assembly each group of the general closure took at the first sample."""
+        logger = self._host.get_logger()
+        for step in self._robot.follower.solver.groups:
+            logger.info(assembly_line(step))
 
     def _report(self, problem: str) -> None:
         """Make the status ERROR with ``problem``: logged and reported at once, when it is new."""
@@ -213,7 +272,7 @@ class RobotLoopsSubscription(MeasuredInput):
         """Read a description afresh; one that cannot be closed leaves the last one followed."""
         try:
             robot = ClosedRobot(message.data, self._host.config)
-        except (LoopError, UrdfError) as error:
+        except DESCRIPTION_ERRORS as error:
             self._report(f'cannot close the loops of the robot description on '
                          f'{self._outputs.description_topic}: '
                          + str(error).replace('\n', '; '))
@@ -232,7 +291,9 @@ class RobotLoopsSubscription(MeasuredInput):
             LoopsView(robot_name=None if robot is None else robot.follower.loops.robot_name,
                       description_from=self._description_from,
                       plan=None if robot is None else robot.follower.plan,
-                      health=self._loops_health))
+                      health=self._loops_health,
+                      groups=(() if robot is None or robot.follower.solver is None
+                              else robot.follower.solver.groups)))
 
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: the thresholds (timeout, jump)."""
@@ -300,6 +361,8 @@ class RobotLoopsSubscription(MeasuredInput):
         self._outputs.record_tf(self._tree.at_sample(followed.joints), stamp_ns)
         if first:
             self._show_activity()
+            if self._robot.follower.solver.groups:
+                self._assembled()
         if self._schedule.due(stamp_ns) or first:
             self._schedule.sent(stamp_ns)
             host.publish_diagnostics(at_ns=stamp_ns)

@@ -61,6 +61,9 @@ ROBOT_DESCRIPTION_QOS = QoSProfile(
 MEASURED_QOS = QoSProfile(depth=100)
 MEASURED_TOPIC = 'measured_joint_states'
 ROBOT_DESCRIPTION_TOPIC = 'robot_description'
+# The closure file's text, logged beside the description (latched as it is), never published:
+# the parameter robot_description_closures holds it.
+CLOSURES_TOPIC = 'robot_description_closures'
 
 
 class StartupError(Exception):
@@ -81,6 +84,17 @@ class Publishers(NamedTuple):
     def present(self) -> tuple[Publisher, ...]:
         """Return the publishers the node has, in order."""
         return tuple(publisher for publisher in self if publisher is not None)
+
+
+def _loops_topics(outputs: NodeOutputs, joint_states: str) -> list[tuple]:
+    """Return what loops robot_description logs beyond what it publishes: description, input."""
+    topics = [(outputs.description_topic, String, ROBOT_DESCRIPTION_QOS, None)]
+    if outputs.config.loops.robot_description_closures:
+        topics.append((outputs.closures_topic, String, ROBOT_DESCRIPTION_QOS, None))
+    # Heard on the topic the node publishes to, the input goes to that topic's record.
+    if outputs.input_topic != joint_states:
+        topics.append((outputs.input_topic, JointState, MEASURED_QOS, None))
+    return topics
 
 
 class NodeOutputs:
@@ -112,6 +126,7 @@ class NodeOutputs:
         # loops robot_description: the input and the lab's description are logged too
         self.input_topic = node.resolve_topic_name(MEASURED_TOPIC)
         self.description_topic = node.resolve_topic_name(ROBOT_DESCRIPTION_TOPIC)
+        self.closures_topic = node.resolve_topic_name(CLOSURES_TOPIC)
         self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
         self._prepared_for: RunConfiguration | None = None
@@ -141,10 +156,7 @@ class NodeOutputs:
         topics += [(TF_STATIC_TOPIC, messages.TFMessage, TF_STATIC_QOS, None),
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         if self.config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
-            topics.append((self.description_topic, String, ROBOT_DESCRIPTION_QOS, None))
-            # Heard on the topic the node publishes to, the input goes to that topic's record.
-            if self.input_topic != self._publishers.joint_states.topic_name:
-                topics.append((self.input_topic, JointState, MEASURED_QOS, None))
+            topics += _loops_topics(self, self._publishers.joint_states.topic_name)
         try:
             return Recorder(
                 self.config.logging.folder, topics=topics, metadata=metadata, cpus=cpus,
@@ -253,11 +265,13 @@ class NodeOutputs:
         """Log one input message's bytes as received, at its stamp."""
         self._record(self.input_topic, data, stamp_ns)
 
-    def record_robot(self, urdf: str, transforms: messages.RobotStateTransforms,
+    def record_robot(self, urdf: str, closures: str, transforms: messages.RobotStateTransforms,
                      stamp_ns: int) -> None:
-        """Log a lab's description and its /tf_static; its /tf goes with each state (record_tf)."""
+        """Log a lab's description, closure file ('': none) and /tf_static (/tf: record_tf)."""
         self._robot_transforms = transforms
         self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
+        if closures:
+            self._record(self.closures_topic, encode_cdr(String(data=closures)), stamp_ns)
         self._record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
 
     def record_tf(self, positions: Sequence[float], stamp_ns: int) -> None:

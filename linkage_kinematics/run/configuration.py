@@ -160,14 +160,18 @@ class Loops:
     """
     Which loops the measured source closes (``loops``), and how.
 
-    With ``loops:=robot_description``: the measured joints (empty: those of the first message),
-    each constraint's assembly branch override (name, ±1), and the URDF ('': from the topic).
+    With ``loops:=robot_description``: the measured joints (empty: the closure file's actuated
+    ones, else those of the first message), each planar loop's assembly branch override (name,
+    ±1), each group's assembly seeds (joint, value in rad or m), the URDF ('': from the topic)
+    and the closure file's text ('': none).
     """
 
     source: LoopsSource
     measured_joints: tuple[str, ...]
     branches: tuple[tuple[str, int], ...]
     robot_description: str
+    assemblies: tuple[tuple[str, float], ...] = ()
+    robot_description_closures: str = ''
 
 
 @dataclass(frozen=True)
@@ -353,6 +357,26 @@ def _loop_branches(entries: list[str]) -> tuple[tuple[str, int], ...]:
     return tuple(branches)
 
 
+def _loop_assemblies(entries: list[str]) -> tuple[tuple[str, float], ...]:
+    """Return ``loops.assemblies`` as (joint, value) pairs."""
+    assemblies = []
+    for entry in entries:
+        name, _, text = entry.rpartition('=')
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not name or not math.isfinite(value):
+            raise ConfigurationError(
+                'loops.assemblies', f'entry {entry!r} is not JOINT=VALUE (a finite number, rad '
+                'or m)')
+        assemblies.append((name, value))
+    names = [name for name, _ in assemblies]
+    if len(set(names)) < len(names):
+        raise ConfigurationError('loops.assemblies', 'gives a joint more than one value')
+    return tuple(assemblies)
+
+
 def _check_loops(checked: Mapping[str, Any]) -> None:
     """Refuse loop settings that the chosen ``loops`` and ``source`` do not use."""
     if checked['loops'] is LoopsSource.ROBOT_DESCRIPTION:
@@ -361,7 +385,8 @@ def _check_loops(checked: Mapping[str, Any]) -> None:
                 'loops', 'robot_description closes the loops of measured joints: it needs '
                 f"source measured, got source {checked['source'].value}")
         return
-    for name in ('loops.measured_joints', 'loops.branches'):
+    for name in ('loops.measured_joints', 'loops.branches', 'loops.assemblies',
+                 'robot_description_closures'):
         if checked[name]:
             raise ConfigurationError(
                 name, f"is used only with loops robot_description, got loops {checked['loops']}")
@@ -502,6 +527,8 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
             measured_joints=tuple(checked['loops.measured_joints']),
             branches=_loop_branches(checked['loops.branches']),
             robot_description=checked['robot_description'],
+            assemblies=_loop_assemblies(checked['loops.assemblies']),
+            robot_description_closures=checked['robot_description_closures'],
         ),
         autostart=checked['autostart'],
     )

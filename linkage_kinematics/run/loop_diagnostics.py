@@ -4,12 +4,15 @@
 """
 What the node's diagnostics say with ``loops:=robot_description``, without ROS.
 
-``LoopsHealth`` is the source's record: dropped messages by reason, overall and per loop, the
-time since the last valid one, and how each measured joint's velocity was obtained.
+``LoopsHealth`` is the source's record: dropped messages by reason, overall and per loop or
+group, the time since the last valid one, and how each measured joint's velocity was obtained.
 ``loop_statuses`` turns it, with the ``StatusInputs`` the node has at that moment, into the
-node's status (waiting for the description or the input, following, problems) and one status
-per loop (its kind, its known joint, what is estimated, its drops, the distance of its known
-joint to its nearest dead point), in ``diagnostics``' style.
+node's status (waiting for the description or the input, following, problems), one status per
+planar loop (its kind, its known joint, what is estimated, its drops, the distance of its known
+joint to its nearest dead point) and one per closure group of the general closure (its
+closures, degrees of freedom, known and solved joints, how it is solved, its idle freedoms and
+unpublished coordinates, its assembly, the conditioning and the distance to the nearest
+singular configuration at the last sample, its drops), in ``diagnostics``' style.
 """
 
 from __future__ import annotations
@@ -21,6 +24,8 @@ from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.loops.follower import dead_point_distances, LoopSample
 from linkage_kinematics.loops.intake import DropReason, Estimate, LOOPS_DROPS
 from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
+from linkage_kinematics.loops.solver import GroupStep
+from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.run.diagnostics import (
     Freshness,
     Level,
@@ -90,6 +95,8 @@ class LoopsView:
     description_from: str  # 'parameter robot_description' or the topic's resolved name
     plan: LoopPlan | None
     health: LoopsHealth
+    # the plan's groups of the general closure as followed (solver.LoopSolver.groups)
+    groups: tuple[GroupStep, ...] = ()
 
 
 def _estimated_joints(plan: LoopPlan, sample: LoopSample | None) -> set[str]:
@@ -152,6 +159,85 @@ def _loop_status(inputs: StatusInputs, view: LoopsView, planned: PlannedLoop,
     return Status(f'loop {constraint}', f'robot {view.robot_name}', level, message, values)
 
 
+def _counts_text(counts: dict[str, int]) -> str:
+    """Return how many of each closure kind a group has: '2 balls', '1 pin and 1 weld'."""
+    parts = [f'{count} {kind}{"s" if count > 1 else ""}' for kind, count in counts.items()]
+    return ', '.join(parts[:-1]) + ' and ' + parts[-1] if len(parts) > 1 else parts[0]
+
+
+def _how(kind: GroupKind) -> str:
+    """Return how a group's positions are solved, for people."""
+    if kind is GroupKind.NEWTON:
+        return 'Newton on the closure equations with their exact Jacobian, to rounding'
+    return kind.value
+
+
+def _group_status(inputs: StatusInputs, view: LoopsView, step: GroupStep,
+                  warnings: tuple[str, ...]) -> Status:
+    """Return one closure group's status (general closure)."""
+    plan, sample = step.plan, view.health.last
+    structure = plan.zero.structure
+    kinds: dict[str, int] = {}
+    for closure in plan.group.closures:
+        kinds[closure.kind.value] = kinds.get(closure.kind.value, 0) + 1
+    followed = sample is not None and step.state is not None
+    estimated = [] if sample is None else [
+        name for name in plan.known if sample.estimates[name] is not Estimate.MEASURED]
+    tree = view.plan.tree
+    hidden_joints = sorted({tree.coordinates[tree.index[name]].joint for name in plan.hidden})
+    values = {
+        'kind': 'closure group of ' + _counts_text(kinds),
+        'closures': ', '.join(f'{closure.name} ({closure.kind.value}, '
+                              f'{closure.encoding.value})' for closure in plan.group.closures),
+        'degrees of freedom': f'{structure.dof} ({len(structure.idle)} idle)',
+        'known joints': ', '.join(plan.known) + ' (measured)',
+        'solves': ', '.join(plan.solved),
+        'solved by': _how(plan.kind),
+        'idle freedoms': ('none' if not structure.idle else '; '.join(
+            ', '.join(idle.joints) for idle in structure.idle)
+            + ' (each held at its assembled value)'),
+        'not published': ('none' if not plan.hidden else ', '.join(plan.hidden)
+                          + f" (the closure file's coordinates of {', '.join(hidden_joints)}"
+                          ': no URDF joints)'),
+        'assembly': ("at the first sample, nearest the zero pose's"
+                     if step.solver is None
+                     else f'orientation {step.solver.orientation:+d} (the sign of det A), '
+                          'assembled at the first sample'),
+        'estimated': ('none' if not estimated else 'velocities of ' + ', '.join(plan.solved)
+                      + f' (from an estimated velocity of {", ".join(estimated)})'),
+    }
+    distance = None
+    if followed:
+        state = step.state
+        distance = step.solver.derivatives.singular_distance([0.0] * len(plan.known))
+        values['conditioning'] = f'{state.conditioning:.3g}'
+        values['Newton iterations'] = str(state.iterations)
+        values['singular configuration distance'] = (
+            f'{distance:.6g} (in the known joints, rad or m; an estimate)')
+    else:
+        for key in ('conditioning', 'Newton iterations', 'singular configuration distance'):
+            values[key] = 'not followed yet'
+    counts = view.health.per_loop.get(plan.name, _counts())
+    values['dropped samples'] = str(sum(counts.values()))
+    values.update({f'dropped {reason.value}': str(count) for reason, count in counts.items()
+                   if reason is not DropReason.NO_DESCRIPTION})
+    notes = list(warnings)
+    if hidden_joints:
+        notes.append('robot_state_publisher cannot pose the links below '
+                     f'{", ".join(hidden_joints)} (the closure file overrides them): model them '
+                     'as revolute joints in the URDF')
+    if distance is not None and distance < inputs.config.outputs.dead_point_warning:
+        notes.append(f'{distance:.3g} from a singular configuration')
+    known = ', '.join(plan.known)
+    if notes:
+        level, message = Level.WARN, '; '.join(notes)
+    elif not followed:
+        level, message = Level.OK, f'waiting for {known}'
+    else:
+        level, message = Level.OK, f'closed from {known}'
+    return Status(f'group {plan.name}', f'robot {view.robot_name}', level, message, values)
+
+
 def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
     """Return the node's status's key values."""
     health, plan = view.health, view.plan
@@ -162,6 +248,9 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
         'description from': view.description_from,
         'measured joints': ('not known yet' if plan is None else ', '.join(plan.measured)),
         'passive joints': ('not known yet' if plan is None else ', '.join(plan.passive)),
+        'closure groups': ('not known yet' if plan is None else ', '.join(
+            f'{group.name} ({"planar loops" if group.zero is None else "general closure"})'
+            for group in plan.groups)),
         **health.sample_values(inputs.now_ns),
     }
     sample = health.last
@@ -185,7 +274,7 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
 
 def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
     """
-    Return the node's status and one per loop (docs/parameters.md, Diagnostics).
+    Return the node's status, one per planar loop, one per group (docs/parameters.md).
 
     The node's: ERROR for ``inputs.problem`` (a description that cannot be closed, the log
     failed) or stale data, WARN for drops since the last status, else OK with the activity.
@@ -211,4 +300,6 @@ def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
         statuses += [_loop_status(inputs, view, planned, solver_of,
                                   loop_warnings.get(planned.loop.constraint, ()))
                      for planned in view.plan.loops]
+        statuses += [_group_status(inputs, view, step, loop_warnings.get(step.plan.name, ()))
+                     for step in view.groups]
     return tuple(statuses)

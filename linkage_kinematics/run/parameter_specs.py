@@ -70,7 +70,7 @@ class LoopsSource(StrEnum):
     """Which loops the measured source closes: parameter ``loops``, by its value."""
 
     PARAMETERS = 'parameters'  # the node's own four-bar, from the geometry parameters
-    ROBOT_DESCRIPTION = 'robot_description'  # every <constraint> loop of a lab's URDF
+    ROBOT_DESCRIPTION = 'robot_description'  # every loop of a lab's URDF (and closure file)
 
 
 class Kind(Enum):
@@ -332,19 +332,31 @@ def _loop_specs() -> tuple[ParameterSpec, ...]:
     return (
         ParameterSpec('loops', LoopsSource.PARAMETERS.value,
                       'parameters: the four-bar of the geometry parameters; robot_description: '
-                      "every <constraint> loop of the robot's URDF (source measured only)",
+                      "every loop closure of the robot's URDF and closure file (source measured "
+                      'only)',
                       Kind.CHOICE, read_only=True, choices=LoopsSource),
         ParameterSpec('loops.measured_joints', [],
-                      'with loops robot_description: the measured joints; empty: the loop '
-                      'joints the first measured_joint_states message carries',
+                      'with loops robot_description: the measured joints; empty: the closure '
+                      "file's actuated joints (name_mot), else the loop joints the first "
+                      'measured_joint_states message carries',
                       Kind.TEXTS, read_only=True),
         ParameterSpec('loops.branches', [],
                       'with loops robot_description: CONSTRAINT=1 or CONSTRAINT=-1, the assembly '
-                      "branch of that constraint's loop; by default the zero pose's",
+                      "branch of that planar loop; by default the zero pose's",
+                      Kind.TEXTS, read_only=True),
+        ParameterSpec('loops.assemblies', [],
+                      'with loops robot_description: JOINT=VALUE (rad or m), a start value of a '
+                      'joint a closure group solves, assembling its group nearer another '
+                      'assembly; by default the one nearest the zero pose',
                       Kind.TEXTS, read_only=True),
         ParameterSpec('robot_description', '',
                       "with loops robot_description: the robot's URDF (as robot_state_publisher's "
                       "parameter); '': from the robot_description topic",
+                      Kind.TEXT, read_only=True, allow_empty=True),
+        ParameterSpec('robot_description_closures', '',
+                      "with loops robot_description: the text of the URDF's closure file "
+                      "(toolbox-parallel-robots' YAML: closed_loop, type, name_mot, joint_name, "
+                      "joint_type), for every description; '': none",
                       Kind.TEXT, read_only=True, allow_empty=True),
     )
 
