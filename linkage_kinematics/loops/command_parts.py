@@ -131,7 +131,7 @@ class PlanarPart:
         self.columns = [tree.index[name] for name in structure.solved]
         self.known = [tree.index[name] for name in structure.known]
         robot = RobotLoops('', frozenset(name for loop in loops for name in loop.names),
-                           tuple(loops), ())
+                           tuple(loops), (), closures=group.closures, tree=tree)
         # the branch at the zero pose whose motion reaches the assembled pose, loop by loop
         branches = {}
         for planned in robot.plan(self.known_names).loops:
