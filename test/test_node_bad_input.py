@@ -103,6 +103,7 @@ ACCEPTED = {
     'loops.measured_joints': set(),          # a list of strings
     'loops.branches': set(),
     'loops.assemblies': set(),
+    'loops.output_joints': set(),
     'robot_description': set(),              # any string, '' for the topic
     'robot_description_closures': set(),     # any string, '' for none
     'autostart': set(),

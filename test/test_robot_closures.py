@@ -317,7 +317,8 @@ def test_the_assemblies_and_the_closure_file_parameters_are_validated_naming_the
             (['a=1', 'a=2'], 'gives a joint more than one value')):
         with pytest.raises(ConfigurationError, match=f'^loops.assemblies: {message}'):
             configuration(**{'loops.assemblies': value})
-    for name, value in (('loops.assemblies', ['a=1']), ('robot_description_closures', text)):
+    for name, value in (('loops.assemblies', ['a=1']), ('loops.output_joints', ['a']),
+                        ('robot_description_closures', text)):
         with pytest.raises(ConfigurationError, match=f'^{name}: is used only with loops '
                                                      'robot_description'):
             configuration(loops='parameters', **{name: value})

@@ -162,8 +162,9 @@ class Loops:
 
     With ``loops:=robot_description``: the measured joints (empty: the closure file's actuated
     ones, else those of the first message), each planar loop's assembly branch override (name,
-    ±1), each group's assembly seeds (joint, value in rad or m), the URDF ('': from the topic)
-    and the closure file's text ('': none).
+    ±1), each group's assembly seeds (joint, value in rad or m), the URDF ('': from the topic),
+    the closure file's text ('': none) and the output joints of the transmission (none: no
+    efforts or commands through the loops).
     """
 
     source: LoopsSource
@@ -172,6 +173,7 @@ class Loops:
     robot_description: str
     assemblies: tuple[tuple[str, float], ...] = ()
     robot_description_closures: str = ''
+    output_joints: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -386,7 +388,7 @@ def _check_loops(checked: Mapping[str, Any]) -> None:
                 f"source measured, got source {checked['source'].value}")
         return
     for name in ('loops.measured_joints', 'loops.branches', 'loops.assemblies',
-                 'robot_description_closures'):
+                 'loops.output_joints', 'robot_description_closures'):
         if checked[name]:
             raise ConfigurationError(
                 name, f"is used only with loops robot_description, got loops {checked['loops']}")
@@ -529,6 +531,7 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
             robot_description=checked['robot_description'],
             assemblies=_loop_assemblies(checked['loops.assemblies']),
             robot_description_closures=checked['robot_description_closures'],
+            output_joints=tuple(checked['loops.output_joints']),
         ),
         autostart=checked['autostart'],
     )

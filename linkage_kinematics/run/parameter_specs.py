@@ -349,6 +349,12 @@ def _loop_specs() -> tuple[ParameterSpec, ...]:
                       'joint a closure group solves, assembling its group nearer another '
                       'assembly; by default the one nearest the zero pose',
                       Kind.TEXTS, read_only=True),
+        ParameterSpec('loops.output_joints', [],
+                      "with loops robot_description: each closure group's independent joints as "
+                      "the lab's controllers see them (as many as the group's degrees of freedom, "
+                      'none measured), whose efforts and commands the transmission gives; empty: '
+                      'none',
+                      Kind.TEXTS, read_only=True),
         ParameterSpec('robot_description', '',
                       "with loops robot_description: the robot's URDF (as robot_state_publisher's "
                       "parameter); '': from the robot_description topic",
