@@ -247,6 +247,7 @@ class FiveBarPositions:
 
     def __init__(self, tree: KinematicTree, group: ClosureGroup,
                  equations: LoopEquations, values: Sequence[float]) -> None:
+        """Place the pins at the assembled ``values`` (all the tree's coordinates)."""
         self.equations = equations
         self.cycle = five_bar_cycle(tree, group.closures[0])
         first = five_bar_pair(tree, group, values)
@@ -271,13 +272,19 @@ class FiveBarPositions:
                     path[place + 1] if place + 1 < len(path) else None,
                     {equations.coordinates.index(tree.steps[above].coordinate)
                      for above in path[:place]}))
-        evaluation = equations.evaluate(values)
+        evaluation = equations.evaluate([values[i] for i in equations.coordinates])
         # the first step below the base turns about the plane's normal, fixed in the base
         self.normal = evaluation.frames[0][2][0]
         apex = self.pin(self.apex, evaluation, None)
-        self.radii = tuple(norm(subtract(apex, self.pin(end, evaluation, self.known_side)))
+        # in the plane: the pins may sit at different heights along the axes
+        self.radii = tuple(norm(self.planar(subtract(apex, self.pin(end, evaluation,
+                                                                    self.known_side))))
                            for end in self.ends)
         self.branch = 1
+
+    def planar(self, vector: Vector) -> Vector:
+        """Return ``vector`` without its component along the plane's normal."""
+        return subtract(vector, scale(dot(self.normal, vector), self.normal))
 
     def pin(self, step: int | None, evaluation: Evaluation, side: int | None) -> tuple:
         """Return a pin's position: a joint's origin, or the closure's point on ``side``."""
@@ -288,6 +295,8 @@ class FiveBarPositions:
     def apex_position(self, evaluation: Evaluation, branch: int) -> tuple:
         """Return the apex pin's position on ``branch``."""
         p, q = (self.pin(end, evaluation, self.known_side) for end in self.ends)
+        # in the plane through p: each joint turns its pin about its axis, whatever its height
+        q = add(p, self.planar(subtract(q, p)))
         return circle_intersection(p, q, self.radii[0], self.radii[1], self.normal, branch)
 
     def reset(self, values: Sequence[float]) -> None:

@@ -318,6 +318,25 @@ class LoopEquations:
                     sx, sy, sz = sx - rate * wx, sy - rate * wy, sz - rate * wz
         return (vx, vy, vz), (sx, sy, sz)
 
+    def frame(self, closure: int, side: int, evaluation: Evaluation) -> tuple[Rotation, Vector]:
+        """Return the rotation and origin of a closure side's moving frame, in the base frame."""
+        program, slot = self._closures[closure][2 + side][:2]
+        rotations, positions = evaluation.frames[program][:2]
+        return rotations[slot], positions[slot]
+
+    def spin(self, closure: int, side: int, evaluation: Evaluation,
+             rates: Sequence[float]) -> Vector:
+        """Return how fast a closure side's moving frame turns in the base frame, for ``rates``."""
+        record = self._closures[closure][2 + side]
+        axes = evaluation.frames[record[0]][2]
+        sx = sy = sz = 0.0
+        for place, col, multiplier, turn in record[4]:
+            rate = multiplier * rates[col]
+            if turn and rate != 0.0:
+                wx, wy, wz = axes[place]
+                sx, sy, sz = sx + rate * wx, sy + rate * wy, sz + rate * wz
+        return (sx, sy, sz)
+
     def socket(self, closure: int) -> tuple[int, int]:
         """Return the program and slot of a closure's side-1 moving frame (a rod's socket)."""
         return self._closures[closure][3][0], self._closures[closure][3][1]

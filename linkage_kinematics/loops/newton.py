@@ -73,6 +73,7 @@ from linkage_kinematics.loops.closed_forms import (
 )
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, inverse, solve
+from linkage_kinematics.loops.reduction import reduce_group, Reduction
 from linkage_kinematics.loops.spatial import (
     apply,
     apply_transposed,
@@ -234,12 +235,12 @@ def residual_bounds(tree: KinematicTree, group: ClosureGroup, equations: LoopEqu
 class _Rods:
     """The rods reduced to distances: their angles in closed form, continued from the last."""
 
-    def __init__(self, equations: LoopEquations, group: ClosureGroup, rods: dict) -> None:
-        names = [closure.name for closure in group.closures]
+    def __init__(self, equations: LoopEquations, unknown: Sequence[int], rods: dict) -> None:
+        names = [name for name, _, _ in equations.closure_rows]
         self.equations = equations
-        # (closure place, rod, outputs: the rod's coordinates' places in group.unknown, the
+        # (closure place, rod, outputs: the rod's coordinates' places in ``unknown``, the
         # first axis in the socket frame, the second in the frame the first turns)
-        self.rods = [(names.index(name), rod, [list(group.unknown).index(c)
+        self.rods = [(names.index(name), rod, [list(unknown).index(c)
                                                for c in rod.coordinates],
                       apply(rod.origins[0], rod.axes[0]), apply(rod.origins[1], rod.axes[1]))
                      for name, rod in rods.items()]
@@ -317,27 +318,36 @@ class GroupSolver:
         self.known = structure.known
         self.solved = structure.solved
         values = assembly.values
-        rods = (reducible_rods(tree, group, structure)
+        # closures rewritten smaller where their end joints allow (reduction.py); a planar
+        # loops' group stays as the planar closed forms read it
+        reduction = (reduce_group(tree, group, structure, values)
+                     if kind is not GroupKind.PLANAR_LOOPS else Reduction(group, structure, ()))
+        work = reduction.group
+        rods = (reducible_rods(tree, work, reduction.structure)
                 if kind in (GroupKind.NEWTON, GroupKind.LEG_INVERSE) else {})
-        self.equations = LoopEquations(tree, group.closures, rods)
-        self._rods = _Rods(self.equations, group, rods)
+        self.equations = LoopEquations(tree, work.closures, rods)
+        self._rods = _Rods(self.equations, group.unknown, rods)
+        self._followers = reduction.followers
         local = [values[i] for i in self.equations.coordinates]
-        self._system = _System(tree, self.equations, [i for i in group.unknown if i not in
-                                                      self._rods.coordinates], structure, local)
+        newton = [i for i in work.unknown if i not in self._rods.coordinates]
+        self._system = _System(tree, self.equations, newton, reduction.structure, local)
         self.derivatives = Derivatives(tree, group, structure, values)
         self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
         self._known_set = frozenset(self._known_columns)
         self._unknown_set = frozenset(self._system.columns)
         self._wrapped = self._system.wrapped(tree, self.equations)
         self._known_turns = [tree.coordinates[i].kind is MotionKind.TURN for i in group.known]
-        self._outputs = [self.equations.coordinates.index(i) if i not in self._rods.coordinates
-                         else None for i in group.unknown]
-        self._bounds = residual_bounds(tree, group, self.equations, structure.size)
+        self._outputs = [self.equations.coordinates.index(i) if i in newton else None
+                         for i in group.unknown]
+        unknown = list(group.unknown)
+        self._follower_outputs = [[unknown.index(c) for c in follower.coordinates]
+                                  for follower in self._followers]
+        self._bounds = residual_bounds(tree, work, self.equations, structure.size)
         if kind is GroupKind.LEG_INVERSE:
-            self._closed_form = LegPositions(tree, group, self.equations,
+            self._closed_form = LegPositions(tree, work, self.equations,
                                              next(iter(rods.values())))
         elif kind is GroupKind.FIVE_BAR:
-            self._closed_form = FiveBarPositions(tree, group, self.equations, local)
+            self._closed_form = FiveBarPositions(tree, work, self.equations, values)
         else:
             self._closed_form = None
         self.reset(values)
@@ -356,6 +366,8 @@ class GroupSolver:
         self._values = local
         self._sensitivity = self._system.sensitivity(found[0], jacobian, self._known_columns)
         self._rods.reset(evaluation, values)
+        for follower in self._followers:
+            follower.reset(self.equations, values)
         if self._closed_form is not None:
             self._closed_form.reset(local)
         self.derivatives.last = None
@@ -558,11 +570,16 @@ class GroupSolver:
         for line, column in zip(sensitivity, system.columns):
             rates[column] = math.fsum([s * v for s, v in zip(line, velocities)])
         rods = self._rods.solve(evaluation, rates, self._refuse)
+        followed = [follower.solve(self.equations, evaluation, rates)
+                    for follower in self._followers]
         # the continuation goes on from here even where the answer is too inaccurate to give
         # (Newton's substeps have kept det A's sign; a closed form keeps its branch)
         self._values, self._sensitivity = values, sensitivity
         self._rods.angles = [rod[0] for rod in rods]
-        conditioning = max([conditioning] + [rod[2] for rod in rods])
+        for follower, (angles, _, _) in zip(self._followers, followed):
+            follower.angles = angles
+        conditioning = max([conditioning] + [rod[2] for rod in rods]
+                           + [result[2] for result in followed])
         if not conditioning <= CONDITION_LIMIT:
             raise self._refuse(Refusal.SINGULAR, f'conditioning {conditioning:.3g} above '
                                f'{CONDITION_LIMIT:.3g}')
@@ -571,6 +588,9 @@ class GroupSolver:
         positions = [values[c] if c is not None else 0.0 for c in self._outputs]
         speeds = [rates[c] if c is not None else 0.0 for c in self._outputs]
         for (angles, angle_rates, _), (_, _, outputs, _, _) in zip(rods, self._rods.rods):
+            for output, angle, rate in zip(outputs, angles, angle_rates):
+                positions[output], speeds[output] = angle, rate
+        for (angles, angle_rates, _), outputs in zip(followed, self._follower_outputs):
             for output, angle, rate in zip(outputs, angles, angle_rates):
                 positions[output], speeds[output] = angle, rate
         self.derivatives.last = (positions, speeds, [values[c] for c in known])
@@ -711,6 +731,12 @@ def plan_group(tree: KinematicTree, group: ClosureGroup, start: Sequence[float],
     assembly = assemble(tree, group, start, None if hold_known else (), seed)
     structure = analyse(tree, group, assembly.values)
     kind = classify(tree, group, structure, assembly.values)
+    if kind is GroupKind.NEWTON and structure.problem is None:
+        # a closed form may solve the group once its closures are rewritten (reduction.py)
+        reduction = reduce_group(tree, group, structure, assembly.values)
+        reduced = classify(tree, reduction.group, reduction.structure, assembly.values)
+        if reduced in (GroupKind.FIVE_BAR, GroupKind.LEG_INVERSE):
+            kind = reduced
     if structure.problem is not None:
         return PlannedGroup(assembly, structure, kind, None, structure.problem)
     try:
