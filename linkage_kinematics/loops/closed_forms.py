@@ -4,10 +4,13 @@
 """
 Closed forms of the spatial mechanisms that have them, in plain floats.
 
-* ``universal_angles``: the two angles of a universal joint that point a rod at a target (the
-  angles of a rod reduced to a distance, equations.Rod): the component of the rod along the
-  first axis is kept by the first turn, so the second angle solves a·cos θ₂ + b·sin θ₂ = c,
-  and the first turns the rod onto the target about the first axis.
+* ``universal_angles`` / ``pointing_angles``: the two angles of a universal joint that point a
+  rod at a target (the angles of a rod reduced to a distance, equations.Rod): the component
+  of the rod along the first axis is kept by the first turn, so the second angle solves
+  a·cos θ₂ + b·sin θ₂ = c, and the first turns the rod onto the target about the first axis.
+* ``ball_angles``: the three angles of a ball written as three turns that make a given
+  rotation: the first two point the third axis where the rotation takes it, the third turns
+  the rest of the way (the joints of a welded rod's ends, reduction.py).
 * ``crank_to_sphere`` / ``slide_to_sphere``: one crank–rod–ball leg's inverse: the ball x known
   (the foot's pose known), the crank angle puts the rod's centre P(θ) at the rod's length L
   from x: |x − P(θ)|² = L² is a·cos φ + b·sin φ = c in the turn φ from the current angle (a
@@ -34,11 +37,16 @@ from linkage_kinematics.loops.spatial import (
     add,
     apply,
     apply_transposed,
+    axis_rotation,
     cross,
     dot,
+    multiply,
     norm,
+    perpendicular_pair,
+    Rotation,
     scale,
     subtract,
+    transpose,
     turn_vector,
     Vector,
 )
@@ -67,18 +75,50 @@ def universal_angles(rod: Rod, target: Vector, branch: int) -> tuple[float, floa
     ``target``: the ball's position relative to the joint's centre P, in the socket frame.
     OutOfReach where |target| is not the rod's length (beyond rounding).
     """
-    first, second = rod.axes
-    w = apply_transposed(rod.origins[0], target)  # before the first turn
-    g = apply_transposed(rod.origins[1], first)  # the first axis, seen before the second turn
-    v = rod.rod
+    return pointing_angles(rod.origins, rod.axes, rod.rod, target, branch)
+
+
+def pointing_angles(origins: Sequence[Rotation], axes: Sequence[Vector], vector: Vector,
+                    target: Vector, branch: int) -> tuple[float, float]:
+    """
+    Return the angles of two turns about axes through one point carrying ``vector`` to ``target``.
+
+    The turns: origin rotation O₁, turn θ₁ about a₁, O₂, turn θ₂ about a₂; ``vector`` in the
+    second turn's frame, ``target`` (as long) in the frame above the first. OutOfReach where no
+    angles do (beyond rounding).
+    """
+    first, second = axes
+    w = apply_transposed(origins[0], target)  # before the first turn
+    g = apply_transposed(origins[1], first)  # the first axis, seen before the second turn
+    v = vector
     along = dot(g, second) * dot(second, v)
     a = dot(g, v) - along
     b = dot(g, cross(second, v))
     c = dot(first, w) - along
     angle2 = math.atan2(b, a) + branch * _acos(c / math.hypot(a, b))
-    u = apply(rod.origins[1], turn_vector(second, angle2, v))
+    u = apply(origins[1], turn_vector(second, angle2, v))
     angle1 = math.atan2(dot(first, cross(u, w)), dot(u, w) - dot(first, u) * dot(first, w))
     return angle1, angle2
+
+
+def ball_angles(origins: Sequence[Rotation], axes: Sequence[Vector], rotation: Rotation,
+                branch: int) -> tuple[float, float, float]:
+    """
+    Return the angles of three turns about axes through one point making ``rotation``.
+
+    ``rotation`` = O₁·R(a₁, θ₁)·O₂·R(a₂, θ₂)·O₃·R(a₃, θ₃): the first two point the third axis
+    where ``rotation`` takes it (``pointing_angles``; the third turn leaves its axis), the third
+    turns about it the rest of the way. ``branch`` (±1) picks one of the two triples.
+    """
+    third = axes[2]
+    angle1, angle2 = pointing_angles(origins[:2], axes[:2], apply(origins[2], third),
+                                     apply(rotation, third), branch)
+    before = multiply(multiply(origins[0], axis_rotation(axes[0], angle1)),
+                      multiply(origins[1], axis_rotation(axes[1], angle2)))
+    rest = multiply(transpose(multiply(before, origins[2])), rotation)
+    p = perpendicular_pair(third)[0]
+    q = apply(rest, p)
+    return angle1, angle2, math.atan2(dot(third, cross(p, q)), dot(p, q))
 
 
 def universal_branch(rod: Rod, target: Vector, angle2: float) -> int:

@@ -100,6 +100,32 @@ class Rod:
     length: float
 
 
+@dataclass(frozen=True)
+class Distance:
+    """
+    A closure written as one distance, |x − P| = L: what a rod (``Rod``) or a welded rod is.
+
+    ``points`` gives per side of the closure (parent, child) the moving frame and the point on
+    it that replaces the side's frame, or None to keep the side's frame's origin; ``trimmed``
+    are the steps that no longer move the loop (the rod's joints, whose angles follow in closed
+    form); P is on side ``center``, x on the other.
+    """
+
+    closure: str
+    points: tuple[tuple[int, Vector] | None, tuple[int, Vector] | None]
+    trimmed: frozenset[int]
+    center: int
+    length: float
+
+
+def rod_distance(rod: Rod) -> Distance:
+    """Return the distance a rod's closure becomes: P at the universal joint, x the ball."""
+    points: list[tuple[int, Vector] | None] = [None, None]
+    points[rod.side] = (rod.socket, rod.center)
+    return Distance(rod.closure, (points[0], points[1]), frozenset(rod.steps), rod.side,
+                    rod.length)
+
+
 def universal_rod(tree: KinematicTree, loop: Loop, side: int) -> Rod | None:
     """
     Return the rod of a ball closure's ``side`` if it hangs from a universal joint, else None.
@@ -158,20 +184,22 @@ class LoopEquations:
     The residuals of a set of closures and their exact Jacobian (module docstring).
 
     Values are given per coordinate in ``coordinates`` order (indices of the tree's
-    coordinates). ``rods`` names the ball closures whose rods are reduced to a distance.
+    coordinates). ``rods`` names the closures written as a distance (a ``Rod``'s ball closure,
+    or any ``Distance``).
     """
 
     def __init__(self, tree: KinematicTree, closures: Sequence[Closure],
-                 rods: Mapping[str, Rod] | None = None) -> None:
-        rods = dict(rods or {})
+                 rods: Mapping[str, Rod | Distance] | None = None) -> None:
+        distances = {name: rod_distance(rod) if isinstance(rod, Rod) else rod
+                     for name, rod in (rods or {}).items()}
         loops = [tree.loop(closure) for closure in closures]
         paths = []
         for loop in loops:
-            rod = rods.get(loop.closure.name)
+            distance = distances.get(loop.closure.name)
             trimmed = list(loop.paths)
-            if rod is not None:
-                trimmed[rod.side] = tuple(step for step in trimmed[rod.side]
-                                          if step not in rod.steps)
+            if distance is not None:
+                trimmed = [tuple(step for step in path if step not in distance.trimmed)
+                           for path in trimmed]
             paths.append(trimmed)
         self.coordinates: tuple[int, ...] = tuple(sorted(
             {tree.steps[step].coordinate for sides in paths for path in sides for step in path}))
@@ -197,7 +225,7 @@ class LoopEquations:
         self.closure_rows: list[tuple[str, int, int]] = []
         for loop, sides in zip(loops, paths):
             program = bases.index(loop.base)
-            record = _closure_record(tree, loop, sides, rods.get(loop.closure.name),
+            record = _closure_record(tree, loop, sides, distances.get(loop.closure.name),
                                      slots[program], column, program)
             self.closure_rows.append((loop.closure.name, len(kinds), record[0].value))
             kinds += _row_kinds(record[0])
@@ -349,8 +377,8 @@ class LoopEquations:
 
 
 def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[int]],
-                    rod: Rod | None, slot: Mapping[int, int], column: Mapping[int, int],
-                    program: int) -> tuple:
+                    distance: Distance | None, slot: Mapping[int, int],
+                    column: Mapping[int, int], program: int) -> tuple:
     """
     Return what the rows of one closure need: (form, steps, side a, side b, extra…).
 
@@ -359,8 +387,9 @@ def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[in
     """
     def side(index: int) -> tuple:
         frame, offset = loop.sides[index]
-        if rod is not None and rod.side == index:
-            frame, offset = rod.socket, Pose(IDENTITY, rod.center)
+        if distance is not None and distance.points[index] is not None:
+            frame, point = distance.points[index]
+            offset = Pose(IDENTITY, point)
         steps = tuple((slot[step + 1] - 1, column[tree.steps[step].coordinate],
                        tree.steps[step].multiplier, tree.steps[step].kind is MotionKind.TURN)
                       for step in paths[index])
@@ -368,9 +397,9 @@ def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[in
 
     a, b = side(0), side(1)
     closure = loop.closure
-    if rod is not None:  # x on the other side, P on the rod's
-        x, center = (b, a) if rod.side == 0 else (a, b)
-        return (_Form.DISTANCE, None, x, center, rod.length)
+    if distance is not None:
+        x, center = (b, a) if distance.center == 0 else (a, b)
+        return (_Form.DISTANCE, None, x, center, distance.length)
     if closure.kind is ClosureKind.BALL:
         return (_Form.BALL, None, a, b)
     if closure.kind is ClosureKind.WELD:

@@ -113,6 +113,9 @@ CORRECTION = 0.25
 CONTRACTION = 0.25
 SUBSTEPS = 64
 SHORTEST = 2.0 ** -12
+# A rewritten closure's joints (reduction.py) must come out of its closed forms at the
+# assembled pose within this (rad) of the pose's, else the closures are solved as written.
+FOLLOWED = 1e-9
 # The residual of a closed loop is the rounding of its forward kinematics: this many ε per
 # step of the loop, times the group's size for length rows.
 RESIDUAL_ROUNDING = 64.0
@@ -322,16 +325,26 @@ class GroupSolver:
         # loops' group stays as the planar closed forms read it
         reduction = (reduce_group(tree, group, structure, values)
                      if kind is not GroupKind.PLANAR_LOOPS else Reduction(group, structure, ()))
+        try:
+            self._build(tree, group, reduction, kind, values)
+        except PlanError:
+            # a rewriting that does not hold at the assembled pose: the closures as written
+            self._build(tree, group, Reduction(group, structure, ()), kind, values)
+        self.derivatives = Derivatives(tree, group, structure, values)
+        self.reset(values)
+
+    def _build(self, tree: KinematicTree, group: ClosureGroup, reduction: Reduction,
+               kind: GroupKind, values: Sequence[float]) -> None:
+        """Build the per-sample equations, system and closed forms; PlanError if they fail."""
         work = reduction.group
         rods = (reducible_rods(tree, work, reduction.structure)
                 if kind in (GroupKind.NEWTON, GroupKind.LEG_INVERSE) else {})
-        self.equations = LoopEquations(tree, work.closures, rods)
+        self.equations = LoopEquations(tree, work.closures, {**rods, **reduction.distances})
         self._rods = _Rods(self.equations, group.unknown, rods)
         self._followers = reduction.followers
         local = [values[i] for i in self.equations.coordinates]
         newton = [i for i in work.unknown if i not in self._rods.coordinates]
         self._system = _System(tree, self.equations, newton, reduction.structure, local)
-        self.derivatives = Derivatives(tree, group, structure, values)
         self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
         self._known_set = frozenset(self._known_columns)
         self._unknown_set = frozenset(self._system.columns)
@@ -342,7 +355,7 @@ class GroupSolver:
         unknown = list(group.unknown)
         self._follower_outputs = [[unknown.index(c) for c in follower.coordinates]
                                   for follower in self._followers]
-        self._bounds = residual_bounds(tree, work, self.equations, structure.size)
+        self._bounds = residual_bounds(tree, work, self.equations, reduction.structure.size)
         if kind is GroupKind.LEG_INVERSE:
             self._closed_form = LegPositions(tree, work, self.equations,
                                              next(iter(rods.values())))
@@ -350,7 +363,11 @@ class GroupSolver:
             self._closed_form = FiveBarPositions(tree, work, self.equations, values)
         else:
             self._closed_form = None
-        self.reset(values)
+        evaluation = self.equations.evaluate(local)
+        for follower in self._followers:
+            if not follower.reset(self.equations, evaluation, values) <= FOLLOWED:
+                raise PlanError(f'group {self.name}: closure {follower.closure} rewritten '
+                                'does not hold at the assembled pose')
 
     def reset(self, values: Sequence[float]) -> None:
         """Start again at an assembled pose (``values`` over all the tree's coordinates)."""
@@ -367,7 +384,7 @@ class GroupSolver:
         self._sensitivity = self._system.sensitivity(found[0], jacobian, self._known_columns)
         self._rods.reset(evaluation, values)
         for follower in self._followers:
-            follower.reset(self.equations, values)
+            follower.reset(self.equations, evaluation, values)
         if self._closed_form is not None:
             self._closed_form.reset(local)
         self.derivatives.last = None
@@ -570,8 +587,11 @@ class GroupSolver:
         for line, column in zip(sensitivity, system.columns):
             rates[column] = math.fsum([s * v for s, v in zip(line, velocities)])
         rods = self._rods.solve(evaluation, rates, self._refuse)
-        followed = [follower.solve(self.equations, evaluation, rates)
-                    for follower in self._followers]
+        try:
+            followed = [follower.solve(self.equations, evaluation, rates)
+                        for follower in self._followers]
+        except OutOfReach as error:
+            raise self._refuse(Refusal.UNREACHABLE, str(error)) from None
         # the continuation goes on from here even where the answer is too inaccurate to give
         # (Newton's substeps have kept det A's sign; a closed form keeps its branch)
         self._values, self._sensitivity = values, sensitivity

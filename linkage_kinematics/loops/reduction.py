@@ -6,25 +6,40 @@ A group's closures rewritten smaller where the joints at their ends allow; those
 
 Exporters close a loop by welding two frames that sit at the end of joints, and Newton then
 carries unknowns and rows that a smaller closure does without (Gepetto's
-example-parallel-robots weld every loop so):
+example-parallel-robots weld every loop so; a welded rod on two balls of three turns is six
+unknowns and six rows where a distance is one row):
 
+* **A welded rod.** Each side's path ends in turns about axes through one point (a universal
+  joint of two, or a ball of three: Gepetto's ``_rev0``–``_rev2`` and the closure file's
+  SPHERICAL and UJOINT overrides), carrying the side's frame, the two points apart: the two
+  links welded are one rod between the two points, and the weld is the distance between
+  them, |x − P| = L (one row; equations.Distance). The joints follow from the rod's
+  direction (``WeldRod``): a universal end points the rod (closed_forms.pointing_angles), the
+  rod's rotation is then known and the ball at the other end turns to it
+  (closed_forms.ball_angles). Two balls leave the rod free to spin about its line: rewritten
+  only where each ball's third turn is that spin and the two are an idle freedom, σ and s·σ
+  (s = ±1 as the axes point), held by its equation; the first ball's first two turns then
+  point the rod. Rates: the pointing turns from ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d as a reduced
+  rod's, the ball's from Ω_rod − Ω_socket = Σ θ̇ᵢωᵢ (its three world axes; their κ is the
+  ball's closeness to its gimbal lock, refused as any conditioning).
 * **Two collinear pins welded.** Each side's path ends in a plain turn carrying the side's frame
   (no mimic), the two turns' axes on one line, and the combination of the two that moves
-  nothing is an idle freedom (the five-bar, the delta): the weld is a pin closure between the
-  links above the two turns, on that line. Of the two angles, θ_a − s·θ_b = φ (s = ±1 as the
-  axes point the same way or not) is the links' relative turn about the line, and the other
-  combination is the idle freedom's, held by its equation k_a·(θ_a − θ_a,ref) + k_b·(θ_b −
-  θ_b,ref) = 0: two linear equations (``PinPair``). Rates likewise: φ̇ = ω·(Ω_b − Ω_a), ω the
-  line's direction, Ω the two links' angular velocities.
+  nothing is an idle freedom (the five-bar, the delta; a welded rod's two spins where the rod
+  is not rewritten): the weld is a pin closure between the links above the two turns, on that
+  line. Of the two angles, θ_a − s·θ_b = φ is the links' relative turn about the line, and
+  the other combination is the idle freedom's, held by its equation k_a·(θ_a − θ_a,ref) +
+  k_b·(θ_b − θ_b,ref) = 0: two linear equations (``PinPair``). Rates likewise: φ̇ = ω·(Ω_b −
+  Ω_a), ω the line's direction, Ω the two links' angular velocities.
 
 ``reduce_group`` returns the group with its closures rewritten (``Reduction``): the
 coordinates a rewritten closure no longer moves leave the group's Newton system, and so do the
 idle freedoms they held. Each is recognised from the tree at the assembled pose, where the
 rewritten closure must coincide with the weld to ``COINCIDENT`` (of the group's size): an
 exporter's printed digits leave some 1e-16, and a closure further off is kept as it was. The
-rewritten closures are closures of the tree (``Closure``), so the closed forms recognise them
-as any other (a welded five-bar becomes the planar five-bar). Plan time, then per sample
-``PinPair.solve``: plain floats. Pure: no ROS.
+rewritten pins are closures of the tree (``Closure``), so the closed forms recognise them as
+any other (a welded five-bar becomes the planar five-bar). Each follower's closed forms must
+give the assembled pose's joints back (newton.py checks, else keeps the weld). Plan time, then
+per sample ``solve``: plain floats. Pure: no ROS.
 """
 
 from __future__ import annotations
@@ -34,18 +49,25 @@ import dataclasses
 from dataclasses import dataclass
 import math
 
+from linkage_kinematics.loops.closed_forms import ball_angles, OutOfReach, pointing_angles
 from linkage_kinematics.loops.closures import Closure, ClosureKind, ClosureSide
-from linkage_kinematics.loops.equations import Evaluation, LoopEquations
+from linkage_kinematics.loops.equations import Distance, Evaluation, LoopEquations
 from linkage_kinematics.loops.spatial import (
+    add,
     apply,
+    apply_transposed,
+    axis_rotation,
     cross,
     dot,
     multiply,
     norm,
     perpendicular_pair,
+    Rotation,
+    scale,
     subtract,
     transpose,
     Vector,
+    ZERO,
 )
 from linkage_kinematics.loops.structure import ClosureGroup, GroupStructure
 from linkage_kinematics.loops.tree import IDENTITY_POSE, KinematicTree, Loop, MotionKind, Pose
@@ -55,42 +77,51 @@ COINCIDENT = 1e-12
 
 
 @dataclass(frozen=True)
-class EndTurn:
-    """A plain turn at the end of a closure side's path, the side's frame on its link."""
+class Turns:
+    """
+    Plain turns (no mimic) at the end of a closure side's path, about axes through one point.
 
-    step: int
-    coordinate: int
-    # the moving frame above the turn, the turn's joint frame in it and its unit axis there
+    The side's frame is on the last one's link; each after the first has its joint origin at
+    the one before's (so all axes pass through the first's joint origin, ``center``).
+    """
+
+    steps: tuple[int, ...]
+    coordinates: tuple[int, ...]
+    # the moving frame above the first turn, and the point in it
     socket: int
-    origin: Pose
-    axis: Vector
-    # the closure side's frame in the turn's moving frame
+    center: Vector
+    # each turn's joint frame rotation in the frame above it, and its unit axis there
+    origins: tuple[Rotation, ...]
+    axes: tuple[Vector, ...]
+    # the closure side's frame in the last turn's moving frame
     offset: Pose
 
 
 class PinPair:
     """The two angles of two collinear pins welded (module docstring), continued per sample."""
 
-    def __init__(self, closure: str, turns: tuple[EndTurn, EndTurn], sign: float,
+    def __init__(self, closure: str, turns: tuple[Turns, Turns], sign: float,
                  coefficients: tuple[float, float], reference: tuple[float, float]) -> None:
         first, second = turns
         self.closure = closure
-        self.coordinates = (first.coordinate, second.coordinate)
+        self.coordinates = (first.coordinates[0], second.coordinates[0])
         self.sign = sign
         self.coefficients = coefficients
         self.reference = reference
-        self.origins = (first.origin.rotation, second.origin.rotation)
-        self.axis = first.axis
-        self.perpendicular = perpendicular_pair(first.axis)[0]
+        self.origins = (first.origins[0], second.origins[0])
+        self.axis = first.axes[0]
+        self.perpendicular = perpendicular_pair(first.axes[0])[0]
         # the second side's frame relative to the first's, both on the welded link
         self.weld = multiply(second.offset.rotation, transpose(first.offset.rotation))
         self.place = 0
         self.angles = (0.0, 0.0)
 
-    def reset(self, equations: LoopEquations, values: Sequence[float]) -> None:
-        """Take the angles at an assembled pose (all the tree's coordinates)."""
+    def reset(self, equations: LoopEquations, evaluation: Evaluation,
+              values: Sequence[float]) -> float:
+        """Take the angles at an assembled pose (all the tree's coordinates); return 0."""
         self.place = [name for name, _, _ in equations.closure_rows].index(self.closure)
         self.angles = (values[self.coordinates[0]], values[self.coordinates[1]])
+        return 0.0
 
     def solve(self, equations: LoopEquations, evaluation: Evaluation,
               rates: Sequence[float]) -> tuple[tuple[float, float], tuple[float, float], float]:
@@ -118,24 +149,161 @@ class PinPair:
         return ((angle + s * second, second), (turning + s * second_rate, second_rate), 1.0)
 
 
+class WeldRod:
+    """
+    The joints at the two ends of a welded rod, from the rod's direction (module docstring).
+
+    The *pointing* end (a universal joint, or a ball whose third turn spins the rod about its
+    own axis) points the rod from its centre P to the other end's centre x; the *other* end (a
+    ball) turns its link to the rod's rotation. With a spin, its angle σ and the other ball's
+    third angle (about the same line: it moves by s·σ) are the idle freedom's, held by its
+    equation. ``coordinates``: the pointing end's, then the other's.
+    """
+
+    def __init__(self, closure: str, pointing: Turns, other: Turns, vector: Vector,
+                 weld: Rotation, spin: tuple[float, tuple[float, float],
+                                             tuple[float, float]] | None) -> None:
+        self.closure = closure
+        self.pointing, self.other = pointing, other
+        self.coordinates = pointing.coordinates + other.coordinates
+        # the other end's centre from P in the pointing end's second turn's frame, and the
+        # other end's last frame's rotation in the pointing end's last frame
+        self.vector, self.weld = vector, weld
+        self.spin = spin
+        self.place = 0
+        self.branches = (1, 1)
+        self.angles: tuple[float, ...] = ()
+
+    def reset(self, equations: LoopEquations, evaluation: Evaluation,
+              values: Sequence[float]) -> float:
+        """
+        Take the branches and angles of an assembled pose (all the tree's coordinates).
+
+        Returns how far the closed forms' angles are from the pose's (rad): rounding, unless
+        the rewriting does not hold (the caller keeps the weld then).
+        """
+        self.place = [name for name, _, _ in equations.closure_rows].index(self.closure)
+        assembled = tuple(values[c] for c in self.coordinates)
+        best = math.inf
+        for branches in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            self.branches, self.angles = branches, assembled
+            try:
+                angles = self.solve(equations, evaluation, None)[0]
+            except OutOfReach:
+                continue
+            gap = max(abs(math.remainder(a - b, 2.0 * math.pi))
+                      for a, b in zip(angles, assembled))
+            if gap < best:
+                best, chosen = gap, branches
+        if best < math.inf:
+            self.branches = chosen
+        self.angles = assembled
+        return best
+
+    def solve(self, equations: LoopEquations, evaluation: Evaluation,
+              rates: Sequence[float] | None) -> tuple[tuple[float, ...], tuple[float, ...], float]:
+        """
+        Return the angles (continued from the last), their rates and conditioning.
+
+        Without ``rates``, the angles only (rates 0, conditioning 1). OutOfReach where the
+        rod's length is not the distance (beyond rounding).
+        """
+        pointing, other = self.pointing, self.other
+        x, center = evaluation.points[self.place]
+        d = subtract(x, center)
+        socket = equations.frame(self.place, 1, evaluation)[0]
+        other_socket = equations.frame(self.place, 0, evaluation)[0]
+        first, second = pointing_angles(pointing.origins[:2], pointing.axes[:2], self.vector,
+                                        apply_transposed(socket, d), self.branches[0])
+        first_turned = multiply(socket, multiply(pointing.origins[0],
+                                                 axis_rotation(pointing.axes[0], first)))
+        second_turned = multiply(first_turned, multiply(pointing.origins[1],
+                                                        axis_rotation(pointing.axes[1], second)))
+        last = self.angles
+        spun = ()
+        if self.spin is None:
+            rod = second_turned
+        else:
+            spun = (last[2],)
+            rod = multiply(second_turned, multiply(pointing.origins[2],
+                                                   axis_rotation(pointing.axes[2], last[2])))
+        relative = multiply(transpose(other_socket), multiply(rod, self.weld))
+        angles = [first, second, *spun, *ball_angles(other.origins, other.axes, relative,
+                                                     self.branches[1])]
+        angles = [previous + math.remainder(angle - previous, 2.0 * math.pi)
+                  for angle, previous in zip(angles, last)]
+        if self.spin is not None:
+            sign, (k_p, k_q), (r_p, r_q) = self.spin
+            # the other ball's third angle moves by s·σ with the spin σ (at σ = last[2] now)
+            base = angles[5] - sign * last[2]
+            angles[2] = (k_p * r_p + k_q * (r_q - base)) / (k_p + k_q * sign)
+            angles[5] = base + sign * angles[2]
+        if rates is None:
+            return tuple(angles), (0.0,) * len(angles), 1.0
+        # (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d = ḋ by its normal equations, as a reduced rod's
+        velocity, spin_rate = equations.relative_motion(self.place, evaluation, rates)
+        w1 = apply(socket, apply(pointing.origins[0], pointing.axes[0]))
+        w2 = apply(first_turned, apply(pointing.origins[1], pointing.axes[1]))
+        d_rate = subtract(velocity, cross(spin_rate, d))
+        c1, c2 = cross(w1, d), cross(w2, d)
+        g11, g12, g22 = dot(c1, c1), dot(c1, c2), dot(c2, c2)
+        det = g11 * g22 - g12 * g12
+        if not det > 0.0:  # the rod along its joint's first axis: refused as singular
+            return tuple(angles), (0.0,) * len(angles), math.inf
+        r1, r2 = dot(c1, d_rate), dot(c2, d_rate)
+        trace = g11 + g22
+        spread = math.sqrt(max(trace * trace - 4.0 * det, 0.0))
+        conditioning = math.sqrt((trace + spread) / max(trace - spread, 1e-300))
+        first_rate, second_rate = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
+        turning = add(spin_rate, add(scale(first_rate, w1), scale(second_rate, w2)))
+        # the other ball: Ω_rod − Ω_socket = Σ θ̇ᵢωᵢ over its three axes
+        relative_rate = subtract(turning, equations.spin(self.place, 0, evaluation, rates))
+        turned = other_socket
+        columns = []
+        for origin, axis, angle in zip(other.origins, other.axes, angles[len(angles) - 3:]):
+            turned = multiply(turned, origin)
+            columns.append(apply(turned, axis))
+            turned = multiply(turned, axis_rotation(axis, angle))
+        ball_rates, ball_conditioning = _solve_columns(columns, relative_rate)
+        if ball_rates is None:  # at the ball's gimbal lock: refused as singular
+            return tuple(angles), (0.0,) * len(angles), math.inf
+        rates_out = [first_rate, second_rate, *([0.0] if self.spin is not None else []),
+                     *ball_rates]
+        if self.spin is not None:
+            sign, (k_p, k_q), _ = self.spin
+            rates_out[2] = -k_q * rates_out[5] / (k_p + k_q * sign)
+            rates_out[5] += sign * rates_out[2]
+        return tuple(angles), tuple(rates_out), max(conditioning, ball_conditioning)
+
+
+def _solve_columns(columns: Sequence[Vector],
+                   rhs: Vector) -> tuple[list[float] | None, float]:
+    """Return x with [c₁ c₂ c₃]·x = rhs (Cramer) and the matrix's κ₁, or None if singular."""
+    c1, c2, c3 = columns
+    rows = (cross(c2, c3), cross(c3, c1), cross(c1, c2))  # the inverse's rows times det
+    det = dot(c1, rows[0])
+    if det == 0.0:
+        return None, math.inf
+    norm_matrix = max(abs(c[0]) + abs(c[1]) + abs(c[2]) for c in columns)
+    norm_inverse = max(sum(abs(row[k]) for row in rows) for k in range(3)) / abs(det)
+    return [dot(row, rhs) / det for row in rows], norm_matrix * norm_inverse
+
+
 @dataclass(frozen=True)
 class Reduction:
     """
     A group with its closures rewritten (module docstring).
 
     ``group`` moves only the coordinates the rewritten closures move (the same known ones);
-    ``structure`` has the idle freedoms without those the followers hold; ``followers`` give
-    the coordinates taken out, per sample.
+    ``structure`` has the idle freedoms without those the followers hold; ``distances`` the
+    welded rods written as a distance (equations.LoopEquations); ``followers`` give the
+    coordinates taken out, per sample.
     """
 
     group: ClosureGroup
     structure: GroupStructure
-    followers: tuple[PinPair, ...]
-
-    @property
-    def coordinates(self) -> frozenset[int]:
-        """Return the coordinates the followers give."""
-        return frozenset(c for follower in self.followers for c in follower.coordinates)
+    followers: tuple[PinPair | WeldRod, ...]
+    distances: dict[str, Distance] = dataclasses.field(default_factory=dict)
 
 
 def reduce_group(tree: KinematicTree, group: ClosureGroup, structure: GroupStructure,
@@ -153,77 +321,159 @@ def reduce_group(tree: KinematicTree, group: ClosureGroup, structure: GroupStruc
     links = {frame: link for link, (frame, offset) in tree.links.items()
              if offset == IDENTITY_POSE}
     closures: list[Closure] = []
-    followers: list[PinPair] = []
+    followers: list[PinPair | WeldRod] = []
+    distances: dict[str, Distance] = {}
     held: set[int] = set()
     for closure, loop in zip(group.closures, loops):
-        pair = None
-        if closure.kind is ClosureKind.WELD:
-            turns = [_end_turn(tree, loop, side, group, count) for side in (0, 1)]
-            if None not in turns:
-                pair = _pin_pair(tree, structure, closure, turns, frames, links, values)
-        if pair is None:
-            closures.append(closure)
+        closures.append(closure)
+        if closure.kind is not ClosureKind.WELD:
             continue
-        pin, follower, idle = pair
-        closures.append(pin)
+        ends = [_end_turns(tree, loop, side, group, count) for side in (0, 1)]
+        if None in ends:
+            continue
+        rod = _weld_rod(tree, structure, closure, ends, values)
+        if rod is not None:
+            distance, follower, idle = rod
+            distances[closure.name] = distance
+        else:
+            last = [_last_turn(end) for end in ends]
+            pair = _pin_pair(tree, structure, closure, last, frames, links, values)
+            if pair is None:
+                continue
+            closures[-1], follower, idle = pair
         followers.append(follower)
-        held.add(idle)
+        if idle is not None:
+            held.add(idle)
     taken = {c for follower in followers for c in follower.coordinates}
     reduced = ClosureGroup(tuple(closures),
                            tuple(c for c in group.coordinates if c not in taken), group.known)
     kept = tuple(idle for place, idle in enumerate(structure.idle) if place not in held)
-    return Reduction(reduced, dataclasses.replace(structure, idle=kept), tuple(followers))
+    return Reduction(reduced, dataclasses.replace(structure, idle=kept), tuple(followers),
+                     distances)
 
 
-def _end_turn(tree: KinematicTree, loop: Loop, side: int, group: ClosureGroup,
-              count: dict[int, int]) -> EndTurn | None:
-    """Return the plain unknown turn a closure side's path ends in, its frame on its link."""
+def _end_turns(tree: KinematicTree, loop: Loop, side: int, group: ClosureGroup,
+               count: dict[int, int]) -> Turns | None:
+    """Return the (up to three) plain unknown turns a closure side's path ends in, or None."""
     path = loop.paths[side]
     frame, offset = loop.sides[side]
     if not path or frame != path[-1] + 1:
         return None
-    step = tree.steps[path[-1]]
-    if (step.kind is not MotionKind.TURN or step.multiplier != 1.0 or step.offset != 0.0
-            or step.coordinate in group.known or count[step.coordinate] != 1):
+    steps: list[int] = []
+    for index in reversed(path):
+        step = tree.steps[index]
+        if (step.kind is not MotionKind.TURN or step.multiplier != 1.0 or step.offset != 0.0
+                or step.coordinate in group.known or count[step.coordinate] != 1):
+            break
+        if steps:
+            below = tree.steps[steps[-1]]
+            if below.parent != index + 1 or below.origin.position != ZERO:
+                break
+        steps.append(index)
+        if len(steps) == 3:
+            break
+    if not steps:
         return None
-    return EndTurn(path[-1], step.coordinate, step.parent, step.origin, step.axis, offset)
+    steps.reverse()
+    first = tree.steps[steps[0]]
+    return Turns(tuple(steps), tuple(tree.steps[i].coordinate for i in steps), first.parent,
+                 first.origin.position, tuple(tree.steps[i].origin.rotation for i in steps),
+                 tuple(tree.steps[i].axis for i in steps), offset)
+
+
+def _last_turn(turns: Turns) -> Turns:
+    """Return the last of the turns on its own (its socket the frame above it)."""
+    if len(turns.steps) == 1:
+        return turns
+    return Turns(turns.steps[-1:], turns.coordinates[-1:], turns.steps[-2] + 1, ZERO,
+                 turns.origins[-1:], turns.axes[-1:], turns.offset)
+
+
+def _idle_of(tree: KinematicTree, structure: GroupStructure,
+             coordinates: Sequence[int]) -> tuple[int, tuple[float, ...]] | None:
+    """Return the idle freedom that moves exactly ``coordinates``, and its components there."""
+    names = [tree.coordinates[c].name for c in coordinates]
+    for place, freedom in enumerate(structure.idle):
+        if set(freedom.joints) == set(names):
+            solved = list(structure.solved)
+            return place, tuple(freedom.direction[solved.index(name)] for name in names)
+    return None
+
+
+def _weld_rod(tree: KinematicTree, structure: GroupStructure, closure: Closure,
+              ends: list[Turns], values: Sequence[float]
+              ) -> tuple[Distance, WeldRod, int | None] | None:
+    """Return a welded rod's distance, its follower and the idle freedom it holds, or None."""
+    a, b = ends
+    if min(len(a.steps), len(b.steps)) < 2 or len(a.steps) + len(b.steps) < 5:
+        return None
+    # b's last frame in a's last frame: its rotation, and its origin (b's centre) from a's
+    weld = multiply(a.offset.rotation, transpose(b.offset.rotation))
+    vector = subtract(a.offset.position, apply(weld, b.offset.position))
+    length = norm(vector)
+    if not length > COINCIDENT * structure.size:
+        return None
+    back = scale(-1.0, apply_transposed(weld, vector))  # a's centre from b's, in b's frame
+    spin = None
+    if len(a.steps) == 2:
+        pointing, other, rotation = a, b, weld
+    elif len(b.steps) == 2:
+        pointing, other, rotation, vector = b, a, transpose(weld), back
+    else:
+        # two balls: each third turn must spin the rod about its own line, the idle freedom
+        # moving just those two
+        if (norm(cross(a.axes[2], vector)) > COINCIDENT * length
+                or norm(cross(b.axes[2], back)) > COINCIDENT * length):
+            return None
+        idle = _idle_of(tree, structure, (a.coordinates[2], b.coordinates[2]))
+        if idle is None:
+            return None
+        sign = 1.0 if dot(a.axes[2], apply(weld, b.axes[2])) > 0.0 else -1.0
+        coefficients = idle[1]
+        if abs(coefficients[0] + coefficients[1] * sign) < 0.5:
+            return None
+        spin = (sign, (coefficients[0], coefficients[1]),
+                (values[a.coordinates[2]], values[b.coordinates[2]]))
+        pointing, other, rotation = a, b, weld
+        # the pointing end's third turn leaves the rod's line: seen before it
+        vector = apply(a.origins[2], vector)
+    points: list[tuple[int, Vector] | None] = [(a.socket, a.center), (b.socket, b.center)]
+    distance = Distance(closure.name, (points[0], points[1]), frozenset(a.steps + b.steps),
+                        0 if pointing is a else 1, length)
+    follower = WeldRod(closure.name, pointing, other, vector, rotation, spin)
+    return distance, follower, None if spin is None else idle[0]
 
 
 def _pin_pair(tree: KinematicTree, structure: GroupStructure, closure: Closure,
-              turns: list[EndTurn], frames: Sequence[Pose], links: dict[int, str],
+              turns: list[Turns], frames: Sequence[Pose], links: dict[int, str],
               values: Sequence[float]) -> tuple[Closure, PinPair, int] | None:
     """Return a weld's pin closure, its follower and the idle freedom it holds, or None."""
     first, second = turns
     if first.socket not in links or second.socket not in links:
         return None
-    names = {tree.coordinates[first.coordinate].name, tree.coordinates[second.coordinate].name}
-    idle = next((place for place, freedom in enumerate(structure.idle)
-                 if set(freedom.joints) == names), None)
+    idle = _idle_of(tree, structure, (first.coordinates[0], second.coordinates[0]))
     if idle is None:
         return None
     # the first turn's origin, carried through the weld to the second's link, then (on its
     # axis, which its turn does not move) into the second's socket
     through = multiply(second.offset.rotation, transpose(first.offset.rotation))
     point = subtract(second.offset.position, apply(through, first.offset.position))
-    point = tuple(o + x for o, x in zip(second.origin.position,
-                                        apply(second.origin.rotation, point)))
-    axes = (apply(first.origin.rotation, first.axis), apply(second.origin.rotation, second.axis))
+    point = add(second.center, apply(second.origins[0], point))
+    axes = (apply(first.origins[0], first.axes[0]), apply(second.origins[0], second.axes[0]))
     world = [frames[turn.socket] for turn in turns]
     directions = [apply(pose.rotation, axis) for pose, axis in zip(world, axes)]
-    points = [world[0].then(Pose(first.origin.rotation, first.origin.position)).position,
-              world[1].then(Pose(second.origin.rotation, point)).position]
+    points = [world[0].then(Pose(first.origins[0], first.center)).position,
+              world[1].then(Pose(second.origins[0], point)).position]
     if (norm(cross(*directions)) > COINCIDENT
             or norm(subtract(points[0], points[1])) > COINCIDENT * structure.size):
         return None
     sign = 1.0 if dot(*directions) > 0.0 else -1.0
-    solved = list(structure.solved)
-    direction = structure.idle[idle].direction
-    coefficients = tuple(direction[solved.index(tree.coordinates[turn.coordinate].name)]
-                         for turn in turns)
+    coefficients = idle[1]
     if abs(coefficients[0] * sign + coefficients[1]) < 0.5:
         return None
     pin = Closure(closure.name, ClosureKind.PIN,
-                  ClosureSide(links[first.socket], first.origin.position, axis=axes[0]),
+                  ClosureSide(links[first.socket], first.center, axis=axes[0]),
                   ClosureSide(links[second.socket], point, axis=axes[1]), closure.encoding)
-    reference = (values[first.coordinate], values[second.coordinate])
-    return pin, PinPair(closure.name, (first, second), sign, coefficients, reference), idle
+    reference = (values[first.coordinates[0]], values[second.coordinates[0]])
+    return (pin, PinPair(closure.name, (first, second), sign, (coefficients[0], coefficients[1]),
+                         reference), idle[0])
