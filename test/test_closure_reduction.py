@@ -42,6 +42,9 @@ MODELS = {
     'digit_like': ([GroupKind.NEWTON, GroupKind.NEWTON], [3, 4], (1, 99)),
     # a rod on a universal joint welded to a ball of three turns (7 and 14)
     'battobot_6d': ([GroupKind.NEWTON] * 4, [2, 2, 4, 4], (1, 99)),
+    # five legs of a hexapod, each a ball, a motor's slide and a ball: rods their motors
+    # lengthen (42; Newton is left the sixth leg's two balls, 6 unknowns, was 36)
+    'wl16_like': ([GroupKind.NEWTON], [12], (1, 99)),
 }
 
 

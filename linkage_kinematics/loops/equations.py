@@ -116,6 +116,10 @@ class Distance:
     trimmed: frozenset[int]
     center: int
     length: float
+    # known slides inside the rod: L = |span + Σ (m·q + o)·u| over (coordinate, m, o, unit u),
+    # span and u in one frame of the rod (empty: L = ``length``)
+    stretch: tuple[tuple[int, float, float, Vector], ...] = ()
+    span: Vector = (0.0, 0.0, 0.0)
 
 
 def rod_distance(rod: Rod) -> Distance:
@@ -202,7 +206,8 @@ class LoopEquations:
                            for path in trimmed]
             paths.append(trimmed)
         self.coordinates: tuple[int, ...] = tuple(sorted(
-            {tree.steps[step].coordinate for sides in paths for path in sides for step in path}))
+            {tree.steps[step].coordinate for sides in paths for path in sides for step in path}
+            | {slide[0] for distance in distances.values() for slide in distance.stretch}))
         self.names = tuple(tree.coordinates[i].name for i in self.coordinates)
         column = {coordinate: i for i, coordinate in enumerate(self.coordinates)}
         bases = sorted({loop.base for loop in loops})
@@ -294,7 +299,7 @@ class LoopEquations:
                                 _side_point(record[3], evaluation)))
             angle = None
             if form is _Form.DISTANCE:
-                gap = abs(gap - record[4])
+                gap = abs(gap - _length(record, evaluation.values))
             elif form is _Form.PIN:
                 n_a = apply(_frame_rotation(record[2], evaluation), record[4])
                 n_b = apply(_frame_rotation(record[3], evaluation), record[5])
@@ -399,7 +404,8 @@ def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[in
     closure = loop.closure
     if distance is not None:
         x, center = (b, a) if distance.center == 0 else (a, b)
-        return (_Form.DISTANCE, None, x, center, distance.length)
+        stretch = tuple((column[c], m, o, u) for c, m, o, u in distance.stretch)
+        return (_Form.DISTANCE, None, x, center, distance.length, distance.span, stretch)
     if closure.kind is ClosureKind.BALL:
         return (_Form.BALL, None, a, b)
     if closure.kind is ClosureKind.WELD:
@@ -441,13 +447,31 @@ def _point_rate(side: tuple, evaluation: Evaluation, motion: Motion) -> Vector:
                         _side_point(side, evaluation))
 
 
+def _span(record: tuple, values: Sequence[float]) -> Vector | None:
+    """Return a distance's rod vector with its known slides at ``values`` (None: no slides)."""
+    stretch = record[6]
+    if not stretch:
+        return None
+    x, y, z = record[5]
+    for col, multiplier, offset, (ux, uy, uz) in stretch:
+        travel = multiplier * values[col] + offset
+        x, y, z = x + travel * ux, y + travel * uy, z + travel * uz
+    return (x, y, z)
+
+
+def _length(record: tuple, values: Sequence[float]) -> float:
+    """Return a distance's length L at ``values`` (its known slides moved)."""
+    span = _span(record, values)
+    return record[4] if span is None else norm(span)
+
+
 def _residual(record: tuple, evaluation: Evaluation,
               points: tuple[Vector, Vector]) -> list[float]:
     form, _, a, b = record[:4]
     p_a, p_b = points
     dx, dy, dz = p_a[0] - p_b[0], p_a[1] - p_b[1], p_a[2] - p_b[2]
     if form is _Form.DISTANCE:
-        length = record[4]
+        length = _length(record, evaluation.values)
         return [(dx * dx + dy * dy + dz * dz - length * length) / (2.0 * length)]
     rows = [dx, dy, dz]
     if form is _Form.PIN:
@@ -467,10 +491,17 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
     if form is _Form.DISTANCE:
         # ∂/∂q of (|d|² − L²)/(2L) = d·(screw at x − screw at P)/L, d·(ω × (p − o)) written as
         # ω·((p − o) × d)
-        length = record[4]
+        span = _span(record, evaluation.values)
+        length = record[4] if span is None else norm(span)
         dx, dy, dz = ((p_a[0] - p_b[0]) / length, (p_a[1] - p_b[1]) / length,
                       (p_a[2] - p_b[2]) / length)
         row = [0.0] * width
+        if span is not None:
+            # a known slide stretches the rod: ∂r/∂L = −(|d|² + L²)/(2L²), ∂L/∂q = m·(u·ℓ)/L
+            factor = -(dx * dx + dy * dy + dz * dz + 1.0) / (2.0 * length)
+            for col, multiplier, _, direction in record[6]:
+                if columns is None or col in columns:
+                    row[col] += factor * multiplier * dot(direction, span)
         for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
             _, _, axes, origins = evaluation.frames[side[0]]
             for place, col, multiplier, turn in side[4]:
@@ -543,8 +574,8 @@ def _rate_rows(record: tuple, evaluation: Evaluation, motion: Motion,
             yield (place, col, multiplier, turn, w, _screw(frames, place, turn, point),
                    motion.screw_rate(side[0], place, turn, w, o, point, velocity))
 
-    if form is _Form.DISTANCE:
-        length = record[4]
+    if form is _Form.DISTANCE:  # (of a rod without known slides: the unreduced equations')
+        length = _length(record, evaluation.values)
         d, d_rate = subtract(p_a, p_b), subtract(v_a, v_b)
         row = [0.0] * width
         for side, point, velocity, sign in ((a, p_a, v_a, 1.0), (b, p_b, v_b, -1.0)):

@@ -19,9 +19,12 @@ unknowns and six rows where a distance is one row):
   (closed_forms.ball_angles). Two balls leave the rod free to spin about its line: rewritten
   only where each ball's third turn is that spin and the two are an idle freedom, σ and s·σ
   (s = ±1 as the axes point), held by its equation; the first ball's first two turns then
-  point the rod. Rates: the pointing turns from ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d as a reduced
-  rod's, the ball's from Ω_rod − Ω_socket = Σ θ̇ᵢωᵢ (its three world axes; their κ is the
-  ball's closeness to its gimbal lock, refused as any conditioning).
+  point the rod. Known slides along the rod between a ball and the weld (wl16_like's legs,
+  which motors lengthen) make L = |span + Σ (m·q + o)·u|, per sample. Rates: the pointing
+  turns from ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d + L̇·d/L as a reduced rod's (its normal
+  equations see only the part across d), the ball's from Ω_rod − Ω_socket = Σ θ̇ᵢωᵢ (its
+  three world axes; their κ is the ball's closeness to its gimbal lock, refused as any
+  conditioning).
 * **Two collinear pins welded.** Each side's path ends in a plain turn carrying the side's frame
   (no mimic), the two turns' axes on one line, and the combination of the two that moves
   nothing is an idle freedom (the five-bar, the delta; a welded rod's two spins where the rod
@@ -59,6 +62,7 @@ from linkage_kinematics.loops.spatial import (
     axis_rotation,
     cross,
     dot,
+    IDENTITY,
     multiply,
     norm,
     perpendicular_pair,
@@ -93,8 +97,10 @@ class Turns:
     # each turn's joint frame rotation in the frame above it, and its unit axis there
     origins: tuple[Rotation, ...]
     axes: tuple[Vector, ...]
-    # the closure side's frame in the last turn's moving frame
+    # the closure side's frame in the last turn's moving frame, known slides below the turns
+    # at 0; each slide as (coordinate, multiplier, offset, unit axis in that frame)
     offset: Pose
+    slides: tuple[tuple[int, float, float, Vector], ...] = ()
 
 
 class PinPair:
@@ -160,16 +166,18 @@ class WeldRod:
     equation. ``coordinates``: the pointing end's, then the other's.
     """
 
-    def __init__(self, closure: str, pointing: Turns, other: Turns, vector: Vector,
-                 weld: Rotation, spin: tuple[float, tuple[float, float],
-                                             tuple[float, float]] | None) -> None:
+    def __init__(self, closure: str, pointing: Turns, other: Turns, span: Vector,
+                 stretch: tuple[tuple[int, float, float, Vector], ...], weld: Rotation,
+                 spin: tuple[float, tuple[float, float], tuple[float, float]] | None) -> None:
         self.closure = closure
         self.pointing, self.other = pointing, other
         self.coordinates = pointing.coordinates + other.coordinates
-        # the other end's centre from P in the pointing end's second turn's frame, and the
-        # other end's last frame's rotation in the pointing end's last frame
-        self.vector, self.weld = vector, weld
+        # the other end's centre from P in the pointing end's second turn's frame, span + Σ
+        # (m·q + o)·u over the known slides in the rod; the other end's last frame's rotation
+        # in the pointing end's last frame
+        self.span, self.stretch, self.weld = span, stretch, weld
         self.spin = spin
+        self.slide_columns: list[int] = []
         self.place = 0
         self.branches = (1, 1)
         self.angles: tuple[float, ...] = ()
@@ -183,6 +191,7 @@ class WeldRod:
         the rewriting does not hold (the caller keeps the weld then).
         """
         self.place = [name for name, _, _ in equations.closure_rows].index(self.closure)
+        self.slide_columns = [equations.coordinates.index(c) for c, *_ in self.stretch]
         assembled = tuple(values[c] for c in self.coordinates)
         best = math.inf
         for branches in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
@@ -213,7 +222,12 @@ class WeldRod:
         d = subtract(x, center)
         socket = equations.frame(self.place, 1, evaluation)[0]
         other_socket = equations.frame(self.place, 0, evaluation)[0]
-        first, second = pointing_angles(pointing.origins[:2], pointing.axes[:2], self.vector,
+        x, y, z = self.span
+        for column, (_, multiplier, offset, (ux, uy, uz)) in zip(self.slide_columns,
+                                                                 self.stretch):
+            travel = multiplier * evaluation.values[column] + offset
+            x, y, z = x + travel * ux, y + travel * uy, z + travel * uz
+        first, second = pointing_angles(pointing.origins[:2], pointing.axes[:2], (x, y, z),
                                         apply_transposed(socket, d), self.branches[0])
         first_turned = multiply(socket, multiply(pointing.origins[0],
                                                  axis_rotation(pointing.axes[0], first)))
@@ -336,6 +350,8 @@ def reduce_group(tree: KinematicTree, group: ClosureGroup, structure: GroupStruc
             distance, follower, idle = rod
             distances[closure.name] = distance
         else:
+            if any(end.slides for end in ends):
+                continue
             last = [_last_turn(end) for end in ends]
             pair = _pin_pair(tree, structure, closure, last, frames, links, values)
             if pair is None:
@@ -354,13 +370,23 @@ def reduce_group(tree: KinematicTree, group: ClosureGroup, structure: GroupStruc
 
 def _end_turns(tree: KinematicTree, loop: Loop, side: int, group: ClosureGroup,
                count: dict[int, int]) -> Turns | None:
-    """Return the (up to three) plain unknown turns a closure side's path ends in, or None."""
+    """
+    Return the (up to three) plain unknown turns a closure side's path ends in, or None.
+
+    Known slides may follow them (a rod a motor lengthens): the side's frame is then on the
+    last slide's link, and moves along the slides' axes.
+    """
     path = loop.paths[side]
     frame, offset = loop.sides[side]
     if not path or frame != path[-1] + 1:
         return None
+    end = len(path)
+    while end > 1 and tree.steps[path[end - 1]].kind is MotionKind.SLIDE and (
+            tree.steps[path[end - 1]].coordinate in group.known
+            and tree.steps[path[end - 1]].parent == path[end - 2] + 1):
+        end -= 1
     steps: list[int] = []
-    for index in reversed(path):
+    for index in reversed(path[:end]):
         step = tree.steps[index]
         if (step.kind is not MotionKind.TURN or step.multiplier != 1.0 or step.offset != 0.0
                 or step.coordinate in group.known or count[step.coordinate] != 1):
@@ -374,11 +400,22 @@ def _end_turns(tree: KinematicTree, loop: Loop, side: int, group: ClosureGroup,
             break
     if not steps:
         return None
+    if end < len(path) and path[end - 1] != steps[0]:
+        return None
     steps.reverse()
+    # the side's frame through the slides (at 0), in the last turn's frame: a slide turns
+    # nothing, so each moves it along its axis as it is seen there
+    pose, slides = Pose(IDENTITY, ZERO), []
+    for index in path[end:]:
+        step = tree.steps[index]
+        pose = pose.then(step.origin)
+        slides.append((step.coordinate, step.multiplier, step.offset,
+                       apply(pose.rotation, step.axis)))
     first = tree.steps[steps[0]]
-    return Turns(tuple(steps), tuple(tree.steps[i].coordinate for i in steps), first.parent,
+    return Turns(tuple(steps) + tuple(path[end:]),
+                 tuple(tree.steps[i].coordinate for i in steps), first.parent,
                  first.origin.position, tuple(tree.steps[i].origin.rotation for i in steps),
-                 tuple(tree.steps[i].axis for i in steps), offset)
+                 tuple(tree.steps[i].axis for i in steps), pose.then(offset), tuple(slides))
 
 
 def _last_turn(turns: Turns) -> Turns:
@@ -405,25 +442,31 @@ def _weld_rod(tree: KinematicTree, structure: GroupStructure, closure: Closure,
               ) -> tuple[Distance, WeldRod, int | None] | None:
     """Return a welded rod's distance, its follower and the idle freedom it holds, or None."""
     a, b = ends
-    if min(len(a.steps), len(b.steps)) < 2 or len(a.steps) + len(b.steps) < 5:
+    turns = (len(a.axes), len(b.axes))
+    if min(turns) < 2 or sum(turns) < 5:
         return None
-    # b's last frame in a's last frame: its rotation, and its origin (b's centre) from a's
+    # b's last frame in a's last frame: its rotation, and its origin (b's centre) from a's,
+    # as the known slides in the rod move it: span + Σ (m·q + o)·u
     weld = multiply(a.offset.rotation, transpose(b.offset.rotation))
-    vector = subtract(a.offset.position, apply(weld, b.offset.position))
-    length = norm(vector)
+    span = subtract(a.offset.position, apply(weld, b.offset.position))
+    stretch = a.slides + tuple((c, m, o, scale(-1.0, apply(weld, u))) for c, m, o, u in b.slides)
+    length = norm(span)
     if not length > COINCIDENT * structure.size:
         return None
-    back = scale(-1.0, apply_transposed(weld, vector))  # a's centre from b's, in b's frame
     spin = None
-    if len(a.steps) == 2:
-        pointing, other, rotation = a, b, weld
-    elif len(b.steps) == 2:
-        pointing, other, rotation, vector = b, a, transpose(weld), back
+    if turns[0] == 2:
+        pointing, other, rotation, into = a, b, weld, IDENTITY
+    elif turns[1] == 2:
+        # seen from b: a's centre, in b's last frame
+        pointing, other, rotation = b, a, transpose(weld)
+        into = tuple(-x for x in rotation)
     else:
-        # two balls: each third turn must spin the rod about its own line, the idle freedom
-        # moving just those two
-        if (norm(cross(a.axes[2], vector)) > COINCIDENT * length
-                or norm(cross(b.axes[2], back)) > COINCIDENT * length):
+        # two balls: each third turn must spin the rod about its own line (the known slides
+        # along it too), the idle freedom moving just those two
+        line = [span] + [u for *_, u in stretch]
+        if any(norm(cross(a.axes[2], v)) > COINCIDENT * norm(v) for v in line if norm(v)):
+            return None
+        if norm(cross(a.axes[2], apply(weld, b.axes[2]))) > COINCIDENT:
             return None
         idle = _idle_of(tree, structure, (a.coordinates[2], b.coordinates[2]))
         if idle is None:
@@ -434,13 +477,14 @@ def _weld_rod(tree: KinematicTree, structure: GroupStructure, closure: Closure,
             return None
         spin = (sign, (coefficients[0], coefficients[1]),
                 (values[a.coordinates[2]], values[b.coordinates[2]]))
-        pointing, other, rotation = a, b, weld
         # the pointing end's third turn leaves the rod's line: seen before it
-        vector = apply(a.origins[2], vector)
-    points: list[tuple[int, Vector] | None] = [(a.socket, a.center), (b.socket, b.center)]
-    distance = Distance(closure.name, (points[0], points[1]), frozenset(a.steps + b.steps),
-                        0 if pointing is a else 1, length)
-    follower = WeldRod(closure.name, pointing, other, vector, rotation, spin)
+        pointing, other, rotation, into = a, b, weld, a.origins[2]
+    distance = Distance(closure.name, ((a.socket, a.center), (b.socket, b.center)),
+                        frozenset(a.steps + b.steps), 0 if pointing is a else 1, length,
+                        stretch, span)
+    follower = WeldRod(closure.name, pointing, other, apply(into, span),
+                       tuple((c, m, o, apply(into, u)) for c, m, o, u in stretch), rotation,
+                       spin)
     return distance, follower, None if spin is None else idle[0]
 
 
