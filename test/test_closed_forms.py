@@ -15,13 +15,13 @@ from __future__ import annotations
 import math
 
 from linkage_kinematics.loops.closed_forms import (
-    ball_angles,
     circle_intersection,
     crank_to_sphere,
     OutOfReach,
     slide_to_sphere,
     three_spheres,
     turn_to,
+    TurnChain,
 )
 from linkage_kinematics.loops.spatial import add, apply, axis_rotation, norm, scale, subtract
 from mpmath import mp, mpf
@@ -118,7 +118,9 @@ def test_a_ball_of_three_turns_makes_a_rotation_with_either_angle_triple():
         for angles in ((0.3, -1.2, 2.5), (-2.0, 0.7, -0.1), (1.0, 1.5, 0.2)):
             target = rotation_50(origins, axes, angles)
             rotation = tuple(float(target[i, j]) for i in range(3) for j in range(3))
-            triples = [ball_angles(origins, axes, rotation, branch) for branch in (1, -1)]
+            ball = TurnChain(origins, axes)
+            images = apply(rotation, axes[2]), apply(rotation, ball.across)
+            triples = [ball.ball(*images, branch) for branch in (1, -1)]
             for found in triples:
                 made = rotation_50(origins, axes, found)
                 assert max(abs(float(made[i, j] - target[i, j])) for i in range(3)

@@ -68,20 +68,12 @@ from linkage_kinematics.loops.closed_forms import (
     FiveBarPositions,
     LegPositions,
     OutOfReach,
-    universal_angles,
-    universal_branch,
+    TurnChain,
 )
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, inverse, solve
 from linkage_kinematics.loops.reduction import reduce_group, Reduction
-from linkage_kinematics.loops.spatial import (
-    apply,
-    apply_transposed,
-    cross,
-    dot,
-    subtract,
-    turn_vector,
-)
+from linkage_kinematics.loops.spatial import apply_transposed, cross, dot, subtract
 from linkage_kinematics.loops.structure import (
     analyse,
     classify,
@@ -241,11 +233,11 @@ class _Rods:
     def __init__(self, equations: LoopEquations, unknown: Sequence[int], rods: dict) -> None:
         names = [name for name, _, _ in equations.closure_rows]
         self.equations = equations
-        # (closure place, rod, outputs: the rod's coordinates' places in ``unknown``, the
-        # first axis in the socket frame, the second in the frame the first turns)
+        # (closure place, rod, outputs: the rod's coordinates' places in ``unknown``, its
+        # universal joint's turns)
         self.rods = [(names.index(name), rod, [list(unknown).index(c)
                                                for c in rod.coordinates],
-                      apply(rod.origins[0], rod.axes[0]), apply(rod.origins[1], rod.axes[1]))
+                      TurnChain(rod.origins, rod.axes))
                      for name, rod in rods.items()]
         self.coordinates = {c for rod in rods.values() for c in rod.coordinates}
         self.branches: list[int] = []
@@ -253,9 +245,10 @@ class _Rods:
 
     def reset(self, evaluation: Evaluation, values: Sequence[float]) -> None:
         """Take each rod's branch and angles at an assembled pose (all the tree's values)."""
-        self.branches = [universal_branch(rod, self.target(place, evaluation)[0],
-                                          values[rod.coordinates[1]])
-                         for place, rod, *_ in self.rods]
+        self.branches = [min((1, -1), key=lambda branch: abs(math.remainder(
+            chain.pointing(rod.rod, self.target(place, evaluation)[0], branch)[1]
+            - values[rod.coordinates[1]], 2.0 * math.pi)))
+            for place, rod, _, chain in self.rods]
         self.angles = [[values[c] for c in rod.coordinates] for _, rod, *_ in self.rods]
 
     def target(self, place: int, evaluation: Evaluation) -> tuple:
@@ -271,11 +264,10 @@ class _Rods:
               ) -> list[tuple[list[float], tuple[float, float], float]]:
         """Return per rod its angles (continued), their rates and the rates' conditioning."""
         results = []
-        for (place, rod, _, axis1_local, second), branch, last in zip(
-                self.rods, self.branches, self.angles):
+        for (place, rod, _, chain), branch, last in zip(self.rods, self.branches, self.angles):
             target, d, socket = self.target(place, evaluation)
             try:
-                angles = universal_angles(rod, target, branch)
+                angles = chain.pointing(rod.rod, target, branch)
             except OutOfReach as error:
                 raise refuse(Refusal.UNREACHABLE, f'rod of {rod.closure}: {error}') from None
             angles = [angle if abs(angle - previous) <= math.pi else angle - 2.0 * math.pi
@@ -283,9 +275,8 @@ class _Rods:
                       for angle, previous in zip(angles, last)]
             # the joint's axes in the base frame: the first fixed on the socket, the second
             # turned with the first
-            axis1 = apply(socket, axis1_local)
-            axis2 = apply(socket, apply(rod.origins[0], turn_vector(rod.axes[0], angles[0],
-                                                                    second)))
+            axis1, axis2 = chain.world_axes(socket, [(math.cos(angles[0]),
+                                                      math.sin(angles[0]))])
             # ḋ = (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d: the rod turns with its socket too
             velocity, spin = self.equations.relative_motion(place, evaluation, rates)
             d_rate = subtract(velocity, cross(spin, d))
@@ -607,7 +598,7 @@ class GroupSolver:
             raise self._refuse(Refusal.ASSEMBLY_CHANGE, 'the sign of det A changed')
         positions = [values[c] if c is not None else 0.0 for c in self._outputs]
         speeds = [rates[c] if c is not None else 0.0 for c in self._outputs]
-        for (angles, angle_rates, _), (_, _, outputs, _, _) in zip(rods, self._rods.rods):
+        for (angles, angle_rates, _), (_, _, outputs, _) in zip(rods, self._rods.rods):
             for output, angle, rate in zip(outputs, angles, angle_rates):
                 positions[output], speeds[output] = angle, rate
         for (angles, angle_rates, _), outputs in zip(followed, self._follower_outputs):

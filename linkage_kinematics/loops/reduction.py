@@ -14,9 +14,9 @@ unknowns and six rows where a distance is one row):
   SPHERICAL and UJOINT overrides), carrying the side's frame, the two points apart: the two
   links welded are one rod between the two points, and the weld is the distance between
   them, |x − P| = L (one row; equations.Distance). The joints follow from the rod's
-  direction (``WeldRod``): a universal end points the rod (closed_forms.pointing_angles), the
-  rod's rotation is then known and the ball at the other end turns to it
-  (closed_forms.ball_angles). Two balls leave the rod free to spin about its line: rewritten
+  direction (``WeldRod``): a universal end points the rod (closed_forms.TurnChain.pointing),
+  the rod's rotation is then known and the ball at the other end turns to it
+  (closed_forms.TurnChain.ball). Two balls leave the rod free to spin about its line: rewritten
   only where each ball's third turn is that spin and the two are an idle freedom, σ and s·σ
   (s = ±1 as the axes point), held by its equation; the first ball's first two turns then
   point the rod. Known slides along the rod between a ball and the weld (wl16_like's legs,
@@ -52,14 +52,13 @@ import dataclasses
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.loops.closed_forms import ball_angles, OutOfReach, pointing_angles
+from linkage_kinematics.loops.closed_forms import OutOfReach, TurnChain
 from linkage_kinematics.loops.closures import Closure, ClosureKind, ClosureSide
 from linkage_kinematics.loops.equations import Distance, Evaluation, LoopEquations
 from linkage_kinematics.loops.spatial import (
     add,
     apply,
     apply_transposed,
-    axis_rotation,
     cross,
     dot,
     IDENTITY,
@@ -170,12 +169,15 @@ class WeldRod:
                  stretch: tuple[tuple[int, float, float, Vector], ...], weld: Rotation,
                  spin: tuple[float, tuple[float, float], tuple[float, float]] | None) -> None:
         self.closure = closure
-        self.pointing, self.other = pointing, other
+        self.pointing = TurnChain(pointing.origins, pointing.axes)
+        self.other = TurnChain(other.origins, other.axes)
         self.coordinates = pointing.coordinates + other.coordinates
         # the other end's centre from P in the pointing end's second turn's frame, span + Σ
-        # (m·q + o)·u over the known slides in the rod; the other end's last frame's rotation
-        # in the pointing end's last frame
-        self.span, self.stretch, self.weld = span, stretch, weld
+        # (m·q + o)·u over the known slides in the rod
+        self.span, self.stretch = span, stretch
+        # the other ball's third axis and a unit vector across it, in its last frame, and both
+        # seen in the pointing end's last frame through the weld
+        self.welded = (apply(weld, other.axes[2]), apply(weld, self.other.across))
         self.spin = spin
         self.slide_columns: list[int] = []
         self.place = 0
@@ -217,33 +219,29 @@ class WeldRod:
         Without ``rates``, the angles only (rates 0, conditioning 1). OutOfReach where the
         rod's length is not the distance (beyond rounding).
         """
-        pointing, other = self.pointing, self.other
-        x, center = evaluation.points[self.place]
-        d = subtract(x, center)
-        socket = equations.frame(self.place, 1, evaluation)[0]
-        other_socket = equations.frame(self.place, 0, evaluation)[0]
+        pointing, other, place = self.pointing, self.other, self.place
+        (xx, xy, xz), (px, py, pz) = evaluation.points[place]
+        d = (xx - px, xy - py, xz - pz)
+        socket = equations.frame(place, 1, evaluation)[0]
+        other_socket = equations.frame(place, 0, evaluation)[0]
         x, y, z = self.span
         for column, (_, multiplier, offset, (ux, uy, uz)) in zip(self.slide_columns,
                                                                  self.stretch):
             travel = multiplier * evaluation.values[column] + offset
             x, y, z = x + travel * ux, y + travel * uy, z + travel * uz
-        first, second = pointing_angles(pointing.origins[:2], pointing.axes[:2], (x, y, z),
-                                        apply_transposed(socket, d), self.branches[0])
-        first_turned = multiply(socket, multiply(pointing.origins[0],
-                                                 axis_rotation(pointing.axes[0], first)))
-        second_turned = multiply(first_turned, multiply(pointing.origins[1],
-                                                        axis_rotation(pointing.axes[1], second)))
+        first, second = pointing.pointing((x, y, z), apply_transposed(socket, d),
+                                          self.branches[0])
         last = self.angles
-        spun = ()
-        if self.spin is None:
-            rod = second_turned
-        else:
-            spun = (last[2],)
-            rod = multiply(second_turned, multiply(pointing.origins[2],
-                                                   axis_rotation(pointing.axes[2], last[2])))
-        relative = multiply(transpose(other_socket), multiply(rod, self.weld))
-        angles = [first, second, *spun, *ball_angles(other.origins, other.axes, relative,
-                                                     self.branches[1])]
+        trig = [(math.cos(first), math.sin(first)), (math.cos(second), math.sin(second))]
+        if self.spin is not None:
+            trig.append((math.cos(last[2]), math.sin(last[2])))
+        # the other ball's third axis and the vector across it, in its socket's frame
+        third, across = (apply_transposed(other_socket, apply(socket, pointing.forward(trig, v)))
+                         for v in self.welded)
+        ball_first, ball_second, ball_third = other.ball(third, across, self.branches[1])
+        ball_trig = [(math.cos(ball_first), math.sin(ball_first)),
+                     (math.cos(ball_second), math.sin(ball_second))]
+        angles = [first, second, *last[2:2 + len(trig) - 2], ball_first, ball_second, ball_third]
         angles = [previous + math.remainder(angle - previous, 2.0 * math.pi)
                   for angle, previous in zip(angles, last)]
         if self.spin is not None:
@@ -255,9 +253,8 @@ class WeldRod:
         if rates is None:
             return tuple(angles), (0.0,) * len(angles), 1.0
         # (Ω_socket + θ̇₁ω₁ + θ̇₂ω₂) × d = ḋ by its normal equations, as a reduced rod's
-        velocity, spin_rate = equations.relative_motion(self.place, evaluation, rates)
-        w1 = apply(socket, apply(pointing.origins[0], pointing.axes[0]))
-        w2 = apply(first_turned, apply(pointing.origins[1], pointing.axes[1]))
+        velocity, spin_rate = equations.relative_motion(place, evaluation, rates)
+        w1, w2 = pointing.world_axes(socket, trig)[:2]
         d_rate = subtract(velocity, cross(spin_rate, d))
         c1, c2 = cross(w1, d), cross(w2, d)
         g11, g12, g22 = dot(c1, c1), dot(c1, c2), dot(c2, c2)
@@ -271,13 +268,8 @@ class WeldRod:
         first_rate, second_rate = (g22 * r1 - g12 * r2) / det, (g11 * r2 - g12 * r1) / det
         turning = add(spin_rate, add(scale(first_rate, w1), scale(second_rate, w2)))
         # the other ball: Ω_rod − Ω_socket = Σ θ̇ᵢωᵢ over its three axes
-        relative_rate = subtract(turning, equations.spin(self.place, 0, evaluation, rates))
-        turned = other_socket
-        columns = []
-        for origin, axis, angle in zip(other.origins, other.axes, angles[len(angles) - 3:]):
-            turned = multiply(turned, origin)
-            columns.append(apply(turned, axis))
-            turned = multiply(turned, axis_rotation(axis, angle))
+        relative_rate = subtract(turning, equations.spin(place, 0, evaluation, rates))
+        columns = other.world_axes(other_socket, ball_trig)
         ball_rates, ball_conditioning = _solve_columns(columns, relative_rate)
         if ball_rates is None:  # at the ball's gimbal lock: refused as singular
             return tuple(angles), (0.0,) * len(angles), math.inf
@@ -299,7 +291,8 @@ def _solve_columns(columns: Sequence[Vector],
     if det == 0.0:
         return None, math.inf
     norm_matrix = max(abs(c[0]) + abs(c[1]) + abs(c[2]) for c in columns)
-    norm_inverse = max(sum(abs(row[k]) for row in rows) for k in range(3)) / abs(det)
+    norm_inverse = max(abs(rows[0][k]) + abs(rows[1][k]) + abs(rows[2][k])
+                       for k in range(3)) / abs(det)
     return [dot(row, rhs) / det for row in rows], norm_matrix * norm_inverse
 
 
