@@ -263,18 +263,29 @@ class LoopEquations:
         """Return the residual rows at coordinate ``values``."""
         return self.evaluate(values).residual
 
-    def jacobian(self, evaluation: Evaluation,
-                 columns: Collection[int] | None = None) -> list[list[float]]:
+    def jacobian(self, evaluation: Evaluation, columns: Collection[int] | None = None,
+                 rows: Collection[int] | None = None) -> list[list[float]]:
         """
         Return ∂(residual)/∂(coordinates) at an evaluation, one list per row.
 
-        Only the ``columns`` asked for are computed (the others left 0); all by default.
+        Only the ``columns`` asked for are computed (the others left 0), and with ``rows``
+        only those rows are sure to be (a closure none of whose rows is asked for gives zero
+        rows; a pin's or weld's angle rows are left 0 unless one of them is asked for); all
+        by default.
         """
         width = len(self.coordinates)
-        rows: list[list[float]] = []
-        for record, pair in zip(self._closures, evaluation.points):
-            rows += _jacobian_rows(record, evaluation, pair, width, columns)
-        return rows
+        result: list[list[float]] = []
+        for record, pair, (_, start, count) in zip(self._closures, evaluation.points,
+                                                   self.closure_rows):
+            if rows is None:
+                angles = True
+            elif not any(row in rows for row in range(start, start + count)):
+                result += [[0.0] * width for _ in range(count)]
+                continue
+            else:
+                angles = any(row in rows for row in range(start + 3, start + count))
+            result += _jacobian_rows(record, evaluation, pair, width, columns, angles)
+        return result
 
     def jacobian_rate(self, evaluation: Evaluation,
                       rates: Sequence[float]) -> list[list[float]]:
@@ -485,7 +496,8 @@ def _residual(record: tuple, evaluation: Evaluation,
 
 
 def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, Vector],
-                   width: int, columns: Collection[int] | None) -> list[list[float]]:
+                   width: int, columns: Collection[int] | None,
+                   angles: bool = True) -> list[list[float]]:
     form, _, a, b = record[:4]
     p_a, p_b = points
     if form is _Form.DISTANCE:
@@ -519,7 +531,9 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
         return [row]
     rows = [[0.0] * width for _ in range(form.value)]
     row_x, row_y, row_z = rows[0], rows[1], rows[2]
-    if form is _Form.PIN:
+    if not angles:
+        form = _Form.BALL
+    elif form is _Form.PIN:
         n_a = apply(_frame_rotation(a, evaluation), record[4])
         r_b = _frame_rotation(b, evaluation)
         normals = (cross(n_a, apply(r_b, record[6])), cross(n_a, apply(r_b, record[7])))

@@ -71,7 +71,7 @@ from linkage_kinematics.loops.closed_forms import (
     TurnChain,
 )
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
-from linkage_kinematics.loops.linear import condition, inverse, solve
+from linkage_kinematics.loops.linear import condition, factor, Factors
 from linkage_kinematics.loops.reduction import reduce_group, Reduction
 from linkage_kinematics.loops.spatial import apply_transposed, cross, dot, subtract
 from linkage_kinematics.loops.structure import (
@@ -339,6 +339,8 @@ class GroupSolver:
         self._known_columns = [self.equations.coordinates.index(i) for i in group.known]
         self._known_set = frozenset(self._known_columns)
         self._unknown_set = frozenset(self._system.columns)
+        # the rows of the Newton system: the only ones the per-sample Jacobian needs
+        self._row_set = frozenset(self._system.rows)
         self._wrapped = self._system.wrapped(tree, self.equations)
         self._known_turns = [tree.coordinates[i].kind is MotionKind.TURN for i in group.known]
         self._outputs = [self.equations.coordinates.index(i) if i in newton else None
@@ -366,7 +368,9 @@ class GroupSolver:
         evaluation = self.equations.evaluate(local)
         jacobian = self.equations.jacobian(evaluation)
         matrix = self._system.matrix(jacobian)
-        found = inverse(matrix) if matrix else ([], 1.0)
+        factors = factor(matrix) if matrix else None
+        found = (factors.inverse(), factors.determinant) if factors is not None else (
+            None if matrix else ([], 1.0))
         if found is None or found[1] == 0.0:
             raise PlanError(f'group {self.name}: the assembled pose is a singular configuration')
         self._sign = 1.0 if found[1] > 0.0 else -1.0
@@ -481,10 +485,10 @@ class GroupSolver:
             for x, column in zip(prediction, system.columns):
                 values[column] += x
             try:
-                count, evaluation, jacobian = self._newton(values, base)
+                count, evaluation, jacobian, factors = self._newton(values, base)
                 iterations += count
                 self._check_residual(evaluation, _StepFailed)
-                found = self._closed(values, evaluation, jacobian)
+                found = self._closed(values, evaluation, jacobian, factors)
                 if found is None:
                     raise _StepFailed(Refusal.SINGULAR, 'the Newton matrix is singular')
                 if (found[1] > 0.0) != (self._sign > 0.0):
@@ -498,9 +502,13 @@ class GroupSolver:
             base, sensitivity, done = values, found[2], end
             length *= 2.0
 
-    def _newton(self, values: list[float], base: Sequence[float]) -> tuple[int, Evaluation, list]:
+    def _newton(self, values: list[float],
+                base: Sequence[float]) -> tuple[int, Evaluation, list, Factors | None]:
         """
         Move ``values`` to the closed pose by Newton; return its iterations and last iterate.
+
+        The last iterate's evaluation, Jacobian and its Newton matrix's factors (None without
+        unknowns).
 
         _StepFailed where Newton does not contract from ``values`` (module docstring). Turns
         outside the idle freedoms are kept within π of ``base`` (the same pose, and sines of
@@ -514,9 +522,14 @@ class GroupSolver:
         for iteration in range(1, ITERATIONS + 1):
             if iteration > 1:
                 evaluation = equations.evaluate(values, evaluation, self._unknown_set)
-            jacobian = equations.jacobian(evaluation, self._unknown_set)
-            step = solve(system.matrix(jacobian), system.right_side(evaluation.residual, values))
-            if step is None or not all(map(math.isfinite, step)):
+            jacobian = equations.jacobian(evaluation, self._unknown_set, self._row_set)
+            matrix = system.matrix(jacobian)
+            factors = factor(matrix) if matrix else None
+            if matrix and factors is None:
+                raise _StepFailed(Refusal.UNREACHABLE, 'the Newton matrix became singular')
+            step = (factors.solve(system.right_side(evaluation.residual, values))
+                    if factors is not None else [])
+            if not all(map(math.isfinite, step)):
                 raise _StepFailed(Refusal.UNREACHABLE, 'the Newton matrix became singular')
             length = max([abs(x) / s for x, s in zip(step, scales)], default=0.0)
             # a correction that does not contract: the start was not near this continuation
@@ -533,11 +546,12 @@ class GroupSolver:
                 values[column] = previous + math.remainder(values[column] - previous,
                                                            2.0 * math.pi)
             if length <= STEP_ROUNDING * EPSILON * size or 0.5 * last_length < length:
-                for row, known_row in zip(jacobian, equations.jacobian(evaluation,
-                                                                       self._known_set)):
+                known_jacobian = equations.jacobian(evaluation, self._known_set, self._row_set)
+                for place in system.rows:
+                    row, known_row = jacobian[place], known_jacobian[place]
                     for column in self._known_columns:
                         row[column] = known_row[column]
-                return iteration, evaluation, jacobian
+                return iteration, evaluation, jacobian, factors
             last_length = length
         raise _StepFailed(Refusal.UNREACHABLE, f'Newton did not converge in {ITERATIONS} '
                           f'steps, residual {max(map(abs, evaluation.residual)):.3g}')
@@ -551,15 +565,23 @@ class GroupSolver:
                 raise error(Refusal.UNREACHABLE,
                             f'closure {name} stays open by {abs(residual):.3g}')
 
-    def _closed(self, values: Sequence[float], evaluation: Evaluation,
-                jacobian: list) -> tuple[list, float, list] | None:
-        """Return (A⁻¹, det A, S) at a closed pose; None where A is singular."""
+    def _closed(self, values: Sequence[float], evaluation: Evaluation, jacobian: list,
+                factors: Factors | None = None) -> tuple[list, float, list] | None:
+        """
+        Return (A⁻¹, det A, S) at a closed pose; None where A is singular.
+
+        ``factors``: A's, where Newton's last step made them.
+        """
         system = self._system
-        matrix = system.matrix(jacobian)
-        found = inverse(matrix) if matrix else ([], self._sign)
-        if found is None:
-            return None
-        return found[0], found[1], system.sensitivity(found[0], jacobian, self._known_columns)
+        if not system.columns:
+            return [], self._sign, []
+        if factors is None:
+            factors = factor(system.matrix(jacobian))
+            if factors is None:
+                return None
+        inverse_matrix = factors.inverse()
+        return (inverse_matrix, factors.determinant,
+                system.sensitivity(inverse_matrix, jacobian, self._known_columns))
 
     def _finish(self, values: list[float], evaluation: Evaluation, jacobian: list,
                 found: tuple[list, float, list] | None, velocities: Sequence[float],
