@@ -56,6 +56,10 @@ from linkage_kinematics.loops.spatial import (
 )
 from linkage_kinematics.loops.tree import KinematicTree, Loop, MotionKind, Pose, unit_axis
 
+# What a closure's Jacobian rows need (LoopEquations._modes): none, its positions', all.
+_SKIP = 0
+_POSITIONS = 1
+_ALL = 2
 # Two universal-joint axes meet where their lines pass within this fraction of the rod's length
 # of each other (an exporter's printed digits leave some 1e-7), and are not parallel.
 CONCURRENT_TOLERANCE = 1e-9
@@ -237,6 +241,9 @@ class LoopEquations:
             self._closures.append(record)
         self.row_kinds = tuple(kinds)
         self.rows = len(kinds)
+        # per set of columns and of rows asked for: what ``jacobian`` computes (its caches)
+        self._prepared: dict[frozenset[int] | None, list[tuple]] = {}
+        self._row_modes: dict[frozenset[int] | None, list[int]] = {}
 
     def evaluate(self, values: Sequence[float], previous: Evaluation | None = None,
                  changed: Collection[int] | None = None) -> Evaluation:
@@ -271,21 +278,55 @@ class LoopEquations:
         Only the ``columns`` asked for are computed (the others left 0), and with ``rows``
         only those rows are sure to be (a closure none of whose rows is asked for gives zero
         rows; a pin's or weld's angle rows are left 0 unless one of them is asked for); all
-        by default.
+        by default. The per-sample solver asks for the same sets every time: give them as
+        frozensets, whose steps are then sorted out once.
         """
         width = len(self.coordinates)
         result: list[list[float]] = []
-        for record, pair, (_, start, count) in zip(self._closures, evaluation.points,
-                                                   self.closure_rows):
-            if rows is None:
-                angles = True
-            elif not any(row in rows for row in range(start, start + count)):
+        steps = self._steps(columns)
+        modes = self._modes(rows)
+        for record, pair, prepared, mode, (_, _, count) in zip(
+                self._closures, evaluation.points, steps, modes, self.closure_rows):
+            if mode == _SKIP:
                 result += [[0.0] * width for _ in range(count)]
-                continue
             else:
-                angles = any(row in rows for row in range(start + 3, start + count))
-            result += _jacobian_rows(record, evaluation, pair, width, columns, angles)
+                result += _jacobian_rows(record, evaluation, pair, width, prepared,
+                                         mode == _ALL)
         return result
+
+    def _steps(self, columns: Collection[int] | None) -> list[tuple]:
+        """Return per closure its sides' steps that move ``columns`` (and its known slides)."""
+        key = columns if columns is None or isinstance(columns, frozenset) else frozenset(
+            columns)
+        prepared = self._prepared.get(key)
+        if prepared is None:
+            prepared = []
+            for record in self._closures:
+                sides = tuple(tuple((place, col, sign * multiplier, turn)
+                                    for place, col, multiplier, turn in side[4]
+                                    if key is None or col in key)
+                              for side, sign in ((record[2], 1.0), (record[3], -1.0)))
+                stretch = () if record[0] is not _Form.DISTANCE else tuple(
+                    slide for slide in record[6] if key is None or slide[0] in key)
+                prepared.append(sides + (stretch,))
+            self._prepared[key] = prepared
+        return prepared
+
+    def _modes(self, rows: Collection[int] | None) -> list[int]:
+        """Return per closure which of its rows ``rows`` needs: none, positions, all."""
+        key = rows if rows is None or isinstance(rows, frozenset) else frozenset(rows)
+        modes = self._row_modes.get(key)
+        if modes is None:
+            modes = []
+            for _, start, count in self.closure_rows:
+                if key is None or any(row in key for row in range(start + 3, start + count)):
+                    modes.append(_ALL)
+                elif any(row in key for row in range(start, start + count)):
+                    modes.append(_POSITIONS)
+                else:
+                    modes.append(_SKIP)
+            self._row_modes[key] = modes
+        return modes
 
     def jacobian_rate(self, evaluation: Evaluation,
                       rates: Sequence[float]) -> list[list[float]]:
@@ -496,10 +537,11 @@ def _residual(record: tuple, evaluation: Evaluation,
 
 
 def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, Vector],
-                   width: int, columns: Collection[int] | None,
-                   angles: bool = True) -> list[list[float]]:
+                   width: int, prepared: tuple, angles: bool) -> list[list[float]]:
+    """Return one closure's Jacobian rows over its ``prepared`` steps (LoopEquations._steps)."""
     form, _, a, b = record[:4]
     p_a, p_b = points
+    steps_a, steps_b, stretch = prepared
     if form is _Form.DISTANCE:
         # ∂/∂q of (|d|² − L²)/(2L) = d·(screw at x − screw at P)/L, d·(ω × (p − o)) written as
         # ω·((p − o) × d)
@@ -511,23 +553,19 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
         if span is not None:
             # a known slide stretches the rod: ∂r/∂L = −(|d|² + L²)/(2L²), ∂L/∂q = m·(u·ℓ)/L
             factor = -(dx * dx + dy * dy + dz * dz + 1.0) / (2.0 * length)
-            for col, multiplier, _, direction in record[6]:
-                if columns is None or col in columns:
-                    row[col] += factor * multiplier * dot(direction, span)
-        for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+            for col, multiplier, _, direction in stretch:
+                row[col] += factor * multiplier * dot(direction, span)
+        for side, (px, py, pz), steps in ((a, p_a, steps_a), (b, p_b, steps_b)):
             _, _, axes, origins = evaluation.frames[side[0]]
-            for place, col, multiplier, turn in side[4]:
-                if columns is not None and col not in columns:
-                    continue
+            for place, col, factor, turn in steps:
                 wx, wy, wz = axes[place]
                 if turn:
                     ox, oy, oz = origins[place]
                     rx, ry, rz = px - ox, py - oy, pz - oz
-                    row[col] += sign * multiplier * (wx * (ry * dz - rz * dy)
-                                                     + wy * (rz * dx - rx * dz)
-                                                     + wz * (rx * dy - ry * dx))
+                    row[col] += factor * (wx * (ry * dz - rz * dy) + wy * (rz * dx - rx * dz)
+                                          + wz * (rx * dy - ry * dx))
                 else:
-                    row[col] += sign * multiplier * (wx * dx + wy * dy + wz * dz)
+                    row[col] += factor * (wx * dx + wy * dy + wz * dz)
         return [row]
     rows = [[0.0] * width for _ in range(form.value)]
     row_x, row_y, row_z = rows[0], rows[1], rows[2]
@@ -536,18 +574,19 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
     elif form is _Form.PIN:
         n_a = apply(_frame_rotation(a, evaluation), record[4])
         r_b = _frame_rotation(b, evaluation)
-        normals = (cross(n_a, apply(r_b, record[6])), cross(n_a, apply(r_b, record[7])))
+        (n0x, n0y, n0z), (n1x, n1y, n1z) = (cross(n_a, apply(r_b, record[6])),
+                                            cross(n_a, apply(r_b, record[7])))
+        row_3, row_4 = rows[3], rows[4]
     elif form is _Form.WELD:
         r_a = _side_rotation(a, evaluation)
         e = log_rotation(multiply(transpose(r_a), _side_rotation(b, evaluation)))
-        rate = log_rate_matrix(e)
-    for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+        # ∂e/∂q = J⁻¹(e)·R_aᵀ·(−factor·ω)
+        m0, m1, m2, m3, m4, m5, m6, m7, m8 = multiply(log_rate_matrix(e), transpose(r_a))
+        row_3, row_4, row_5 = rows[3], rows[4], rows[5]
+    for side, (px, py, pz), steps in ((a, p_a, steps_a), (b, p_b, steps_b)):
         _, _, axes, origins = evaluation.frames[side[0]]
-        for place, col, multiplier, turn in side[4]:
-            if columns is not None and col not in columns:
-                continue
-            factor = sign * multiplier
-            wx, wy, wz = w = axes[place]
+        for place, col, factor, turn in steps:
+            wx, wy, wz = axes[place]
             if not turn:
                 row_x[col] += factor * wx
                 row_y[col] += factor * wy
@@ -559,13 +598,12 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
             row_y[col] += factor * (wz * rx - wx * rz)
             row_z[col] += factor * (wx * ry - wy * rx)
             if form is _Form.PIN:
-                rows[3][col] += factor * dot(w, normals[0])
-                rows[4][col] += factor * dot(w, normals[1])
+                row_3[col] += factor * (wx * n0x + wy * n0y + wz * n0z)
+                row_4[col] += factor * (wx * n1x + wy * n1y + wz * n1z)
             elif form is _Form.WELD:
-                ex, ey, ez = apply(rate, apply_transposed(r_a, scale(-factor, w)))
-                rows[3][col] += ex
-                rows[4][col] += ey
-                rows[5][col] += ez
+                row_3[col] -= factor * (m0 * wx + m1 * wy + m2 * wz)
+                row_4[col] -= factor * (m3 * wx + m4 * wy + m5 * wz)
+                row_5[col] -= factor * (m6 * wx + m7 * wy + m8 * wz)
     return rows
 
 

@@ -127,9 +127,15 @@ def condition(matrix: Matrix, inverse_matrix: Matrix, row_scale: Sequence[float]
               column_scale: Sequence[float]) -> float:
     """Return ‖R·A·C‖₁·‖(R·A·C)⁻¹‖₁ for the diagonal scalings R and C."""
     n = len(matrix)
-    scaled = max(sum(abs(matrix[i][j]) * row_scale[i] for i in range(n)) * column_scale[j]
-                 for j in range(n))
+    sums = [0.0] * n
+    for row, scale in zip(matrix, row_scale):
+        for j in range(n):
+            sums[j] += abs(row[j]) * scale
+    scaled = max([total * scale for total, scale in zip(sums, column_scale)])
     # (R·A·C)⁻¹ = C⁻¹·A⁻¹·R⁻¹
-    inverted = max(sum(abs(inverse_matrix[i][j]) / column_scale[i] for i in range(n))
-                   / row_scale[j] for j in range(n))
+    sums = [0.0] * n
+    for row, scale in zip(inverse_matrix, column_scale):
+        for j in range(n):
+            sums[j] += abs(row[j]) / scale
+    inverted = max([total / scale for total, scale in zip(sums, row_scale)])
     return scaled * inverted

@@ -598,7 +598,10 @@ class GroupSolver:
         for column, rate in zip(known, velocities):
             rates[column] = rate
         for line, column in zip(sensitivity, system.columns):
-            rates[column] = math.fsum([s * v for s, v in zip(line, velocities)])
+            total = 0.0
+            for s, v in zip(line, velocities):  # in order: the same bits on every Python
+                total += s * v
+            rates[column] = total
         rods = self._rods.solve(evaluation, rates, self._refuse)
         try:
             followed = [follower.solve(self.equations, evaluation, rates)

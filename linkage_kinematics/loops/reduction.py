@@ -113,11 +113,14 @@ class PinPair:
         self.sign = sign
         self.coefficients = coefficients
         self.reference = reference
-        self.origins = (first.origins[0], second.origins[0])
+        self.origin = first.origins[0]
         self.axis = first.axes[0]
+        self.lifted = apply(first.origins[0], first.axes[0])
         self.perpendicular = perpendicular_pair(first.axes[0])[0]
-        # the second side's frame relative to the first's, both on the welded link
-        self.weld = multiply(second.offset.rotation, transpose(first.offset.rotation))
+        # a vector p across the first axis, carried through the weld and the second turn's
+        # origin: (R_a·O_a)ᵀ·R_b·(this) is p turned by θ_a − s·θ_b about the first axis
+        weld = multiply(second.offset.rotation, transpose(first.offset.rotation))
+        self.carried = apply(second.origins[0], apply(weld, self.perpendicular))
         self.place = 0
         self.angles = (0.0, 0.0)
 
@@ -133,12 +136,10 @@ class PinPair:
         """Return the two angles (continued from the last), their rates and conditioning 1."""
         rotation_a, _ = equations.frame(self.place, 0, evaluation)
         rotation_b, _ = equations.frame(self.place, 1, evaluation)
-        joint_a = multiply(rotation_a, self.origins[0])
-        # G·H: the turn θ_a − s·θ_b about the first axis (module docstring)
-        turn = multiply(multiply(transpose(joint_a), multiply(rotation_b, self.origins[1])),
-                        self.weld)
+        # the links' relative turn about the line, θ_a − s·θ_b: where it takes p
         p = self.perpendicular
-        q = apply(turn, p)
+        q = apply_transposed(self.origin, apply_transposed(rotation_a,
+                                                           apply(rotation_b, self.carried)))
         angle = math.atan2(dot(self.axis, cross(p, q)), dot(p, q))
         (a, b), s = self.angles, self.sign
         last = a - s * b
@@ -146,7 +147,7 @@ class PinPair:
         (k_a, k_b), (r_a, r_b) = self.coefficients, self.reference
         determinant = k_a * s + k_b
         second = (k_a * r_a + k_b * r_b - k_a * angle) / determinant
-        axis = apply(joint_a, self.axis)
+        axis = apply(rotation_a, self.lifted)
         spin = subtract(equations.spin(self.place, 1, evaluation, rates),
                         equations.spin(self.place, 0, evaluation, rates))
         turning = dot(axis, spin)
