@@ -5,8 +5,9 @@
 loops.closed_forms: each closed form against the same geometry solved at 50 digits.
 
 Three spheres (a delta's forward kinematics), the circles of a planar triangle near tangency,
-a crank or a slide onto a sphere (a crank–rod–ball leg's inverse) and a universal joint's
-angles that point its rod, each with both branches.
+a crank or a slide onto a sphere (a crank–rod–ball leg's inverse), a universal joint's angles
+that point its rod and a ball of three turns' angles that make a rotation, each with both
+branches.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from linkage_kinematics.loops.closed_forms import (
     slide_to_sphere,
     three_spheres,
     turn_to,
+    TurnChain,
 )
 from linkage_kinematics.loops.spatial import add, apply, axis_rotation, norm, scale, subtract
 from mpmath import mp, mpf
@@ -88,3 +90,42 @@ def test_turn_to_carries_a_point_onto_its_target_about_an_axis():
     target = add(origin, apply(axis_rotation(axis, 2.5), subtract(point, origin)))
     assert turn_to(axis, origin, point, target) == pytest.approx(2.5, abs=1e-15)
     assert norm(subtract(target, origin)) == pytest.approx(norm(subtract(point, origin)))
+
+
+def rotation_50(origins, axes, angles):
+    """Return O₁·R(a₁, θ₁)·O₂·R(a₂, θ₂)·… at 50 digits (Rodrigues), as an mp matrix."""
+    with mp.workdps(50):
+        result = mp.eye(3)
+        for origin, axis, angle in zip(origins, axes, angles):
+            x, y, z = (mpf(v) for v in axis)
+            k = mp.matrix([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+            turn = mp.eye(3) + mp.sin(mpf(angle)) * k + (1 - mp.cos(mpf(angle))) * k * k
+            result = result * mp.matrix([[mpf(origin[3 * i + j]) for j in range(3)]
+                                         for i in range(3)]) * turn
+        return result
+
+
+def test_a_ball_of_three_turns_makes_a_rotation_with_either_angle_triple():
+    # Battobot's ball (x, y, z about its joint frame, turned in its link), and a ball whose
+    # axes are not perpendicular: both triples make the rotation to rounding, one of them
+    # with the angles it was made with
+    tilted = axis_rotation((0.6, 0.0, 0.8), 0.4)
+    identity = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+    for origins, axes in (((tilted, identity, identity),
+                           ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))),
+                          ((identity, tilted, identity),
+                           ((0.0, 0.0, 1.0), (0.6, 0.8, 0.0), (1.0, 0.0, 0.0)))):
+        for angles in ((0.3, -1.2, 2.5), (-2.0, 0.7, -0.1), (1.0, 1.5, 0.2)):
+            target = rotation_50(origins, axes, angles)
+            rotation = tuple(float(target[i, j]) for i in range(3) for j in range(3))
+            ball = TurnChain(origins, axes)
+            images = apply(rotation, axes[2]), apply(rotation, ball.across)
+            triples = [ball.ball(*images, branch) for branch in (1, -1)]
+            for found in triples:
+                made = rotation_50(origins, axes, found)
+                assert max(abs(float(made[i, j] - target[i, j])) for i in range(3)
+                           for j in range(3)) <= 2e-15
+            apart = [max(abs(math.remainder(a - b, 2.0 * math.pi))
+                         for a, b in zip(found, angles)) for found in triples]
+            # (1.5 rad is near the gimbal lock: the angles carry some 14 times the rounding)
+            assert min(apart) <= 2e-14 and max(apart) > 0.1

@@ -4,10 +4,13 @@
 """
 Closed forms of the spatial mechanisms that have them, in plain floats.
 
-* ``universal_angles``: the two angles of a universal joint that point a rod at a target (the
+* ``TurnChain.pointing``: the two angles of a universal joint that point a rod at a target (the
   angles of a rod reduced to a distance, equations.Rod): the component of the rod along the
   first axis is kept by the first turn, so the second angle solves a·cos θ₂ + b·sin θ₂ = c,
   and the first turns the rod onto the target about the first axis.
+* ``TurnChain.ball``: the three angles of a ball written as three turns that make a given
+  rotation: the first two point the third axis where the rotation takes it, the third turns
+  the rest of the way (the joints of a welded rod's ends, reduction.py).
 * ``crank_to_sphere`` / ``slide_to_sphere``: one crank–rod–ball leg's inverse: the ball x known
   (the foot's pose known), the crank angle puts the rod's centre P(θ) at the rod's length L
   from x: |x − P(θ)|² = L² is a·cos φ + b·sin φ = c in the turn φ from the current angle (a
@@ -29,17 +32,19 @@ from __future__ import annotations
 from collections.abc import Sequence
 import math
 
-from linkage_kinematics.loops.equations import Evaluation, LoopEquations, Rod
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations
 from linkage_kinematics.loops.spatial import (
     add,
     apply,
     apply_transposed,
     cross,
     dot,
+    IDENTITY,
     norm,
+    perpendicular_pair,
+    Rotation,
     scale,
     subtract,
-    turn_vector,
     Vector,
 )
 from linkage_kinematics.loops.structure import ClosureGroup, five_bar_cycle, five_bar_pair
@@ -60,31 +65,95 @@ def _acos(ratio: float) -> float:
     return math.acos(max(-1.0, min(1.0, ratio)))
 
 
-def universal_angles(rod: Rod, target: Vector, branch: int) -> tuple[float, float]:
+def turn(axis: Vector, cosine: float, sine: float, v: Vector) -> Vector:
+    """Return v turned about the unit ``axis`` by the angle of that cosine and sine."""
+    ax, ay, az = axis
+    x, y, z = v
+    along = (1.0 - cosine) * (ax * x + ay * y + az * z)
+    return (cosine * x + sine * (ay * z - az * y) + along * ax,
+            cosine * y + sine * (az * x - ax * z) + along * ay,
+            cosine * z + sine * (ax * y - ay * x) + along * az)
+
+
+class TurnChain:
     """
-    Return the universal joint's angles (θ₁, θ₂, rad) that point its rod at ``target``.
+    Two or three turns about axes through one point: a universal joint, or a ball (module text).
 
-    ``target``: the ball's position relative to the joint's centre P, in the socket frame.
-    OutOfReach where |target| is not the rod's length (beyond rounding).
+    Turn i: its joint frame's rotation Oᵢ in the frame above it, then θᵢ about its unit axis
+    aᵢ; the joint's rotation is O₁·R(a₁, θ₁)·O₂·R(a₂, θ₂)·…; the turns' angles enter as their
+    (cos, sin), computed once per sample. Plain floats.
     """
-    first, second = rod.axes
-    w = apply_transposed(rod.origins[0], target)  # before the first turn
-    g = apply_transposed(rod.origins[1], first)  # the first axis, seen before the second turn
-    v = rod.rod
-    along = dot(g, second) * dot(second, v)
-    a = dot(g, v) - along
-    b = dot(g, cross(second, v))
-    c = dot(first, w) - along
-    angle2 = math.atan2(b, a) + branch * _acos(c / math.hypot(a, b))
-    u = apply(rod.origins[1], turn_vector(second, angle2, v))
-    angle1 = math.atan2(dot(first, cross(u, w)), dot(u, w) - dot(first, u) * dot(first, w))
-    return angle1, angle2
 
+    def __init__(self, origins: Sequence[Rotation], axes: Sequence[Vector]) -> None:
+        self.origins = [None if origin == IDENTITY else origin for origin in origins]
+        self.axes = tuple(axes)
+        # each axis in the frame above its turn (its origin rotation applied)
+        self.lifted = tuple(apply(origin, axis) for origin, axis in zip(origins, axes))
+        # the first axis seen before the second turn (``pointing``)
+        self.seen = apply_transposed(origins[1], axes[0])
+        # a unit vector across the third axis (``ball``)
+        self.across = perpendicular_pair(axes[2])[0] if len(axes) > 2 else None
 
-def universal_branch(rod: Rod, target: Vector, angle2: float) -> int:
-    """Return the branch (±1) of ``universal_angles`` whose second angle is ``angle2``."""
-    return min((1, -1), key=lambda branch: abs(_wrap(
-        universal_angles(rod, target, branch)[1] - angle2)))
+    def forward(self, trig: Sequence[tuple[float, float]], v: Vector) -> Vector:
+        """Return O₁·R₁·O₂·R₂·…·v over the turns ``trig`` gives (cos, sin) for."""
+        count = len(trig)
+        for place in range(count - 1, -1, -1):
+            cosine, sine = trig[place]
+            v = turn(self.axes[place], cosine, sine, v)
+            if self.origins[place] is not None:
+                v = apply(self.origins[place], v)
+        return v
+
+    def backward(self, trig: Sequence[tuple[float, float]], v: Vector) -> Vector:
+        """Return (O₁·R₁·O₂·R₂·…)ᵀ·v over the turns ``trig`` gives (cos, sin) for."""
+        for origin, axis, (cosine, sine) in zip(self.origins, self.axes, trig):
+            if origin is not None:
+                v = apply_transposed(origin, v)
+            v = turn(axis, cosine, -sine, v)
+        return v
+
+    def pointing(self, vector: Vector, target: Vector, branch: int) -> tuple[float, float]:
+        """
+        Return the first two turns' angles carrying ``vector`` (their frame) to ``target``.
+
+        ``target`` as long as ``vector``, in the frame above the first turn: the component
+        along the first axis is kept by the first turn, so the second angle solves a·cos θ₂ +
+        b·sin θ₂ = c and the first turns the vector onto the target. OutOfReach where no
+        angles do (beyond rounding).
+        """
+        first, second = self.axes[0], self.axes[1]
+        w = target if self.origins[0] is None else apply_transposed(self.origins[0], target)
+        g = self.seen
+        along = dot(g, second) * dot(second, vector)
+        a = dot(g, vector) - along
+        b = dot(g, cross(second, vector))
+        angle2 = math.atan2(b, a) + branch * _acos((dot(first, w) - along) / math.hypot(a, b))
+        u = turn(second, math.cos(angle2), math.sin(angle2), vector)
+        if self.origins[1] is not None:
+            u = apply(self.origins[1], u)
+        angle1 = math.atan2(dot(first, cross(u, w)), dot(u, w) - dot(first, u) * dot(first, w))
+        return angle1, angle2
+
+    def ball(self, third: Vector, across: Vector,
+             branch: int) -> tuple[float, float, float]:
+        """
+        Return a ball's three angles for a rotation R, from R·a₃ and R·``self.across``.
+
+        The first two point the third axis where R takes it (the third turn leaves it), the
+        third turns the rest of the way. ``branch`` (±1) picks one of the two triples.
+        """
+        angle1, angle2 = self.pointing(self.lifted[2], third, branch)
+        trig = ((math.cos(angle1), math.sin(angle1)), (math.cos(angle2), math.sin(angle2)))
+        rest = self.backward(trig, across)
+        if self.origins[2] is not None:
+            rest = apply_transposed(self.origins[2], rest)
+        p = self.across
+        return angle1, angle2, math.atan2(dot(self.axes[2], cross(p, rest)), dot(p, rest))
+
+    def world_axes(self, socket: Rotation, trig: Sequence[tuple[float, float]]) -> list[Vector]:
+        """Return the turns' axes in the frame ``socket`` maps from (the one above the first)."""
+        return [apply(socket, self.forward(trig[:place], self.lifted[place]))
+                for place in range(len(self.axes))]
 
 
 def crank_to_sphere(origin: Vector, axis: Vector, point: Vector, center: Vector,
@@ -247,6 +316,7 @@ class FiveBarPositions:
 
     def __init__(self, tree: KinematicTree, group: ClosureGroup,
                  equations: LoopEquations, values: Sequence[float]) -> None:
+        """Place the pins at the assembled ``values`` (all the tree's coordinates)."""
         self.equations = equations
         self.cycle = five_bar_cycle(tree, group.closures[0])
         first = five_bar_pair(tree, group, values)
@@ -271,13 +341,19 @@ class FiveBarPositions:
                     path[place + 1] if place + 1 < len(path) else None,
                     {equations.coordinates.index(tree.steps[above].coordinate)
                      for above in path[:place]}))
-        evaluation = equations.evaluate(values)
+        evaluation = equations.evaluate([values[i] for i in equations.coordinates])
         # the first step below the base turns about the plane's normal, fixed in the base
         self.normal = evaluation.frames[0][2][0]
         apex = self.pin(self.apex, evaluation, None)
-        self.radii = tuple(norm(subtract(apex, self.pin(end, evaluation, self.known_side)))
+        # in the plane: the pins may sit at different heights along the axes
+        self.radii = tuple(norm(self.planar(subtract(apex, self.pin(end, evaluation,
+                                                                    self.known_side))))
                            for end in self.ends)
         self.branch = 1
+
+    def planar(self, vector: Vector) -> Vector:
+        """Return ``vector`` without its component along the plane's normal."""
+        return subtract(vector, scale(dot(self.normal, vector), self.normal))
 
     def pin(self, step: int | None, evaluation: Evaluation, side: int | None) -> tuple:
         """Return a pin's position: a joint's origin, or the closure's point on ``side``."""
@@ -288,6 +364,8 @@ class FiveBarPositions:
     def apex_position(self, evaluation: Evaluation, branch: int) -> tuple:
         """Return the apex pin's position on ``branch``."""
         p, q = (self.pin(end, evaluation, self.known_side) for end in self.ends)
+        # in the plane through p: each joint turns its pin about its axis, whatever its height
+        q = add(p, self.planar(subtract(q, p)))
         return circle_intersection(p, q, self.radii[0], self.radii[1], self.normal, branch)
 
     def reset(self, values: Sequence[float]) -> None:

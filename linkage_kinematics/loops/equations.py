@@ -56,6 +56,10 @@ from linkage_kinematics.loops.spatial import (
 )
 from linkage_kinematics.loops.tree import KinematicTree, Loop, MotionKind, Pose, unit_axis
 
+# What a closure's Jacobian rows need (LoopEquations._modes): none, its positions', all.
+_SKIP = 0
+_POSITIONS = 1
+_ALL = 2
 # Two universal-joint axes meet where their lines pass within this fraction of the rod's length
 # of each other (an exporter's printed digits leave some 1e-7), and are not parallel.
 CONCURRENT_TOLERANCE = 1e-9
@@ -98,6 +102,36 @@ class Rod:
     center: Vector
     rod: Vector
     length: float
+
+
+@dataclass(frozen=True)
+class Distance:
+    """
+    A closure written as one distance, |x − P| = L: what a rod (``Rod``) or a welded rod is.
+
+    ``points`` gives per side of the closure (parent, child) the moving frame and the point on
+    it that replaces the side's frame, or None to keep the side's frame's origin; ``trimmed``
+    are the steps that no longer move the loop (the rod's joints, whose angles follow in closed
+    form); P is on side ``center``, x on the other.
+    """
+
+    closure: str
+    points: tuple[tuple[int, Vector] | None, tuple[int, Vector] | None]
+    trimmed: frozenset[int]
+    center: int
+    length: float
+    # known slides inside the rod: L = |span + Σ (m·q + o)·u| over (coordinate, m, o, unit u),
+    # span and u in one frame of the rod (empty: L = ``length``)
+    stretch: tuple[tuple[int, float, float, Vector], ...] = ()
+    span: Vector = (0.0, 0.0, 0.0)
+
+
+def rod_distance(rod: Rod) -> Distance:
+    """Return the distance a rod's closure becomes: P at the universal joint, x the ball."""
+    points: list[tuple[int, Vector] | None] = [None, None]
+    points[rod.side] = (rod.socket, rod.center)
+    return Distance(rod.closure, (points[0], points[1]), frozenset(rod.steps), rod.side,
+                    rod.length)
 
 
 def universal_rod(tree: KinematicTree, loop: Loop, side: int) -> Rod | None:
@@ -158,23 +192,26 @@ class LoopEquations:
     The residuals of a set of closures and their exact Jacobian (module docstring).
 
     Values are given per coordinate in ``coordinates`` order (indices of the tree's
-    coordinates). ``rods`` names the ball closures whose rods are reduced to a distance.
+    coordinates). ``rods`` names the closures written as a distance (a ``Rod``'s ball closure,
+    or any ``Distance``).
     """
 
     def __init__(self, tree: KinematicTree, closures: Sequence[Closure],
-                 rods: Mapping[str, Rod] | None = None) -> None:
-        rods = dict(rods or {})
+                 rods: Mapping[str, Rod | Distance] | None = None) -> None:
+        distances = {name: rod_distance(rod) if isinstance(rod, Rod) else rod
+                     for name, rod in (rods or {}).items()}
         loops = [tree.loop(closure) for closure in closures]
         paths = []
         for loop in loops:
-            rod = rods.get(loop.closure.name)
+            distance = distances.get(loop.closure.name)
             trimmed = list(loop.paths)
-            if rod is not None:
-                trimmed[rod.side] = tuple(step for step in trimmed[rod.side]
-                                          if step not in rod.steps)
+            if distance is not None:
+                trimmed = [tuple(step for step in path if step not in distance.trimmed)
+                           for path in trimmed]
             paths.append(trimmed)
         self.coordinates: tuple[int, ...] = tuple(sorted(
-            {tree.steps[step].coordinate for sides in paths for path in sides for step in path}))
+            {tree.steps[step].coordinate for sides in paths for path in sides for step in path}
+            | {slide[0] for distance in distances.values() for slide in distance.stretch}))
         self.names = tuple(tree.coordinates[i].name for i in self.coordinates)
         column = {coordinate: i for i, coordinate in enumerate(self.coordinates)}
         bases = sorted({loop.base for loop in loops})
@@ -197,13 +234,16 @@ class LoopEquations:
         self.closure_rows: list[tuple[str, int, int]] = []
         for loop, sides in zip(loops, paths):
             program = bases.index(loop.base)
-            record = _closure_record(tree, loop, sides, rods.get(loop.closure.name),
+            record = _closure_record(tree, loop, sides, distances.get(loop.closure.name),
                                      slots[program], column, program)
             self.closure_rows.append((loop.closure.name, len(kinds), record[0].value))
             kinds += _row_kinds(record[0])
             self._closures.append(record)
         self.row_kinds = tuple(kinds)
         self.rows = len(kinds)
+        # per set of columns and of rows asked for: what ``jacobian`` computes (its caches)
+        self._prepared: dict[frozenset[int] | None, list[tuple]] = {}
+        self._row_modes: dict[frozenset[int] | None, list[int]] = {}
 
     def evaluate(self, values: Sequence[float], previous: Evaluation | None = None,
                  changed: Collection[int] | None = None) -> Evaluation:
@@ -230,18 +270,63 @@ class LoopEquations:
         """Return the residual rows at coordinate ``values``."""
         return self.evaluate(values).residual
 
-    def jacobian(self, evaluation: Evaluation,
-                 columns: Collection[int] | None = None) -> list[list[float]]:
+    def jacobian(self, evaluation: Evaluation, columns: Collection[int] | None = None,
+                 rows: Collection[int] | None = None) -> list[list[float]]:
         """
         Return ∂(residual)/∂(coordinates) at an evaluation, one list per row.
 
-        Only the ``columns`` asked for are computed (the others left 0); all by default.
+        Only the ``columns`` asked for are computed (the others left 0), and with ``rows``
+        only those rows are sure to be (a closure none of whose rows is asked for gives zero
+        rows; a pin's or weld's angle rows are left 0 unless one of them is asked for); all
+        by default. The per-sample solver asks for the same sets every time: give them as
+        frozensets, whose steps are then sorted out once.
         """
         width = len(self.coordinates)
-        rows: list[list[float]] = []
-        for record, pair in zip(self._closures, evaluation.points):
-            rows += _jacobian_rows(record, evaluation, pair, width, columns)
-        return rows
+        result: list[list[float]] = []
+        steps = self._steps(columns)
+        modes = self._modes(rows)
+        for record, pair, prepared, mode, (_, _, count) in zip(
+                self._closures, evaluation.points, steps, modes, self.closure_rows):
+            if mode == _SKIP:
+                result += [[0.0] * width for _ in range(count)]
+            else:
+                result += _jacobian_rows(record, evaluation, pair, width, prepared,
+                                         mode == _ALL)
+        return result
+
+    def _steps(self, columns: Collection[int] | None) -> list[tuple]:
+        """Return per closure its sides' steps that move ``columns`` (and its known slides)."""
+        key = columns if columns is None or isinstance(columns, frozenset) else frozenset(
+            columns)
+        prepared = self._prepared.get(key)
+        if prepared is None:
+            prepared = []
+            for record in self._closures:
+                sides = tuple(tuple((place, col, sign * multiplier, turn)
+                                    for place, col, multiplier, turn in side[4]
+                                    if key is None or col in key)
+                              for side, sign in ((record[2], 1.0), (record[3], -1.0)))
+                stretch = () if record[0] is not _Form.DISTANCE else tuple(
+                    slide for slide in record[6] if key is None or slide[0] in key)
+                prepared.append(sides + (stretch,))
+            self._prepared[key] = prepared
+        return prepared
+
+    def _modes(self, rows: Collection[int] | None) -> list[int]:
+        """Return per closure which of its rows ``rows`` needs: none, positions, all."""
+        key = rows if rows is None or isinstance(rows, frozenset) else frozenset(rows)
+        modes = self._row_modes.get(key)
+        if modes is None:
+            modes = []
+            for _, start, count in self.closure_rows:
+                if key is None or any(row in key for row in range(start + 3, start + count)):
+                    modes.append(_ALL)
+                elif any(row in key for row in range(start, start + count)):
+                    modes.append(_POSITIONS)
+                else:
+                    modes.append(_SKIP)
+            self._row_modes[key] = modes
+        return modes
 
     def jacobian_rate(self, evaluation: Evaluation,
                       rates: Sequence[float]) -> list[list[float]]:
@@ -266,7 +351,7 @@ class LoopEquations:
                                 _side_point(record[3], evaluation)))
             angle = None
             if form is _Form.DISTANCE:
-                gap = abs(gap - record[4])
+                gap = abs(gap - _length(record, evaluation.values))
             elif form is _Form.PIN:
                 n_a = apply(_frame_rotation(record[2], evaluation), record[4])
                 n_b = apply(_frame_rotation(record[3], evaluation), record[5])
@@ -318,6 +403,25 @@ class LoopEquations:
                     sx, sy, sz = sx - rate * wx, sy - rate * wy, sz - rate * wz
         return (vx, vy, vz), (sx, sy, sz)
 
+    def frame(self, closure: int, side: int, evaluation: Evaluation) -> tuple[Rotation, Vector]:
+        """Return the rotation and origin of a closure side's moving frame, in the base frame."""
+        program, slot = self._closures[closure][2 + side][:2]
+        rotations, positions = evaluation.frames[program][:2]
+        return rotations[slot], positions[slot]
+
+    def spin(self, closure: int, side: int, evaluation: Evaluation,
+             rates: Sequence[float]) -> Vector:
+        """Return how fast a closure side's moving frame turns in the base frame, for ``rates``."""
+        record = self._closures[closure][2 + side]
+        axes = evaluation.frames[record[0]][2]
+        sx = sy = sz = 0.0
+        for place, col, multiplier, turn in record[4]:
+            rate = multiplier * rates[col]
+            if turn and rate != 0.0:
+                wx, wy, wz = axes[place]
+                sx, sy, sz = sx + rate * wx, sy + rate * wy, sz + rate * wz
+        return (sx, sy, sz)
+
     def socket(self, closure: int) -> tuple[int, int]:
         """Return the program and slot of a closure's side-1 moving frame (a rod's socket)."""
         return self._closures[closure][3][0], self._closures[closure][3][1]
@@ -330,8 +434,8 @@ class LoopEquations:
 
 
 def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[int]],
-                    rod: Rod | None, slot: Mapping[int, int], column: Mapping[int, int],
-                    program: int) -> tuple:
+                    distance: Distance | None, slot: Mapping[int, int],
+                    column: Mapping[int, int], program: int) -> tuple:
     """
     Return what the rows of one closure need: (form, steps, side a, side b, extra…).
 
@@ -340,8 +444,9 @@ def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[in
     """
     def side(index: int) -> tuple:
         frame, offset = loop.sides[index]
-        if rod is not None and rod.side == index:
-            frame, offset = rod.socket, Pose(IDENTITY, rod.center)
+        if distance is not None and distance.points[index] is not None:
+            frame, point = distance.points[index]
+            offset = Pose(IDENTITY, point)
         steps = tuple((slot[step + 1] - 1, column[tree.steps[step].coordinate],
                        tree.steps[step].multiplier, tree.steps[step].kind is MotionKind.TURN)
                       for step in paths[index])
@@ -349,9 +454,10 @@ def _closure_record(tree: KinematicTree, loop: Loop, paths: Sequence[Sequence[in
 
     a, b = side(0), side(1)
     closure = loop.closure
-    if rod is not None:  # x on the other side, P on the rod's
-        x, center = (b, a) if rod.side == 0 else (a, b)
-        return (_Form.DISTANCE, None, x, center, rod.length)
+    if distance is not None:
+        x, center = (b, a) if distance.center == 0 else (a, b)
+        stretch = tuple((column[c], m, o, u) for c, m, o, u in distance.stretch)
+        return (_Form.DISTANCE, None, x, center, distance.length, distance.span, stretch)
     if closure.kind is ClosureKind.BALL:
         return (_Form.BALL, None, a, b)
     if closure.kind is ClosureKind.WELD:
@@ -393,13 +499,31 @@ def _point_rate(side: tuple, evaluation: Evaluation, motion: Motion) -> Vector:
                         _side_point(side, evaluation))
 
 
+def _span(record: tuple, values: Sequence[float]) -> Vector | None:
+    """Return a distance's rod vector with its known slides at ``values`` (None: no slides)."""
+    stretch = record[6]
+    if not stretch:
+        return None
+    x, y, z = record[5]
+    for col, multiplier, offset, (ux, uy, uz) in stretch:
+        travel = multiplier * values[col] + offset
+        x, y, z = x + travel * ux, y + travel * uy, z + travel * uz
+    return (x, y, z)
+
+
+def _length(record: tuple, values: Sequence[float]) -> float:
+    """Return a distance's length L at ``values`` (its known slides moved)."""
+    span = _span(record, values)
+    return record[4] if span is None else norm(span)
+
+
 def _residual(record: tuple, evaluation: Evaluation,
               points: tuple[Vector, Vector]) -> list[float]:
     form, _, a, b = record[:4]
     p_a, p_b = points
     dx, dy, dz = p_a[0] - p_b[0], p_a[1] - p_b[1], p_a[2] - p_b[2]
     if form is _Form.DISTANCE:
-        length = record[4]
+        length = _length(record, evaluation.values)
         return [(dx * dx + dy * dy + dz * dz - length * length) / (2.0 * length)]
     rows = [dx, dy, dz]
     if form is _Form.PIN:
@@ -413,48 +537,56 @@ def _residual(record: tuple, evaluation: Evaluation,
 
 
 def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, Vector],
-                   width: int, columns: Collection[int] | None) -> list[list[float]]:
+                   width: int, prepared: tuple, angles: bool) -> list[list[float]]:
+    """Return one closure's Jacobian rows over its ``prepared`` steps (LoopEquations._steps)."""
     form, _, a, b = record[:4]
     p_a, p_b = points
+    steps_a, steps_b, stretch = prepared
     if form is _Form.DISTANCE:
         # ∂/∂q of (|d|² − L²)/(2L) = d·(screw at x − screw at P)/L, d·(ω × (p − o)) written as
         # ω·((p − o) × d)
-        length = record[4]
+        span = _span(record, evaluation.values)
+        length = record[4] if span is None else norm(span)
         dx, dy, dz = ((p_a[0] - p_b[0]) / length, (p_a[1] - p_b[1]) / length,
                       (p_a[2] - p_b[2]) / length)
         row = [0.0] * width
-        for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+        if span is not None:
+            # a known slide stretches the rod: ∂r/∂L = −(|d|² + L²)/(2L²), ∂L/∂q = m·(u·ℓ)/L
+            factor = -(dx * dx + dy * dy + dz * dz + 1.0) / (2.0 * length)
+            for col, multiplier, _, direction in stretch:
+                row[col] += factor * multiplier * dot(direction, span)
+        for side, (px, py, pz), steps in ((a, p_a, steps_a), (b, p_b, steps_b)):
             _, _, axes, origins = evaluation.frames[side[0]]
-            for place, col, multiplier, turn in side[4]:
-                if columns is not None and col not in columns:
-                    continue
+            for place, col, factor, turn in steps:
                 wx, wy, wz = axes[place]
                 if turn:
                     ox, oy, oz = origins[place]
                     rx, ry, rz = px - ox, py - oy, pz - oz
-                    row[col] += sign * multiplier * (wx * (ry * dz - rz * dy)
-                                                     + wy * (rz * dx - rx * dz)
-                                                     + wz * (rx * dy - ry * dx))
+                    row[col] += factor * (wx * (ry * dz - rz * dy) + wy * (rz * dx - rx * dz)
+                                          + wz * (rx * dy - ry * dx))
                 else:
-                    row[col] += sign * multiplier * (wx * dx + wy * dy + wz * dz)
+                    row[col] += factor * (wx * dx + wy * dy + wz * dz)
         return [row]
     rows = [[0.0] * width for _ in range(form.value)]
     row_x, row_y, row_z = rows[0], rows[1], rows[2]
-    if form is _Form.PIN:
+    if not angles:
+        form = _Form.BALL
+    elif form is _Form.PIN:
         n_a = apply(_frame_rotation(a, evaluation), record[4])
         r_b = _frame_rotation(b, evaluation)
-        normals = (cross(n_a, apply(r_b, record[6])), cross(n_a, apply(r_b, record[7])))
+        (n0x, n0y, n0z), (n1x, n1y, n1z) = (cross(n_a, apply(r_b, record[6])),
+                                            cross(n_a, apply(r_b, record[7])))
+        row_3, row_4 = rows[3], rows[4]
     elif form is _Form.WELD:
         r_a = _side_rotation(a, evaluation)
         e = log_rotation(multiply(transpose(r_a), _side_rotation(b, evaluation)))
-        rate = log_rate_matrix(e)
-    for side, (px, py, pz), sign in ((a, p_a, 1.0), (b, p_b, -1.0)):
+        # ∂e/∂q = J⁻¹(e)·R_aᵀ·(−factor·ω)
+        m0, m1, m2, m3, m4, m5, m6, m7, m8 = multiply(log_rate_matrix(e), transpose(r_a))
+        row_3, row_4, row_5 = rows[3], rows[4], rows[5]
+    for side, (px, py, pz), steps in ((a, p_a, steps_a), (b, p_b, steps_b)):
         _, _, axes, origins = evaluation.frames[side[0]]
-        for place, col, multiplier, turn in side[4]:
-            if columns is not None and col not in columns:
-                continue
-            factor = sign * multiplier
-            wx, wy, wz = w = axes[place]
+        for place, col, factor, turn in steps:
+            wx, wy, wz = axes[place]
             if not turn:
                 row_x[col] += factor * wx
                 row_y[col] += factor * wy
@@ -466,13 +598,12 @@ def _jacobian_rows(record: tuple, evaluation: Evaluation, points: tuple[Vector, 
             row_y[col] += factor * (wz * rx - wx * rz)
             row_z[col] += factor * (wx * ry - wy * rx)
             if form is _Form.PIN:
-                rows[3][col] += factor * dot(w, normals[0])
-                rows[4][col] += factor * dot(w, normals[1])
+                row_3[col] += factor * (wx * n0x + wy * n0y + wz * n0z)
+                row_4[col] += factor * (wx * n1x + wy * n1y + wz * n1z)
             elif form is _Form.WELD:
-                ex, ey, ez = apply(rate, apply_transposed(r_a, scale(-factor, w)))
-                rows[3][col] += ex
-                rows[4][col] += ey
-                rows[5][col] += ez
+                row_3[col] -= factor * (m0 * wx + m1 * wy + m2 * wz)
+                row_4[col] -= factor * (m3 * wx + m4 * wy + m5 * wz)
+                row_5[col] -= factor * (m6 * wx + m7 * wy + m8 * wz)
     return rows
 
 
@@ -495,8 +626,8 @@ def _rate_rows(record: tuple, evaluation: Evaluation, motion: Motion,
             yield (place, col, multiplier, turn, w, _screw(frames, place, turn, point),
                    motion.screw_rate(side[0], place, turn, w, o, point, velocity))
 
-    if form is _Form.DISTANCE:
-        length = record[4]
+    if form is _Form.DISTANCE:  # (of a rod without known slides: the unreduced equations')
+        length = _length(record, evaluation.values)
         d, d_rate = subtract(p_a, p_b), subtract(v_a, v_b)
         row = [0.0] * width
         for side, point, velocity, sign in ((a, p_a, v_a, 1.0), (b, p_b, v_b, -1.0)):

@@ -127,7 +127,12 @@ class Program:
                 w = apply(rp, axis)
                 b, d = extra
                 s, t = math.sin(value), 1.0 - math.cos(value)
-                turned = tuple(rotation[n] + s * b[n] + t * d[n] for n in range(9))
+                r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation
+                turned = (r0 + s * b[0] + t * d[0], r1 + s * b[1] + t * d[1],
+                          r2 + s * b[2] + t * d[2], r3 + s * b[3] + t * d[3],
+                          r4 + s * b[4] + t * d[4], r5 + s * b[5] + t * d[5],
+                          r6 + s * b[6] + t * d[6], r7 + s * b[7] + t * d[7],
+                          r8 + s * b[8] + t * d[8])
                 child = turned if parent == 0 else multiply(rp, turned)
                 p = o
             else:
