@@ -10,7 +10,8 @@ comment holds a colon). ``linkage-check-loops`` finds its four closure groups: p
 one-degree-of-freedom knee known from its motor and a two-degree-of-freedom ankle of two balls
 known from its two motors. Every answer of the follower, over a motion through the joints'
 ranges, closes every loop by urchin's forward kinematics (not the package's): each knee's pin
-and each ankle's ball within 1e-15 m, the pins' axes parallel.
+and each ankle's ball within 1e-15 m, the pins' axes parallel. The follower's lists reach the
+solver as the same floats as the joints by name (``LoopSolver.solve``), bit for bit.
 """
 
 from __future__ import annotations
@@ -25,7 +26,9 @@ import tempfile
 
 from linkage_kinematics.cli import check_loops
 from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
+from linkage_kinematics.loops.intake import joint_velocity
 from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.loops.solver import LoopSolver
 from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.model.urdf_reader import JointType, read_urdf
 import numpy as np
@@ -160,3 +163,36 @@ def test_every_answer_closes_the_loops_by_urchins_forward_kinematics() -> None:
     assert worst <= TOLERANCE
     # the motion bends the knees and tilts the feet as far as it means to
     assert reached['knee'] > 1.4 and reached['ankle_pitch'] > 0.2 and reached['ankle_roll'] > 0.2
+
+
+def test_the_followers_samples_are_the_solvers_by_name_bit_for_bit() -> None:
+    """
+    The follower hands the solver the intake's lists: the same floats as by joint name.
+
+    A second solver of the same plan, given each sample's measured joints by name
+    (``LoopSolver.solve``), gives the same positions and velocities to the bit: every other
+    message carries velocities, the others none (the intake's backward difference).
+    """
+    follower = RobotLoopsFollower(read_loops(read_urdf(URDF.read_text(encoding='utf-8'))),
+                                  MOTORS, {}, math.pi / 2)
+    by_name = LoopSolver(follower.plan)
+    names = [*HIPS, *MOTORS]
+    last = None
+    for index, measured in enumerate(motion(SAMPLES)):
+        stamp_ns = (index + 1) * 10_000_000
+        positions = [measured[name] for name in names]
+        given = [0.01 * index - 0.1 * place for place in range(len(names))]
+        sample = follower.follow(stamp_ns, names, positions, given if index % 2 else [])
+        assert isinstance(sample, LoopSample)
+        rates = {name: joint_velocity(
+            stamp_ns, measured[name], given[names.index(name)] if index % 2 else None,
+            None if last is None else (last[0], last[1][name]))[0] for name in MOTORS}
+        last = stamp_ns, measured
+        solved, solved_rates = by_name.solve({name: measured[name] for name in MOTORS}, rates)
+        assert sample.names == tuple(solved)
+        assert [value.hex() for value in sample.positions] == [
+            value.hex() for value in solved.values()]
+        assert [value.hex() for value in sample.velocities] == [
+            value.hex() for value in solved_rates.values()]
+        assert list(sample.joints.items()) == [*((name, measured[name]) for name in MOTORS),
+                                               *solved.items()]
