@@ -39,10 +39,14 @@ PLACEMENTS = {'default': {}, 'cpu_affinity:=0': {'cpu_affinity': '0'}}
 CLOCK_TICKS = os.sysconf('SC_CLK_TCK')
 
 
-def cpu_seconds(pid: int) -> float:
-    """Utime + stime so far (s) of a process and its children (a logging node's bag writer)."""
+def cpu_seconds(pid: int, children: bool = True) -> float:
+    """
+    Utime + stime so far (s) of a process and its children (a logging node's bag writer).
+
+    ``children`` False: of the process alone.
+    """
     total = 0
-    for process in node_bench.with_children(pid):
+    for process in node_bench.with_children(pid) if children else [pid]:
         with open(f'/proc/{process}/stat', encoding='ascii') as stat:
             fields = stat.read().rsplit(')', 1)[1].split()
         total += int(fields[11]) + int(fields[12])

@@ -119,6 +119,26 @@ SECTIONS = {
         'joints.',
         ('The per-sample path in this process', 'The quadruped, side by side with the relay',
          'The excavator, side by side with the relay')),
+    'biped': Section(
+        "A biped's loops closed at 1 kHz: issue 29's cost goal",
+        '`urdf/biped.urdf`: per leg three hip joints outside the loops, a knee driven through a '
+        'planar four-bar from its motor and a parallel pitch–roll ankle on two motors (twelve '
+        'measured joints, four closure groups: two planar one-degree-of-freedom knees, two '
+        'two-degree-of-freedom ankles solved by Newton), walked by the encoder (each joint '
+        "swinging at 0.5 Hz over a walk's range, the right leg half a period behind the left, "
+        'velocities included; `bench/biped_bench.py`). First the per-sample path in this '
+        'process, part by part over one period of the walk: CPU time per sample of each part '
+        "(medians of interleaved runs), its share of the whole callback's, and with valgrind "
+        'its instructions per sample (callgrind, counted inside the part only: they do not '
+        "depend on the machine's load); the hand relay's callback with rclpy's "
+        '(de)serialisation is the yardstick of its own Python work. Then the measured '
+        "section's run: `linkage_node` (`loops:=robot_description`, logging on) and "
+        "`bench/minimal_relay.py` follow the encoder at once; CPU of each (the node's with its "
+        "bag writer's), latency from the encoder's stamp to a third process, samples lost, "
+        "and from the node's own bag which samples it received and published. The goal: CPU "
+        "≤ 1.0× the relay's, p99 latency ≤ the relay's + 0.5 ms, no sample lost by the node.",
+        ('The per-sample path in this process, part by part',
+         'Side by side with the relay')),
     'parallel': Section(
         'Parallel robots closed per sample, against the peers',
         "The package's general closure (`loops.newton.GroupSolver`, built as the node builds "
@@ -266,7 +286,7 @@ rewrites only its part. Earlier figures are in this file's git history
 ./dev bench                        # every section, written here
 ./dev bench --quick                # about 7 minutes: fewer angles, shorter runs
 ./dev bench --only cost            # one section (kinematics, drive, tf, node, cost, measured,
-                                   # loops, parallel, memory)
+                                   # loops, biped, parallel, memory)
 ./dev bench --only node --no-document   # print only
 ```
 

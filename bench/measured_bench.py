@@ -62,6 +62,9 @@ def follow_side_by_side(
     """
     Return per follower: CPU share of one core, latency p50 and p99 (s), samples lost.
 
+    The node's also: its process's CPU share without its bag writer's (``cpu alone``), and what
+    its bag says it did with the samples (``in the node``).
+
     ``node`` is (its name in the table, its namespace, its ``--ros-args`` after the measured
     source's and logging's); the relay follows the same encoder at the same time. ``files``
     (name → text) are written into the run's folder first, and ``{folder}`` in an argument is
@@ -106,8 +109,10 @@ def follow_side_by_side(
             time.sleep(1.0)
             started = time.monotonic()
             before = {key: cpu_seconds(process.pid) for key, process in processes.items()}
+            alone_before = cpu_seconds(node_process.pid, children=False)
             time.sleep(seconds - 2.0)
             after = {key: cpu_seconds(process.pid) for key, process in processes.items()}
+            alone_after = cpu_seconds(node_process.pid, children=False)
             elapsed = time.monotonic() - started
             data = node_bench.collect(listener, output)
             encoder.wait(timeout=seconds + 60.0)
@@ -131,6 +136,7 @@ def follow_side_by_side(
         raise RuntimeError(f'{name} published {shown}, not the joints {sorted(published)}')
     cpu = {key: (after[key] - before[key]) / elapsed for key in processes}
     figures = _figures(data['received'], sent, outputs, cpu)
+    figures[name]['cpu alone'] = (alone_after - alone_before) / elapsed
     expected = figures[name].pop('expected stamps')
     figures[RELAY].pop('expected stamps')
     # Only the loops node logs its input; the four-bar node's bag has its outputs alone.
@@ -186,6 +192,8 @@ def report(figures: dict[str, dict[str, float]]) -> str:
     table = markdown_table(['process', 'CPU (one core)', 'latency p50', 'latency p99',
                             'samples lost'], rows)
     goals = (
+        f"\nThe node's CPU without its bag writer's: {100.0 * node['cpu alone']:.1f} % (the "
+        f"writer's {100.0 * (node['cpu'] - node['cpu alone']):.1f} %)."
         f"\nCPU ratio node ÷ relay: {node['cpu'] / relay['cpu']:.2f} (goal ≤ 1.0); p99 "
         f"latency node − relay: {1e3 * (node['p99'] - relay['p99']):+.3f} ms (goal ≤ +0.5 ms); "
         f"samples the listener missed from the node: {node['lost']}."

@@ -9,13 +9,14 @@ tf (one state's /tf bytes, prepared against the generic forward kinematics), nod
 tick, rates, jitter, latency and log size), cost (the node's CPU side by side with a minimal
 hand-written rclpy publisher, its highest sustained rate with the default placement and with
 cpu_affinity:=0), measured and loops (the measured source, and a URDF's four loops closed, each
-against a minimal hand-written rclpy relay), parallel (parallel robots' loops closed per sample
-by the package and beside it by toolbox-parallel-robots, Pinocchio with Gauss–Newton and PlaCo,
-which it installs on first use: bench/peers.py) and memory (the node's resident memory over a
-long 1 kHz run). Every section prints markdown tables, which the run writes into
-docs/benchmarks.md (bench/document.py); the kinematics section also draws
-docs/benchmark_speed_error.png, the cost section docs/benchmark_cost_rate.png, the parallel
-section docs/benchmark_parallel.png.
+against a minimal hand-written rclpy relay), biped (issue 29's cost goal: a biped's two knees
+and two parallel ankles closed at 1 kHz beside the relay, and its per-sample path part by part),
+parallel (parallel robots' loops closed per sample by the package and beside it by
+toolbox-parallel-robots, Pinocchio with Gauss–Newton and PlaCo, which it installs on first use:
+bench/peers.py) and memory (the node's resident memory over a long 1 kHz run). Every section
+prints markdown tables, which the run writes into docs/benchmarks.md (bench/document.py); the
+kinematics section also draws docs/benchmark_speed_error.png, the cost section
+docs/benchmark_cost_rate.png, the parallel section docs/benchmark_parallel.png.
 """
 
 from __future__ import annotations
@@ -37,11 +38,11 @@ import document  # noqa: E402
 from ros_domains import domain_lease  # noqa: E402
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'parallel',
-            'memory')
+SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'biped',
+            'parallel', 'memory')
 # The sections that run nodes, each kind of run on its own ROS_DOMAIN_ID: the first one and the
 # four after it (node_bench's DOMAIN_* offsets).
-ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'memory')
+ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'biped', 'memory')
 DOMAIN_COUNT = 5
 
 
@@ -69,9 +70,9 @@ def main(argv: list[str] | None = None) -> int:
                         help="length of the node's resident-memory run at 1 kHz "
                              '(default 10, 0.5 with --quick)')
     parser.add_argument('--ros-domain', type=int, default=None,
-                        help='first of the five ROS_DOMAIN_IDs the node, cost, measured, loops '
-                             'and memory sections use (default: five in a row that no test or '
-                             'other benchmark run holds)')
+                        help='first of the five ROS_DOMAIN_IDs the node, cost, measured, loops, '
+                             'biped and memory sections use (default: five in a row that no '
+                             'test or other benchmark run holds)')
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
         parser.error('--repetitions must be at least 1')
@@ -159,6 +160,11 @@ def run_sections(arguments: argparse.Namespace, sections: Collection[str],
 
             parts = (loops_bench.path_run(arguments.quick, repetitions),
                      loops_bench.run(arguments.quick, ros_domain))
+        elif key == 'biped':
+            import biped_bench
+
+            parts = (biped_bench.path_run(arguments.quick, repetitions),
+                     biped_bench.run(arguments.quick, ros_domain))
         elif key == 'parallel':
             import parallel_bench
             import peers

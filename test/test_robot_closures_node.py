@@ -2,21 +2,21 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-linkage_node closing models others wrote, and the package's humanoid ankle, over DDS.
+linkage_node closing models others wrote, and the package's humanoid ankle and biped, over DDS.
 
 A real node (``loops:=robot_description``) is fed measured joints from this process; every
 ``joint_states`` it publishes must close the model's loops by the URDF's own forward kinematics,
 urchin's, not the package's: each closure's two frames put where urchin puts their links, their
 origins within 1e-12 m (and a weld's frames within 1e-12 rad). The models come in each of the
-three encodings: the ankle's ``<constraint>`` balls, Gepetto/example-parallel-robots' closure
-files, and the same closures written as ``<constraint>`` or ``<loop_joint>`` elements
-(test/example_parallel_robots.py). Battobot's closure file reads eight of its joints as
-universal and spherical joints, whose coordinates the node solves but does not publish (they
-are no URDF joints, so urchin cannot pose them): its answers are closed by the 50-digit
-reference's kinematics instead (test/closure_reference.py), which solves those coordinates
-itself with every published joint held. The samples start at the model's assembly the package
-takes at the zero pose (a closed pose: the measured joints there) and move every measured joint
-by up to a hundredth of a radian (or metre).
+three encodings: the ankle's ``<constraint>`` balls (and the biped's, with its knees' pins),
+Gepetto/example-parallel-robots' closure files, and the same closures written as
+``<constraint>`` or ``<loop_joint>`` elements (test/example_parallel_robots.py). Battobot's
+closure file reads eight of its joints as universal and spherical joints, whose coordinates the
+node solves but does not publish (they are no URDF joints, so urchin cannot pose them): its
+answers are closed by the 50-digit reference's kinematics instead (test/closure_reference.py),
+which solves those coordinates itself with every published joint held. The samples start at
+the model's assembly the package takes at the zero pose (a closed pose: the measured joints
+there) and move every measured joint by up to a hundredth of a radian (or metre).
 """
 
 from __future__ import annotations
@@ -46,6 +46,7 @@ import yaml
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 ANKLE = REPOSITORY / 'urdf' / 'humanoid_ankle.urdf'
+BIPED = REPOSITORY / 'urdf' / 'biped.urdf'
 TOLERANCE = 1e-12
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 START_NS = 1_000_000_000
@@ -73,6 +74,10 @@ def model(name: str, encoding: str) -> tuple[str, str | None, list[str]]:
     """
     if name == 'humanoid_ankle':
         return ANKLE.read_text(encoding='utf-8'), None, ['motor_left', 'motor_right']
+    if name == 'biped':  # its motors; the hips, outside the loops, stay at 0
+        return BIPED.read_text(encoding='utf-8'), None, [
+            f'{side}_{motor}' for side in ('left', 'right')
+            for motor in ('knee_motor', 'ankle_motor_lateral', 'ankle_motor_medial')]
     if encoding == 'closure file':
         return models.urdf(name), models.closure_file(name), []
     urdf = (models.with_constraints(name) if encoding == '<constraint>'
@@ -219,6 +224,7 @@ def worst_gap(urdf: str, closures: list, answered: list[dict[str, float]]) -> fl
 
 @pytest.mark.parametrize(('name', 'encoding'), [
     ('humanoid_ankle', '<constraint>'),
+    ('biped', '<constraint>'),
     ('5bar_linkage', '<loop_joint>'),
     ('cassie_like', 'closure file'),
     ('digit_like', '<constraint>'),

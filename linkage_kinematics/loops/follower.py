@@ -128,6 +128,7 @@ class RobotLoopsFollower:
                                    if planned.known.name == name)
                        + tuple(group.name for group in plan.general if name in group.known)
                        for name in measured}
+        self._measured = plan.measured  # in the order the intake takes them
         self._passive = plan.passive  # the solved joints' names, in the order solve gives them
 
     def restart(self) -> None:
@@ -159,19 +160,18 @@ class RobotLoopsFollower:
                                                        self._loops_of(taken.joints),
                                                        taken.detail)
         _, values, rates, estimates = taken
-        measured = self.solver.plan.measured
-        measured_values = dict(zip(measured, values))
         try:
-            solved, solved_rates = self.solver.solve(measured_values, dict(zip(measured, rates)))
+            solved, solved_rates = self.solver.solve_measured(values, rates)
         except LoopSampleError as error:
             return LoopDrop(DropReason.JOINTS_UNREACHABLE if error.refusal is None
                             else REFUSAL_DROPS[error.refusal],
                             () if error.constraint is None else (error.constraint,), str(error))
         self._intake.keep(stamp_ns, values)
-        joints = {**measured_values, **solved}
+        measured = self._measured
+        joints = dict(zip(measured, values))
+        joints.update(zip(self._passive, solved))
         return LoopSample(
-            stamp_ns, self._passive, tuple(solved.values()), tuple(solved_rates.values()),
-            joints, dict(zip(measured, estimates)),
+            stamp_ns, self._passive, solved, solved_rates, joints, dict(zip(measured, estimates)),
             {constraint: joints[known] for constraint, known in self._known})
 
 

@@ -213,6 +213,8 @@ class Intake:
                     jumps.append(self.joints[place])
             if jumps:
                 return IntakeDrop(DropReason.JUMP, tuple(jumps), f'{jumps} jumped')
+        if None not in given:  # every velocity measured, as an encoder's: joint_velocity's
+            return measured, values, given, [Estimate.MEASURED] * len(given)
         rates, estimates = [], []
         for place, rate in enumerate(given):
             rate, estimate = joint_velocity(

@@ -188,6 +188,31 @@ class LoopSolver:
                                       f'velocity {rate} are not both finite')
             values.append(value)
             rates.append(rate)
+        solved, solved_rates = self._close(values, rates)
+        return dict(zip(self._passive, solved)), dict(zip(self._passive, solved_rates))
+
+    def solve_measured(self, values: Sequence[float], rates: Sequence[float]
+                       ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """
+        Return every passive joint's position and velocity, in ``plan.passive``'s order.
+
+        ``solve`` without the names: the measured joints' ``values`` and ``rates`` (floats) in
+        ``plan.measured``'s order, as the follower's intake gives them, none missing. Raises as
+        ``solve``.
+        """
+        isfinite = math.isfinite
+        # one sum for the usual sample, every value finite; only a sum that is not is searched
+        if not isfinite(sum(values) + sum(rates)):
+            for name, value, rate in zip(self.plan.measured, values, rates):
+                if not (isfinite(value) and isfinite(rate)):
+                    raise LoopSampleError(f'measured joint {name!r}: position {value} and '
+                                          f'velocity {rate} are not both finite')
+        # the passive joints' are appended to the lists: the caller's stay as they are
+        return self._close(list(values), list(rates))
+
+    def _close(self, values: list[float], rates: list[float]
+               ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """Close the loops at the measured ``values`` and ``rates`` (checked), appended to."""
         known_values, branches = [], []
         solved = len(values)  # where the passive joints start
         previous = self._previous
@@ -229,5 +254,4 @@ class LoopSolver:
                     rates.append(velocities_out[index])
         self._known_values, self._branches = known_values, branches
         self._previous = values[solved:]
-        return (dict(zip(self._passive, self._previous)),
-                dict(zip(self._passive, rates[solved:])))
+        return tuple(self._previous), tuple(rates[solved:])
