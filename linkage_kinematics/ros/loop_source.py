@@ -322,7 +322,7 @@ class RobotLoopsSubscription(MeasuredInput):
         if host.control.paused:
             return  # ~/pause: not followed, not counted
         try:
-            stamp_ns, names, positions, velocities = self._decoder.decode(data)
+            stamp_ns, names, positions, velocities, _ = self._decoder.decode(data)
         except ValueError:  # not logged: it has no stamp, and readers would refuse it
             self._loops_health.drop(DropReason.MALFORMED)
             return
