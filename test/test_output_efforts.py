@@ -13,7 +13,9 @@ sample's own velocities. Without output joints, without efforts in the message, 
 among the actuators' efforts (joint_state_broadcaster's value for a missing interface), the
 sample has none. A group whose joints are not named keeps 0 on every joint. At the knee's toggle
 the efforts are withheld, naming the group, and the positions are still published. The output
-joints are checked when the plan is made: one line naming every problem.
+joints are checked when the plan is made: one line naming every problem. The diagnostics give
+each group with output joints a status: its actuators and outputs, its mechanical advantage at
+the last sample, what became of that sample's efforts and how many were withheld.
 """
 
 from __future__ import annotations
@@ -27,6 +29,11 @@ from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.loops.robot_transmission import plan_transmissions
 from linkage_kinematics.loops.transmission import MechanicalAdvantage, TransmissionError
 from linkage_kinematics.model.urdf_reader import read_urdf
+from linkage_kinematics.run.configuration import build_configuration
+from linkage_kinematics.run.control import RunState
+from linkage_kinematics.run.diagnostics import Level, Status, StatusInputs
+from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
+from linkage_kinematics.run.parameter_specs import parameter_specs
 import loop_robots
 import pytest
 
@@ -136,13 +143,12 @@ def test_a_group_without_output_joints_keeps_its_joints_at_zero():
     assert again.efforts == sample.efforts
 
 
-def test_at_the_knees_toggle_the_efforts_are_withheld_and_the_positions_published():
-    """At a rocker's end the crank and coupler are in line: dm/do has no bound there."""
-    followed = follower('knee')
+def toggle_angle(followed: RobotLoopsFollower) -> float:
+    """Return a motor angle where the knee's rocker turns back (d(output)/d(motor) = 0)."""
 
     def output_rate(motor: float) -> float:
         followed.restart()
-        sample = followed.follow(1, ['knee_motor'], [motor], [1.0], [1.0])
+        sample = followed.follow(1, ['knee_motor'], [motor], [1.0])
         return dict(zip(sample.names, sample.velocities))['knee_output']
 
     low = 0.0
@@ -153,6 +159,13 @@ def test_at_the_knees_toggle_the_efforts_are_withheld_and_the_positions_publishe
         middle = 0.5 * (low + high)
         low, high = ((middle, high) if output_rate(middle) * output_rate(low) > 0.0
                      else (low, middle))
+    return low
+
+
+def test_at_the_knees_toggle_the_efforts_are_withheld_and_the_positions_published():
+    """At a rocker's end the crank and coupler are in line: dm/do has no bound there."""
+    followed = follower('knee')
+    low = toggle_angle(followed)
     followed.restart()
     sample = followed.follow(1, ['knee_motor'], [low], [1.0], [1.0])
     assert sample.efforts == () and sample.withheld == 'knee_output_pin'
@@ -177,7 +190,7 @@ def test_output_joints_that_cannot_be_the_groups_are_refused_in_one_line():
         "twice; group boom_cylinder_pin: output joints ['boom_cylinder']: ['boom_cylinder'] "
         "are measured; an output joint is one the actuators ['boom_cylinder'] move; group "
         "bucket_cylinder_pin+bucket_pin: output joints ['bucket_joint', 'bucket_link_joint']: 2 "
-        "joints for 1 degrees of freedom that move it (as many as its actuators "
+        'joints for 1 degrees of freedom that move it (as many as its actuators '
         "['bucket_cylinder'])")
     # planned at the first message when the measured joints are not given: refused there
     later = RobotLoopsFollower(loops, (), {}, math.pi, outputs=('boom_cylinder',))
@@ -186,3 +199,72 @@ def test_output_joints_that_cannot_be_the_groups_are_refused_in_one_line():
     plan = loops.plan(CYLINDERS)
     assert [found.group.name for found in plan_transmissions(plan, ('bucket_joint',))] == [
         'bucket_cylinder_pin+bucket_pin']
+
+
+def transmission_statuses(followed: RobotLoopsFollower, health: LoopsHealth) -> list[Status]:
+    """Return the statuses of the follower's transmissions, as the node would publish them."""
+    values = {spec.name: spec.default for spec in parameter_specs('paper')}
+    config = build_configuration({**values, 'log.enabled': False, 'source': 'measured',
+                                  'loops': 'robot_description'})
+    inputs = StatusInputs(config=config, run_state=RunState.RUNNING, state=None,
+                          activity='following', achieved_rate=None, missed_deadlines=0,
+                          log_file=None, log_size=None, now_ns=0)
+    view = LoopsView(robot_name='r', description_from='topic', plan=followed.plan,
+                     health=health, groups=followed.solver.groups,
+                     transmissions=followed.output_efforts)
+    return [status for status in loop_statuses(inputs, view)
+            if status.task.startswith('transmission ')]
+
+
+def test_each_groups_transmission_has_a_status_with_its_advantage_now():
+    followed = follower('ankle')
+    health = LoopsHealth(0)
+    (status,) = transmission_statuses(followed, health)
+    assert (status.task, status.level, status.message) == (
+        'transmission ball_left+ball_right', Level.OK, 'waiting for motor_left, motor_right')
+    assert status.values == {
+        'actuators': 'motor_left, motor_right', 'output joints': 'ankle_pitch, ankle_roll',
+        'efforts': 'not followed yet', 'efforts withheld (samples)': '0',
+        'mechanical advantage': 'not followed yet', 'd(actuators)/d(outputs)': 'not followed yet'}
+    sample = followed.follow(1, ['motor_left', 'motor_right'], [0.2, -0.2], [0.0, 0.0], [1.0, 2.0])
+    health.accept(1, sample)
+    (status,) = transmission_statuses(followed, health)
+    (found,) = followed.output_efforts.groups
+    advantage = found.transmission.advantage(
+        [0.2, -0.2], [sample.joints[joint] for joint in found.transmission.solved])
+    assert (status.level, status.message) == (
+        Level.OK, 'ankle_pitch, ankle_roll from motor_left, motor_right')
+    assert status.values['mechanical advantage'] == advantage.describe()
+    assert status.values['mechanical advantage'].startswith(
+        'singular values of d(actuators)/d(outputs) ')
+    (left, right) = advantage.ratio
+    assert status.values['d(actuators)/d(outputs)'] == (
+        f'motor_left: {left[0]:.6g}, {left[1]:.6g}; motor_right: {right[0]:.6g}, {right[1]:.6g}')
+    assert status.values['efforts'] == (
+        "published: each output joint Mᵀ·(the actuators' measured efforts), every other "
+        'published joint 0')
+    health.accept(2, followed.follow(2, ['motor_left', 'motor_right'], [0.2, -0.2], [0.0, 0.0]))
+    (status,) = transmission_statuses(followed, health)
+    assert status.values['efforts'] == (
+        'not published: the input does not carry a finite effort of each of motor_left, '
+        'motor_right')
+
+
+def test_the_knees_status_warns_at_its_toggle_and_counts_the_samples_withheld():
+    followed = follower('knee')
+    health = LoopsHealth(0)
+    health.accept(1, followed.follow(1, ['knee_motor'], [0.7], [1.0], [1.0]))
+    (status,) = transmission_statuses(followed, health)
+    assert status.values['mechanical advantage'].startswith('d(knee_motor)/d(knee_output) = ')
+    # the rocker's end (test above): the crank in line with the coupler
+    toggle = toggle_angle(followed)
+    followed.restart()
+    health.accept(2, followed.follow(2, ['knee_motor'], [toggle], [1.0], [1.0]))
+    (status,) = transmission_statuses(followed, health)
+    assert status.level is Level.WARN
+    assert status.message.startswith('group knee_output_pin: the output joints are too near a '
+                                     'singular configuration of the transmission')
+    assert status.values['efforts'] == (
+        'withheld: the transmission is too near a singular configuration')
+    assert status.values['efforts withheld (samples)'] == '1'
+    assert status.values['mechanical advantage'] == 'none: ' + status.message

@@ -175,21 +175,22 @@ class OutputEfforts:
         Return each group's mechanical advantage at a sample, or why it has none there.
 
         ``joints``: the sample's measured and published joints by name; a coordinate the
-        closure file overrides is taken from its group's ``steps`` state (None: the group has
-        not solved a sample since it was last assembled).
+        closure file overrides is taken from its group's ``steps`` state. None where the sample
+        lacks a joint of the group (another description's) or the group has not solved one since
+        it was last assembled.
         """
         found: list[MechanicalAdvantage | TransmissionSingular | None] = []
         for source in self._sources:
             transmission = source.transmission
             state = None if source.step is None else steps[source.step].state
-            if state is None and not set(transmission.solved) <= set(joints):
+            known = [joints.get(name) for name in transmission.actuators]
+            solved = [joints.get(name, None if state is None else state.positions[place])
+                      for place, name in enumerate(transmission.solved)]
+            if None in known or None in solved:
                 found.append(None)
                 continue
-            solved = [joints[name] if name in joints else state.positions[place]
-                      for place, name in enumerate(transmission.solved)]
             try:
-                found.append(transmission.advantage(
-                    [joints[name] for name in transmission.actuators], solved))
+                found.append(transmission.advantage(known, solved))
             except TransmissionSingular as singular:
                 found.append(singular)
         return tuple(found)
