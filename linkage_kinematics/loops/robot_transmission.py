@@ -6,11 +6,12 @@ A robot's transmissions with names: which groups have output joints, and their e
 
 ``plan_transmissions`` takes a ``plan.LoopPlan`` and the output joints (``loops.output_joints``)
 and gives each closure group that they name joints of its ``transmission.Transmission``, built
-and checked at the group's assembled pose nearest the zero pose (a group of the general closure:
-the plan's own, ``GroupPlan.zero``; a group of planar loops, which the plan closes in closed form
-without assembling it: assembled here the same way), with that pose: what the command direction
-(``command.CommandGroup``) starts from too. A group none of whose joints is named has no
-transmission: its joints are published as without the parameter.
+and checked at the robot's assembled pose: a group of the general closure at its zero-pose
+assembly (``GroupPlan.zero``), the planar loops closed in closed form at the actuators' zero
+values on their planned branches (the zero pose's, or ``loops.branches``), as the node closes
+them; with that pose, which the command direction (``command.CommandGroup``) starts from too.
+A group none of whose joints is named has no transmission: its joints are published as without
+the parameter.
 
 ``OutputEfforts`` turns one sample's measured actuator efforts into the efforts of the joints
 the node publishes (``LoopPlan.passive``, in that order): each output joint τ_o = Mᵀ·τ_m
@@ -27,13 +28,11 @@ mechanical advantage at a sample (diagnostics; not the per-sample path). Pure: n
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
-from linkage_kinematics.loops.assembly import AssemblyError
-from linkage_kinematics.loops.newton import plan_group
 from linkage_kinematics.loops.plan import GroupPlan, LoopPlan
-from linkage_kinematics.loops.solver import GroupStep
-from linkage_kinematics.loops.structure import GroupStructure
+from linkage_kinematics.loops.solver import GroupStep, LoopSampleError, LoopSolver
+from linkage_kinematics.loops.structure import analyse, GroupStructure
 from linkage_kinematics.loops.transmission import (
     assign_outputs,
     MechanicalAdvantage,
@@ -58,13 +57,29 @@ class GroupTransmission:
     transmission: Transmission
 
 
-def _assembled(plan: LoopPlan, group: GroupPlan) -> tuple[GroupStructure, tuple[float, ...]]:
-    """Return a group's structure and its assembled pose nearest the zero pose (AssemblyError)."""
-    if group.zero is not None:
-        return group.zero.structure, group.zero.assembly.values
+def _assembled(plan: LoopPlan) -> list[float]:
+    """
+    Return the robot's assembled pose (module docstring), every coordinate of the tree.
+
+    TransmissionError where the planar loops do not close at the actuators' zero values.
+    """
     tree = plan.tree
-    planned = plan_group(tree, group.group, [0.0] * len(tree.names), hold_known=False)
-    return planned.structure, planned.assembly.values
+    values = [0.0] * len(tree.names)
+    for group in plan.general:
+        for index in group.group.coordinates:
+            values[index] = group.zero.assembly.values[index]
+    if plan.loops:
+        planar = LoopSolver(replace(plan, groups=tuple(group for group in plan.groups
+                                                       if group.zero is None)))
+        zeros = dict.fromkeys(plan.measured, 0.0)
+        try:
+            solved, _ = planar.solve(zeros, zeros)
+        except LoopSampleError as error:
+            raise TransmissionError("the planar loops do not close at the actuators' zero "
+                                    f'values: {error}') from None
+        for name, value in solved.items():
+            values[tree.index[name]] = value
+    return values
 
 
 def plan_transmissions(plan: LoopPlan,
@@ -76,7 +91,8 @@ def plan_transmissions(plan: LoopPlan,
     joint of the robot, is named twice or is a joint of no closure group
     (``transmission.assign_outputs``), a coordinate the closure file overrides (never
     published), and per group output joints that cannot be its (``transmission.check_outputs``:
-    measured, not as many as its degrees of freedom, not independent at the assembled pose).
+    measured, not as many as its degrees of freedom, not independent at the assembled pose);
+    or planar loops that do not close at the actuators' zero values.
     """
     tree = plan.tree
     assigned, problems = assign_outputs(tree, [group.group for group in plan.groups], outputs)
@@ -85,14 +101,19 @@ def plan_transmissions(plan: LoopPlan,
     problems += [f'output joint {name!r} is a coordinate the closure file overrides: it is '
                  'solved but not published' for name in outputs if name in hidden]
     found = []
+    try:
+        values = _assembled(plan) if any(assigned.values()) else []
+    except TransmissionError as error:
+        raise TransmissionError('; '.join([*problems, str(error)])) from None
     for group in plan.groups:
         names = assigned[group.name]
         if not names:
             continue
+        structure = (group.zero.structure if group.zero is not None
+                     else analyse(tree, group.group, values))
         try:
-            structure, values = _assembled(plan, group)
             transmission = Transmission(tree, group.group, structure, names, values)
-        except (AssemblyError, TransmissionError) as error:
+        except TransmissionError as error:
             problems.append(str(error))
             continue
         found.append(GroupTransmission(group, structure, tuple(values), transmission))
