@@ -15,19 +15,28 @@ sample has none. A group whose joints are not named keeps 0 on every joint. At t
 the efforts are withheld, naming the group, and the positions are still published. The output
 joints are checked when the plan is made: one line naming every problem. The diagnostics give
 each group with output joints a status: its actuators and outputs, its mechanical advantage at
-the last sample, what became of that sample's efforts and how many were withheld.
+the last sample, what became of that sample's efforts and how many were withheld. The command
+direction's examples in docs/following_loops.md (the excavator's boom trajectory, the ankle's
+torques) are what the command direction gives with the node's transmissions.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+import re
 import sys
 
+from linkage_kinematics.loops.command import CommandGroup, CommandRefused, JointPoint
 from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
 from linkage_kinematics.loops.plan import read_loops
+from linkage_kinematics.loops.robot_command import RobotCommand
 from linkage_kinematics.loops.robot_transmission import plan_transmissions
-from linkage_kinematics.loops.transmission import MechanicalAdvantage, TransmissionError
+from linkage_kinematics.loops.transmission import (
+    actuator_efforts,
+    MechanicalAdvantage,
+    TransmissionError,
+)
 from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.control import RunState
@@ -36,6 +45,7 @@ from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, 
 from linkage_kinematics.run.parameter_specs import parameter_specs
 import loop_robots
 import pytest
+import yaml
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 EPSILON = sys.float_info.epsilon
@@ -268,3 +278,65 @@ def test_the_knees_status_warns_at_its_toggle_and_counts_the_samples_withheld():
         'withheld: the transmission is too near a singular configuration')
     assert status.values['efforts withheld (samples)'] == '1'
     assert status.values['mechanical advantage'] == 'none: ' + status.message
+
+
+# --- the command direction the document shows ---------------------------------------------------
+
+def documented_section(title: str) -> str:
+    """Return a section of docs/following_loops.md, from its heading to the next one."""
+    text = (REPOSITORY / 'docs' / 'following_loops.md').read_text(encoding='utf-8')
+    start = text.index(f'### {title}\n')
+    return text[start:text.index('\n##', start + 4)]
+
+
+def robot_command(urdf: str, measured: tuple[str, ...],
+                  outputs: tuple[str, ...]) -> RobotCommand:
+    """Return the robot's command direction, its groups those of the node's transmissions."""
+    loops = read_loops(read_urdf(urdf))
+    plan = loops.plan(measured)
+    return RobotCommand([CommandGroup(plan.tree, found.transmission, found.values, loops.loops)
+                         for found in plan_transmissions(plan, outputs)], loops.joint_names)
+
+
+def test_the_documented_boom_trajectory_is_what_the_command_direction_gives():
+    """The boom joint's three points in, the boom cylinder's out (positions, velocities)."""
+    section = documented_section('The excavator: cylinder forces and a boom trajectory')
+    sent = yaml.safe_load(re.search(r'JointTrajectory \\\n  "(\{.*?\})"', section).group(1))
+    relayed = yaml.safe_load(re.findall(r'```text\n(.*?)```', section, re.DOTALL)[1])
+    command = robot_command((REPOSITORY / 'urdf' / 'excavator.urdf').read_text(encoding='utf-8'),
+                            CYLINDERS, BOOM_STICK_BUCKET)
+    names = sent['joint_names']
+    points = command.trajectory(names, [JointPoint(tuple(point['positions']),
+                                                   tuple(point['velocities']))
+                                        for point in sent['points']])
+    assert list(command.names(names)) == relayed['joint_names'] == ['boom_cylinder']
+    assert len(points) == len(relayed['points'])
+    for point, given, shown in zip(points, sent['points'], relayed['points']):
+        assert list(point.positions) == pytest.approx(shown['positions'], rel=1e-12, abs=1e-15)
+        assert list(point.velocities) == pytest.approx(shown['velocities'], rel=1e-12,
+                                                       abs=1e-15)
+        assert shown['time_from_start'] == given['time_from_start']
+    # beyond the stroke: the boom at −1.0 rad needs more than the cylinder's 0.5 m
+    with pytest.raises(CommandRefused, match=r"actuator 'boom_cylinder' at 0\.5\d+ outside"):
+        command.trajectory(names, [JointPoint((-0.4,)), JointPoint((-1.0,))])
+
+
+def test_the_documented_ankle_torques_are_what_the_command_direction_gives():
+    """Pitch and roll torques in, at the pose the motors measure, the motors' out."""
+    section = documented_section("The humanoid ankle's torques")
+    sent = yaml.safe_load(re.search(r'Float64MultiArray \\\n  "(\{.*?\})"', section).group(1))
+    relayed = yaml.safe_load(re.findall(r'```text\n(.*?)```', section, re.DOTALL)[1])
+    # the pose the motors measure in the document's sample, closed as the node closes it
+    followed = follower('ankle')
+    sample = followed.follow(1, ['motor_left', 'motor_right'], [0.2, -0.2], [0.5, 0.5])
+    (found,) = followed.output_efforts.groups
+    transmission = found.transmission
+    ratio = transmission.ratio(transmission.local(
+        [0.2, -0.2], [sample.joints[joint] for joint in transmission.solved]))
+    assert list(actuator_efforts(ratio, sent['data'])) == pytest.approx(relayed['data'],
+                                                                         rel=1e-12)
+    command = robot_command(ANKLE, ('motor_left', 'motor_right'), ('ankle_pitch', 'ankle_roll'))
+    point = command.convert(['ankle_pitch', 'ankle_roll'], JointPoint(
+        (sample.joints['ankle_pitch'], sample.joints['ankle_roll']), (), (),
+        tuple(sent['data'])))
+    assert list(point.efforts) == pytest.approx(relayed['data'], rel=1e-12)

@@ -13,13 +13,15 @@ efforts as sent, the outputs' as published), and every other joint 0; a message 
 is answered without; the bag holds the input and the output as they went. Each group with output
 joints has its status with its mechanical advantage. Without the parameter nothing of this is
 published. Output joints that cannot be a group's end the start with one line (exit 2), or, for a
-description on the topic, make the status ERROR while the node keeps running.
+description on the topic, make the status ERROR while the node keeps running. The efforts
+docs/following_loops.md shows for the excavator and the ankle are what the node publishes.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+import re
 import sys
 
 import loop_robots
@@ -30,6 +32,7 @@ from rosbags.typesys import get_typestore, Stores
 from sensor_msgs.msg import JointState
 from std_msgs.msg import String
 from test_robot_loops import loop_node, LoopNode, values
+import yaml
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 ANKLE = (REPOSITORY / 'urdf' / 'humanoid_ankle.urdf').read_text(encoding='utf-8')
@@ -200,3 +203,46 @@ def test_a_description_on_the_topic_with_bad_output_joints_is_an_error(
             'joints for 2 degrees of freedom that move it (as many as its actuators '
             "['motor_left', 'motor_right'])")
         assert node.process.poll() is None
+
+
+def documented_section(title: str) -> str:
+    """Return a section of docs/following_loops.md, from its heading to the next one."""
+    text = (REPOSITORY / 'docs' / 'following_loops.md').read_text(encoding='utf-8')
+    start = text.index(f'### {title}\n')
+    return text[start:text.index('\n##', start + 4)]
+
+
+def documented_sample(section: str) -> tuple[list[str], list[float], list[float], list[float]]:
+    """Return the names, positions, velocities and efforts of a section's JointState pub."""
+    published = re.search(r'"\{name: \[(.*?)\], position: \[(.*?)\], velocity: \[(.*?)\], '
+                          r'effort: \[(.*?)\]\}"', section)
+    names = [name.strip() for name in published.group(1).split(',')]
+    return names, *([float(value) for value in published.group(k).split(',')]
+                     for k in (2, 3, 4))
+
+
+@pytest.mark.parametrize(('title', 'name'), [
+    ('The excavator: cylinder forces and a boom trajectory', 'excavator'),
+    ("The humanoid ankle's torques", 'ankle')])
+def test_the_documented_efforts_are_what_the_node_publishes(context, nodes, tmp_path, title,
+                                                            name):
+    """The document's sample with efforts in, the efforts of its echo out."""
+    section = documented_section(title)
+    names, positions, velocities, efforts = documented_sample(section)
+    echo = yaml.safe_load(re.search(r'```text\n(.*?)```', section, re.DOTALL).group(1))
+    urdf, measured, outputs, _, _ = ROBOTS[name]
+    assert names == measured
+    with loop_node(context, nodes, tmp_path, {**parameters(name), 'log.enabled': False}) as node:
+        send(node, START_NS, names, positions, velocities, efforts)
+        group = f'transmission {next(iter(ROBOTS[name][4]))}'
+        status = values(node.status(group, lambda status: values(status)[
+            'mechanical advantage'] != 'not followed yet'))
+        assert nodes.interrupt(node.process) == 0
+        node.listener.drain()
+    (message,) = node.outputs
+    if 'name' in echo:
+        assert list(message.name) == echo['name']
+    assert list(message.effort) == pytest.approx(echo['effort'], rel=1e-12, abs=1e-12)
+    if name == 'excavator':
+        assert (f'`mechanical advantage: {status["mechanical advantage"]}`'
+                in ' '.join(section.split()))
