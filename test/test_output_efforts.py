@@ -333,8 +333,8 @@ def test_the_documented_ankle_torques_are_what_the_command_direction_gives():
     transmission = found.transmission
     ratio = transmission.ratio(transmission.local(
         [0.2, -0.2], [sample.joints[joint] for joint in transmission.solved]))
-    assert list(actuator_efforts(ratio, sent['data'])) == pytest.approx(relayed['data'],
-                                                                         rel=1e-12)
+    motors = actuator_efforts(ratio, sent['data'])
+    assert list(motors) == pytest.approx(relayed['data'], rel=1e-12)
     command = robot_command(ANKLE, ('motor_left', 'motor_right'), ('ankle_pitch', 'ankle_roll'))
     point = command.convert(['ankle_pitch', 'ankle_roll'], JointPoint(
         (sample.joints['ankle_pitch'], sample.joints['ankle_roll']), (), (),

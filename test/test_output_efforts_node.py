@@ -217,8 +217,9 @@ def documented_sample(section: str) -> tuple[list[str], list[float], list[float]
     published = re.search(r'"\{name: \[(.*?)\], position: \[(.*?)\], velocity: \[(.*?)\], '
                           r'effort: \[(.*?)\]\}"', section)
     names = [name.strip() for name in published.group(1).split(',')]
-    return names, *([float(value) for value in published.group(k).split(',')]
-                     for k in (2, 3, 4))
+    positions, velocities, efforts = ([float(value) for value in published.group(k).split(',')]
+                                      for k in (2, 3, 4))
+    return names, positions, velocities, efforts
 
 
 @pytest.mark.parametrize(('title', 'name'), [
