@@ -188,7 +188,7 @@ def path_workloads(measured: tuple[str, ...], urdf: str, inputs: list[Message]
 
     def fields_before(data: bytes) -> tuple:
         stamp_ns, names, positions, velocities = decode_before(data)
-        return stamp_ns, tuple(names), tuple(positions), tuple(velocities)
+        return stamp_ns, tuple(names), tuple(positions), tuple(velocities), ()
 
     loop_joints = follower.loop_joints
     identical = all(

@@ -1,7 +1,12 @@
 # Copyright 2026 linkage_kinematics maintainers
 # SPDX-License-Identifier: Apache-2.0
 
-"""linkage-check-loops, run as a process: its printout, its problem lines and exit statuses."""
+"""
+linkage-check-loops, run as a process: its printout, its problem lines and exit statuses.
+
+With ``--outputs``, each group's transmission: the lines ``loops.transmission_range`` gives for
+the same group planned independently (test/transmission_robots.py), within the URDF's limits.
+"""
 
 from __future__ import annotations
 
@@ -12,8 +17,11 @@ import re
 import subprocess
 import sys
 
-from loop_robots import parallelogram_mimic, ROBOTS
+from linkage_kinematics.loops.command import CommandRefusal
+from linkage_kinematics.loops.transmission_range import advantage_range
+from loop_robots import excavator, parallelogram_mimic, ROBOTS
 from test_loops_model import four_bar
+import transmission_robots
 
 COMMAND = [sys.executable, '-m', 'linkage_kinematics.cli.check_loops']
 PROGRAM = 'linkage-check-loops'
@@ -310,3 +318,99 @@ def test_an_assembly_seed_picks_the_other_assembly(tmp_path: Path) -> None:
     seeded = assembled('--assemblies', f'free1={-math.radians(free1) * 3:.6f}')
     assert ', seeded free1 = ' in seeded
     assert abs(float(re.search(r'free1 (-?\d+\.\d+)°', seeded).group(1)) - free1) > 1.0
+
+
+# --- transmissions: --outputs ------------------------------------------------------------------
+
+EXCAVATOR = Path(__file__).resolve().parent.parent / 'urdf' / 'excavator.urdf'
+CYLINDERS = ('boom_cylinder', 'stick_cylinder', 'bucket_cylinder')
+BOOM_STICK_BUCKET = ('boom_joint', 'stick_joint', 'bucket_joint')
+
+
+def test_the_excavator_file_is_the_test_robots() -> None:
+    """urdf/excavator.urdf is test/loop_robots.py's excavator with a comment at its head."""
+    text = EXCAVATOR.read_text(encoding='utf-8')
+    assert re.sub(r'<!--.*?-->\n', '', text, flags=re.DOTALL) == excavator()
+
+
+def transmissions(stdout: str) -> dict[str, list[str]]:
+    """Return the printout's transmissions: each group's lines, its head line first."""
+    found: dict[str, list[str]] = {}
+    group = None
+    for line in stdout.splitlines():
+        head = re.match(r"transmission of group '([^']+)': ", line)
+        if head:
+            group = head.group(1)
+            found[group] = [line]
+        elif group is not None and line.startswith('  '):
+            found[group].append(line)
+        else:
+            group = None
+    return found
+
+
+def test_each_groups_transmission_ratio_over_its_reach_within_the_cylinders_strokes() -> None:
+    completed = run(str(EXCAVATOR), '--measured', *CYLINDERS, '--outputs', *BOOM_STICK_BUCKET)
+    assert (completed.returncode, completed.stderr) == (0, '')
+    found = transmissions(completed.stdout)
+    robot = transmission_robots.build('excavator')
+    assert list(found) == [transmission.name for transmission in robot.transmissions]
+    for transmission, planned, command in zip(robot.transmissions, robot.planned,
+                                              robot.commands):
+        lines = found[transmission.name]
+        (actuator,), (output,) = transmission.actuators, transmission.outputs
+        assert lines[0] == (f"transmission of group '{transmission.name}': output joints "
+                            f'{output}; actuators {actuator}')
+        values = planned.assembly.values
+        index = robot.tree.index
+        now = transmission.advantage([values[index[actuator]]],
+                                     [values[index[name]] for name in transmission.solved])
+        assert lines[1] == f'  at the assembled pose: {now.describe()}'
+        swept = advantage_range(command)
+        assert lines[2:] == swept.describe()
+        # every end of the boom's and stick's reach is where the cylinder's stroke ends, which
+        # is where commands stop (the bucket's low end: its linkage's singular configuration)
+        (sweep,) = swept.sweeps
+        assert sweep.high_end == CommandRefusal.LIMIT.value
+        assert f'{output}: [' in lines[3] and 'its URDF <limit>' in lines[3]
+        low, high = swept.ratio
+        assert low <= now.ratio[0][0] <= high
+
+
+def test_the_ankles_ratio_is_swept_in_slices_within_its_limits() -> None:
+    completed = run(str(ANKLE), '--measured', 'motor_left', 'motor_right', '--outputs',
+                    'ankle_pitch', 'ankle_roll')
+    assert (completed.returncode, completed.stderr) == (0, '')
+    lines = transmissions(completed.stdout)['ball_left+ball_right']
+    assert lines[0] == ("transmission of group 'ball_left+ball_right': output joints "
+                        'ankle_pitch, ankle_roll; actuators motor_left, motor_right')
+    assert lines[1].startswith('  at the assembled pose: singular values of '
+                               'd(actuators)/d(outputs) ')
+    assert lines[2].startswith("  output joints ['ankle_pitch', 'ankle_roll'] -> actuators "
+                               "['motor_left', 'motor_right'] (slices: ")
+    # pitch up to its URDF limit, down to where a motor would leave its own; roll to its limits
+    assert lines[3].startswith('    ankle_pitch: [')
+    assert lines[3].endswith(', 0.5] (low end: an actuator would leave its URDF <limit>; high '
+                             'end: its URDF <limit>)')
+    assert lines[4].startswith('    ankle_roll: [-0.35, 0.35] ')
+    smallest, largest = (float(value) for value in re.findall(
+        r'from ([^ ]+) \(at .*\) to ([^ ]+)$', lines[5])[0])
+    assert 0.5 < smallest < largest < 10.0
+    assert lines[6].startswith('    actuator effort per unit output effort, at worst: '
+                               'motor_left ')
+
+
+def test_output_joints_that_are_no_groups_are_one_line_and_exit_1() -> None:
+    completed = run(str(EXCAVATOR), '--measured', *CYLINDERS, '--outputs', 'boom_cylinder',
+                    'tooth')
+    assert completed.returncode == 1
+    assert completed.stderr.splitlines() == [
+        f"{PROGRAM}: --outputs: output joint 'tooth' is not a joint of the robot; group "
+        "boom_cylinder_pin: output joints ['boom_cylinder']: ['boom_cylinder'] are measured; an "
+        "output joint is one the actuators ['boom_cylinder'] move"]
+    assert 'transmission of group' not in completed.stdout
+    unmeasured = run(str(EXCAVATOR), '--outputs', 'boom_joint')
+    assert unmeasured.returncode == 1
+    assert unmeasured.stderr.splitlines() == [
+        f'{PROGRAM}: --outputs: the output joints are those of closure groups the measured '
+        "joints close (--measured, or the closure file's name_mot)"]

@@ -10,6 +10,9 @@ the paper quantities it plots as plain fields of /linkage/state.
 The node runs once (the seed's variable-law turn) and logs a bag; every message path of the
 layout is then parsed, walked through the ``ros2msg`` schema stored in that bag and evaluated on
 every logged message, and the values it reads are compared with the library and the seed's table.
+The efforts tab's paths are those of a loops node's bag (``loops:=robot_description`` with
+``loops.output_joints``): the humanoid ankle's motors' efforts as measured, beside pitch's and
+roll's as published, whose power balances the motors'.
 """
 from __future__ import annotations
 
@@ -25,10 +28,12 @@ from linkage_kinematics.kinematics.solver import solve
 from linkage_kinematics.ros import messages
 from mcap.reader import make_reader
 from mcap_ros2.decoder import DecoderFactory
-from node_process import decode, NodeProcesses, REPOSITORY
+from node_process import decode, NodeProcesses, REPOSITORY, ros_context
 import pytest
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import get_types_from_msg
+from sensor_msgs.msg import JointState
+from test_robot_loops import loop_node
 
 NODE_EXIT_TIMEOUT = 60.0  # s; the stop run ends by itself after 1.57 s of motion
 LAYOUT_FILE = REPOSITORY / 'foxglove' / 'linkage_layout.json'
@@ -50,6 +55,13 @@ MESSAGE_PATH = re.compile(r'(?P<topic>/[A-Za-z0-9_/]+)(?P<fields>(?:\.[A-Za-z_]\
 FIELD = re.compile(r'\.([A-Za-z_]\w*)(?:\[(\d+)\])?')
 NUMERIC_TYPES = {'float32', 'float64', 'int8', 'uint8', 'int16', 'uint16', 'int32', 'uint32',
                  'int64', 'uint64'}
+# The efforts tab: the plots of a loops node's bag (the others: the four-bar's), read against
+# the humanoid ankle's, its motors measured and its pitch and roll the output joints.
+EFFORTS_TAB = 'Efforts'
+ANKLE_URDF = REPOSITORY / 'urdf' / 'humanoid_ankle.urdf'
+MOTORS = ['motor_left', 'motor_right']
+ANKLE_OUTPUTS = ['ankle_pitch', 'ankle_roll']
+EFFORT_SAMPLES = 50
 
 
 def load_layout() -> dict[str, Any]:
@@ -61,10 +73,25 @@ def plots(layout: dict[str, Any]) -> dict[str, dict[str, Any]]:
             if key.startswith('Plot!')}
 
 
-def plotted_paths(layout: dict[str, Any]) -> list[str]:
-    """Every message path the plots read: their series and their custom x axes."""
+def effort_plots(layout: dict[str, Any]) -> dict[str, dict[str, Any]]:
+    """Return the efforts tab's plots, which read a loops node's bag."""
+    [tab_panel] = [config for key, config in layout['configById'].items()
+                   if key.startswith('Tab!')]
+    [tab] = [tab for tab in tab_panel['tabs'] if tab['title'] == EFFORTS_TAB]
+    return {key: layout['configById'][key] for key in layout_tree_panels(tab['layout'])}
+
+
+def plotted_paths(layout: dict[str, Any], four_bar: bool | None = None) -> list[str]:
+    """
+    Every message path the plots read: their series and their custom x axes.
+
+    ``four_bar``: True, the plots of the four-bar's bag only; False, of a loops node's bag only.
+    """
+    efforts = effort_plots(layout)
     paths = []
-    for config in plots(layout).values():
+    for key, config in plots(layout).items():
+        if four_bar is not None and four_bar == (key in efforts):
+            continue
         paths += [series['value'] for series in config['paths']]
         if config['xAxisVal'] == 'custom':
             paths.append(config['xAxisPath']['value'])
@@ -151,6 +178,49 @@ def node_bag(
     return {'schemas': schema_of_topic, 'messages': decoded, 'log_times': log_times}
 
 
+def read_bag(folder: Any) -> dict[str, Any]:
+    """Return a node's bag in ``folder``: its schemas, channels and decoded messages per topic."""
+    [mcap_file] = folder.glob('*/*.mcap')
+    with open(mcap_file, 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        summary = reader.get_summary()
+        assert summary is not None
+        schema_of_topic = {channel.topic: summary.schemas[channel.schema_id]
+                           for channel in summary.channels.values()}
+        decoded: dict[str, list[Any]] = {topic: [] for topic in schema_of_topic}
+        for _, channel, _, message in reader.iter_decoded_messages():
+            decoded[channel.topic].append(message)
+    return {'schemas': schema_of_topic, 'messages': decoded}
+
+
+@pytest.fixture(scope='module')
+def efforts_bag(tmp_path_factory: pytest.TempPathFactory, module_nodes: NodeProcesses,
+                domain_id: int) -> dict[str, Any]:
+    """
+    Return a loops node's bag of the humanoid ankle with efforts in and out.
+
+    Its motors measured with their efforts, pitch and roll its output joints.
+    """
+    run_folder = tmp_path_factory.mktemp('efforts_run')
+    parameters = {'robot_description': ANKLE_URDF.read_text(encoding='utf-8'),
+                  'loops.measured_joints': MOTORS, 'loops.output_joints': ANKLE_OUTPUTS}
+    with ros_context(domain_id) as context, loop_node(context, module_nodes, run_folder,
+                                                      parameters) as node:
+        for index in range(EFFORT_SAMPLES):
+            phase = 2.0 * math.pi * index / EFFORT_SAMPLES
+            message = JointState(name=MOTORS, position=[0.3 * math.sin(phase),
+                                                        0.2 * math.sin(2.0 * phase)],
+                                 velocity=[0.3 * math.cos(phase), 0.4 * math.cos(2.0 * phase)],
+                                 effort=[2.0 + math.cos(phase), -1.5 * math.sin(phase)])
+            stamp = 1_000_000_000 + index * 10_000_000
+            message.header.stamp.sec, message.header.stamp.nanosec = divmod(stamp,
+                                                                            1_000_000_000)
+            node.inputs.publish(message)
+            assert node.listener.spin_until(lambda: len(node.outputs) == index + 1)
+        assert module_nodes.interrupt(node.process) == 0
+    return read_bag(run_folder / 'bags')
+
+
 # --- the layout on its own -----------------------------------------------------------------------
 
 
@@ -192,7 +262,7 @@ def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_a
     [tab_panel] = [config for key, config in layout['configById'].items()
                    if key.startswith('Tab!')]
     assert tab_panel['activeTabIdx'] == 0
-    over_time, against_alpha = (
+    over_time, against_alpha, efforts = (
         [layout['configById'][key] for key in layout_tree_panels(tab['layout'])]
         for tab in tab_panel['tabs']
     )
@@ -209,6 +279,16 @@ def test_first_tab_plots_over_time_second_reproduces_the_seeds_figures_against_a
     assert all(config['xAxisVal'] == 'custom' and config['xAxisPath']
                == {'value': X_ALPHA_PATH, 'enabled': True} for config in against_alpha)
     assert labels(against_alpha) == {'β', 'γ', 'ω_AB', 'ω_BC', 'ω̇_AB', 'ω̇_BC', 'V_A', 'V_B'}
+    # the third: a loops node's actuator efforts (its input) beside its output joints' (its
+    # joint_states), over time at the input's stamps, which the answers carry
+    assert [config['foxglovePanelTitle'] for config in efforts] == [
+        'Actuator efforts, measured (N·m or N)', 'Output efforts, published (N·m or N)']
+    assert all(config['xAxisVal'] == 'timestamp' for config in efforts)
+    assert {series['timestampMethod'] for config in efforts
+            for series in config['paths']} == {'headerStamp'}
+    assert [[series['value'] for series in config['paths']] for config in efforts] == [
+        ['/measured_joint_states.effort[0]', '/measured_joint_states.effort[1]'],
+        ['/joint_states.effort[0]', '/joint_states.effort[1]']]
 
 
 def test_scene_frames_the_whole_paper_mechanism_with_margin() -> None:
@@ -262,19 +342,22 @@ def test_legends_sit_beside_the_plots_and_tab_names_fit_their_tabs() -> None:
     [tab_panel] = [config for key, config in layout['configById'].items()
                    if key.startswith('Tab!')]
     # Lichtblick's tabs are at most 120 px wide (panels/Tab/ToolbarTab.tsx): about 14 letters.
-    assert [tab['title'] for tab in tab_panel['tabs']] == ['Over time', 'Against α']
+    assert [tab['title'] for tab in tab_panel['tabs']] == ['Over time', 'Against α', EFFORTS_TAB]
 
 
 # --- the layout against a real node bag ----------------------------------------------------------
 
 
+@pytest.mark.parametrize('four_bar', [True, False])
 def test_every_message_path_resolves_against_the_logged_definitions(
-    node_bag: dict[str, Any],
+    node_bag: dict[str, Any], efforts_bag: dict[str, Any], four_bar: bool,
 ) -> None:
-    for path in plotted_paths(load_layout()):
+    """The four-bar's plots against its bag, the efforts tab's against a loops node's."""
+    bag = node_bag if four_bar else efforts_bag
+    for path in plotted_paths(load_layout(), four_bar):
         topic, fields = split_path(path)
-        assert topic in node_bag['schemas'], f'{path}: the bag has no topic {topic}'
-        schema = node_bag['schemas'][topic]
+        assert topic in bag['schemas'], f'{path}: the bag has no topic {topic}'
+        schema = bag['schemas'][topic]
         assert schema.encoding == 'ros2msg'
         types = get_types_from_msg(schema.data.decode(), schema.name)
         type_name = schema.name
@@ -293,16 +376,19 @@ def test_every_message_path_resolves_against_the_logged_definitions(
                 assert node_type == Nodetype.BASE, f'{path}: {name} is an array'
                 leaf = detail[0]
         assert leaf in NUMERIC_TYPES, f'{path} ends in {leaf or type_name}, not a number'
-        logged = node_bag['messages'][topic]
+        logged = bag['messages'][topic]
         assert logged
         for message in logged:
             assert isinstance(evaluate(message, fields, path), float | int)
 
 
-def test_layout_names_only_topics_and_frames_the_node_logs(node_bag: dict[str, Any]) -> None:
+def test_layout_names_only_topics_and_frames_the_node_logs(node_bag: dict[str, Any],
+                                                           efforts_bag: dict[str, Any]) -> None:
     layout = load_layout()
     panels = layout['configById']
-    named = {split_path(path)[0] for path in plotted_paths(layout)}
+    assert {split_path(path)[0] for path in plotted_paths(layout, False)} == {
+        '/measured_joint_states', '/joint_states'} <= set(efforts_bag['schemas'])
+    named = {split_path(path)[0] for path in plotted_paths(layout, True)}
     [three_d] = [config for key, config in panels.items() if key.startswith('3D!')]
     named |= set(three_d['topics'])
     diagnostics = [config for key, config in panels.items() if key.startswith('Diagnostic')]
@@ -326,7 +412,8 @@ def test_custom_x_and_y_come_from_other_topics_with_equal_counts_and_stamps(
     So each plotted y stream and its x stream have one message per state with the same stamps;
     and x comes from another topic than y: Lichtblick reads the x topic's messages for x only.
     """
-    custom = [config for config in plots(load_layout()).values() if config['xAxisVal'] == 'custom']
+    custom = [config for config in plots(load_layout()).values()
+              if config['xAxisVal'] == 'custom']
     assert len(custom) == 4
     for config in custom:
         x_topic, _ = split_path(config['xAxisPath']['value'])
@@ -378,6 +465,39 @@ def test_plotted_quantities_have_the_papers_signs_and_the_librarys_values(
     assert read('V_B') == pytest.approx([state.v_b for state in library], rel=1e-12)
     assert read('β') == pytest.approx([state.beta for state in library], rel=1e-12)
     assert read('γ') == pytest.approx([state.gamma for state in library], rel=1e-12)
+
+
+def test_the_efforts_tab_shows_the_motors_measured_and_pitch_and_roll_published(
+    efforts_bag: dict[str, Any],
+) -> None:
+    """What the efforts plots read: as sent, and as published, the power balanced."""
+    layout = load_layout()
+    actuator, output = effort_plots(layout).values()
+    messages = efforts_bag['messages']
+    inputs, answers = messages['/measured_joint_states'], messages['/joint_states']
+    assert len(inputs) == len(answers) == EFFORT_SAMPLES
+    assert [list(message.name) for message in inputs] == [MOTORS] * EFFORT_SAMPLES
+    assert {tuple(message.name[:2]) for message in answers} == {tuple(ANKLE_OUTPUTS)}
+
+    def read(config: dict[str, Any], topic_messages: list[Any]) -> list[list[float]]:
+        found = []
+        for series in config['paths']:
+            _, fields = split_path(series['value'])
+            found.append([evaluate(message, fields, series['value'])
+                          for message in topic_messages])
+        return found
+
+    measured, published = read(actuator, inputs), read(output, answers)
+    assert measured == [[message.effort[k] for message in inputs] for k in range(2)]
+    for index, (given, answer) in enumerate(zip(inputs, answers)):
+        assert stamp_of(given) == stamp_of(answer)
+        motor_power = math.fsum(t * v for t, v in zip(given.effort, given.velocity))
+        output_power = math.fsum(published[k][index] * answer.velocity[k] for k in range(2))
+        assert output_power == pytest.approx(motor_power, rel=1e-12, abs=1e-12)
+
+
+def stamp_of(message: Any) -> int:
+    return message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
 
 
 # --- the paper's quantities as plain fields of /linkage/state ------------------------------------

@@ -8,8 +8,9 @@ Many random messages (empty and unequal name/position/velocity/effort lengths, n
 NaN and ±inf, frame_ids of every length mod 8 so that each sequence starts at another alignment,
 names repeated at shifted starts) are serialized by rclpy (little endian) and by rosbags (both
 byte orders), and one decoder's fields equal what rclpy's ``deserialize_message`` and rosbags'
-``deserialize_cdr`` read from the same bytes, float bits too. Malformed and truncated bytes
-raise ValueError naming the problem.
+``deserialize_cdr`` read from the same bytes, float bits too: the efforts by a decoder made to
+read them, none by one that is not. Malformed and truncated bytes raise ValueError naming the
+problem.
 """
 
 from __future__ import annotations
@@ -62,11 +63,17 @@ def float_bits(values: Any) -> bytes:
     return struct.pack(f'<{len(values)}d', *values)
 
 
-def fields_of(message: Any) -> tuple[int, tuple[str, ...], bytes, bytes]:
-    """Return a decoded message's stamp (ns), names and float bits (rclpy's or rosbags')."""
+def fields_of(message: Any, efforts: bool = True) -> tuple[int, tuple[str, ...], bytes, bytes,
+                                                           bytes]:
+    """
+    Return a decoded message's stamp (ns), names and float bits (rclpy's or rosbags').
+
+    The efforts' bits, or none where a decoder does not read them (``efforts`` False).
+    """
     stamp = message.header.stamp
     return (stamp.sec * 1_000_000_000 + stamp.nanosec, tuple(message.name),
-            float_bits(message.position), float_bits(message.velocity))
+            float_bits(message.position), float_bits(message.velocity),
+            float_bits(message.effort if efforts else ()))
 
 
 def rosbags_message(message: JointState) -> Any:
@@ -85,7 +92,7 @@ def rosbags_message(message: JointState) -> Any:
 def test_decoded_fields_equal_rclpys_and_rosbags_in_both_byte_orders() -> None:
     """Each message's bytes, by either serializer and byte order, decode as both libraries do."""
     rng = random.Random(23)
-    decoder = JointStateDecoder()
+    decoders = {False: JointStateDecoder(), True: JointStateDecoder(efforts=True)}
     names_pool: list[list[str]] = []
     orders = set()
     for _ in range(MESSAGES):
@@ -98,13 +105,16 @@ def test_decoded_fields_equal_rclpys_and_rosbags_in_both_byte_orders() -> None:
                 (bytes(TYPESTORE.serialize_cdr(independent, TYPE_NAME, little_endian=False)),
                  True)):
             orders.add(data[:2])
-            stamp_ns, names, positions, velocities = decoder.decode(data)
-            got = (stamp_ns, names, float_bits(positions), float_bits(velocities))
-            assert got == fields_of(deserialize_message(data, JointState))
-            if rosbags_reads:
-                assert got == fields_of(TYPESTORE.deserialize_cdr(data, TYPE_NAME))
-            assert got == fields_of(message)
-            assert isinstance(names, tuple) and isinstance(positions, tuple)
+            for efforts, decoder in decoders.items():
+                stamp_ns, names, positions, velocities, read = decoder.decode(data)
+                got = (stamp_ns, names, float_bits(positions), float_bits(velocities),
+                       float_bits(read))
+                assert got == fields_of(deserialize_message(data, JointState), efforts)
+                if rosbags_reads:
+                    assert got == fields_of(TYPESTORE.deserialize_cdr(data, TYPE_NAME), efforts)
+                assert got == fields_of(message, efforts)
+                assert isinstance(names, tuple) and isinstance(positions, tuple)
+                assert isinstance(read, tuple)
     assert orders == {b'\x00\x00', b'\x00\x01'}
 
 
@@ -129,9 +139,11 @@ def test_every_truncation_is_refused() -> None:
     for data in (encode_cdr(message), bytes(TYPESTORE.serialize_cdr(
             rosbags_message(message), TYPE_NAME, little_endian=False))):
         assert JointStateDecoder().decode(data)[1] == ('knee', 'hip')
+        assert JointStateDecoder(efforts=True).decode(data)[4] == (3.0,)
         for length in range(len(data)):
-            with pytest.raises(ValueError, match='JointState|encapsulation'):
-                JointStateDecoder().decode(data[:length])
+            for decoder in (JointStateDecoder(), JointStateDecoder(efforts=True)):
+                with pytest.raises(ValueError, match='JointState|encapsulation'):
+                    decoder.decode(data[:length])
 
 
 def little_endian(frame_id: bytes, names: list[bytes], tail: bytes = b'') -> bytes:
@@ -163,15 +175,18 @@ EMPTY_SEQUENCES = bytes(3) + struct.pack('<III', 0, 0, 0)  # padding, then three
      'position of 1000000000 values goes past the end'),
     (little_endian(b'\x00', [b'a\x00'], bytes(2) + struct.pack('<I', 0)),
      'ends before the length of its velocity'),
+    (little_endian(b'\x00', [b'a\x00'], bytes(2) + struct.pack('<III', 0, 0, 5) + bytes(32)),
+     'effort of 5 values goes past the end'),
 ])
 def test_malformed_bytes_are_refused_naming_the_problem(data: bytes, problem: str) -> None:
     """An unknown encapsulation, a bad length, a string without NUL or UTF-8: ValueError."""
-    with pytest.raises(ValueError, match=problem):
-        JointStateDecoder().decode(data)
+    for decoder in (JointStateDecoder(), JointStateDecoder(efforts=True)):
+        with pytest.raises(ValueError, match=problem):
+            decoder.decode(data)
 
 
 def test_the_hand_written_bytes_are_a_joint_state_when_well_formed() -> None:
     """The malformed cases above differ from bytes rclpy reads by their one defect."""
     data = little_endian(b'\x00', [b'a\x00', 'ä'.encode() + b'\x00'], EMPTY_SEQUENCES)
-    assert JointStateDecoder().decode(data) == (1_000_000_002, ('a', 'ä'), (), ())
+    assert JointStateDecoder().decode(data) == (1_000_000_002, ('a', 'ä'), (), (), ())
     assert list(deserialize_message(data, JointState).name) == ['a', 'ä']

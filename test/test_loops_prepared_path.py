@@ -10,7 +10,8 @@ the path as it was before that, message by message through ``solve_loop`` and
 ``continued_branch_of`` as they were (each looking the loop's closed form up by its hash).
 On a sweep of every test robot, there and back, across whole turns of its revolute measured
 joints, with and without velocities, and through refusals, both give the same floats bit for
-bit; and the published ``joint_states`` bytes are ``encode_cdr``'s of the same message.
+bit; and the published ``joint_states`` bytes are ``encode_cdr``'s of the same message, with
+efforts (``loops.output_joints``) too.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from linkage_kinematics.loops.follower import (
 from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import read_urdf
-from linkage_kinematics.ros.messages import JointStateEncoder
+from linkage_kinematics.ros.messages import JointStateEffortEncoder, JointStateEncoder
 from linkage_kinematics.shared.cdr import encode_cdr
 from loop_robots import ROBOTS
 from loops_per_call import ReferenceFollower
@@ -128,3 +129,24 @@ def test_the_output_encoder_writes_encode_cdrs_bytes(name: str, stamp_ns: int) -
                                     nanosec=stamp_ns % 1_000_000_000)
         assert encoder.encode(stamp_ns, sample.positions, sample.velocities) == encode_cdr(
             message)
+
+
+@pytest.mark.parametrize('stamp_ns', [0, 1_700_000_000_123_456_789, -1_500_000_001])
+def test_the_output_encoder_with_efforts_writes_encode_cdrs_bytes(stamp_ns: int) -> None:
+    """Each published joint's effort after its velocity, as encode_cdr writes the message."""
+    excavator = ROBOTS['excavator']
+    follower = RobotLoopsFollower(read_loops(read_urdf(excavator.urdf())),
+                                  excavator.measured_joints, {}, math.pi / 2,
+                                  outputs=('boom_joint', 'stick_joint', 'bucket_joint'))
+    encoder = None
+    for stamp, names, positions, velocities in sweep('excavator', False)[:SAMPLES:37]:
+        sample = follower.follow(stamp, names, positions, velocities,
+                                 [1e5 * (1 + k) for k in range(len(names))])
+        assert isinstance(sample, LoopSample) and len(sample.efforts) == len(sample.names)
+        encoder = encoder or JointStateEffortEncoder(sample.names)
+        message = JointState(name=list(sample.names), position=list(sample.positions),
+                             velocity=list(sample.velocities), effort=list(sample.efforts))
+        message.header.stamp = Time(sec=stamp_ns // 1_000_000_000,
+                                    nanosec=stamp_ns % 1_000_000_000)
+        assert encoder.encode(stamp_ns, sample.positions, sample.velocities,
+                              sample.efforts) == encode_cdr(message)

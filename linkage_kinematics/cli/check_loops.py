@@ -15,9 +15,15 @@ joints, degrees of freedom, known and solved joints, how it is solved, its resid
 pose and at the pose it assembles nearest it, the conditioning and the distance to the nearest
 singular configuration there, its idle freedoms and overridden joints, and for one or two known
 joints each one's reachable interval with the other held (``loops.reach``). Angles are printed
-in degrees. Each problem is one line on standard error; the exit status is 0 without problems,
-1 for problems in the description (or with the measured joints), 2 for a usage error or input
-that cannot be read (a file, a text that is no URDF, a closure file that is not one).
+in degrees. With ``--outputs`` (the node's ``loops.output_joints``), for each group they name
+joints of: its output joints and actuators, its mechanical advantage at the assembled pose, and
+the range of its transmission ratio (one output joint) or of its singular values (two) over
+the output joints' reachable range, swept by the command direction's own solver, which stops
+where no assembly reaches, at a singular configuration, or where an actuator would leave its
+URDF ``<limit>`` (``loops.transmission_range``; rad, m, and efforts in N·m, N). Each problem
+is one line on standard error; the exit status is 0 without problems, 1 for problems in the
+description (or with the measured or output joints), 2 for a usage error or input that cannot
+be read (a file, a text that is no URDF, a closure file that is not one).
 """
 
 from __future__ import annotations
@@ -31,8 +37,9 @@ from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.loops.assembly import ClosureGap
 from linkage_kinematics.loops.closures import ClosureError, ClosureSide
+from linkage_kinematics.loops.command import CommandGroup
 from linkage_kinematics.loops.description import LoopError
-from linkage_kinematics.loops.newton import Refusal
+from linkage_kinematics.loops.newton import PlanError, Refusal
 from linkage_kinematics.loops.plan import (
     find_loops,
     GroupPlan,
@@ -42,7 +49,10 @@ from linkage_kinematics.loops.plan import (
 )
 from linkage_kinematics.loops.planar import Loop, LoopJoint
 from linkage_kinematics.loops.reach import reach
+from linkage_kinematics.loops.robot_transmission import GroupTransmission, plan_transmissions
 from linkage_kinematics.loops.structure import GroupKind
+from linkage_kinematics.loops.transmission import TransmissionError, TransmissionSingular
+from linkage_kinematics.loops.transmission_range import advantage_range
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 
@@ -85,6 +95,11 @@ def _parser() -> argparse.ArgumentParser:
                         default=[],
                         help="start values of joints a closure group solves, as the node's "
                              'loops.assemblies')
+    parser.add_argument('--outputs', nargs='+', metavar='JOINT', default=[],
+                        help="each closure group's output joints, as the node's "
+                             'loops.output_joints: its transmission ratio (mechanical '
+                             "advantage) over their reachable range, within the actuators' "
+                             'URDF limits')
     return parser
 
 
@@ -269,6 +284,46 @@ def _group_lines(tree: KinematicTree, group: GroupPlan, overrides: dict,
     return lines
 
 
+def _transmission_lines(loops: RobotLoops,
+                        found: GroupTransmission) -> tuple[list[str], str | None]:
+    """Return a group's transmission: its advantage now and over its range; or a problem."""
+    transmission = found.transmission
+    tree = loops.tree
+    head = (f'transmission of group {found.group.name!r}: output joints '
+            f'{", ".join(transmission.outputs)}; actuators {", ".join(transmission.actuators)}')
+    values = found.values
+    try:
+        now = transmission.advantage([values[tree.index[name]] for name in transmission.actuators],
+                                     [values[tree.index[name]] for name in transmission.solved])
+        command = CommandGroup(tree, transmission, values, loops.loops)
+    except (TransmissionSingular, PlanError) as error:
+        return [head], str(error)
+    lines = [head, f'  at the assembled pose: {now.describe()}']
+    swept = advantage_range(command)
+    if swept is None:
+        lines.append(f'  not swept: {len(transmission.outputs)} output joints (a sweep is of '
+                     'one or two)')
+    else:
+        lines += swept.describe()
+    return lines, None
+
+
+def transmission_report(loops: RobotLoops, plan: LoopPlan,
+                        outputs: Sequence[str]) -> tuple[list[str], list[str]]:
+    """Return the transmissions of the groups ``outputs`` names joints of, and the problems."""
+    try:
+        groups = plan_transmissions(plan, outputs)
+    except TransmissionError as error:
+        return [], [f'--outputs: {error}']
+    lines, problems = [], []
+    for found in groups:
+        group_lines, problem = _transmission_lines(loops, found)
+        lines += group_lines
+        if problem is not None:
+            problems.append(problem)
+    return lines, problems
+
+
 def report(loops: RobotLoops, plan: LoopPlan | None, survey: LoopPlan | None = None,
            known_given: bool = True) -> list[str]:
     """
@@ -331,6 +386,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f'robot {loops.robot_name!r}: no <constraint> elements, no loops to close')
     else:
         print('\n'.join(report(loops, plan, survey, bool(measured))))
+    if arguments.outputs and plan is not None:
+        lines, found = transmission_report(loops, plan, arguments.outputs)
+        if lines:
+            print('\n'.join(lines))
+        problems += found
+    elif arguments.outputs and not problems:
+        problems.append('--outputs: the output joints are those of closure groups the measured '
+                        "joints close (--measured, or the closure file's name_mot)")
     warnings = survey.warnings
     for message in loops.parser_messages:
         print(f'{PROGRAM}: note: urdf_parser_py: {message}', file=sys.stderr)

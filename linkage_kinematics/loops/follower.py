@@ -14,8 +14,12 @@ measured joints are those given, else the closure file's actuated joints (``name
 the loop joints the first message carries. A measured joint without a velocity gets the
 intake's estimate (the backward difference over the header stamps, 0 for a first sample). A
 revolute measured joint is unwrapped across turns, as the four-bar's driver is, and
-``measured.max_jump`` (rad) applies to it; a prismatic one's length (m) has no such bound. No
-ROS.
+``measured.max_jump`` (rad) applies to it; a prismatic one's length (m) has no such bound.
+
+With output joints (``loops.output_joints``, ``robot_transmission.plan_transmissions``, checked
+when the plan is made) and a message whose measured actuators carry finite efforts, the sample
+also holds every published joint's effort (``robot_transmission.OutputEfforts``): only then is
+that path taken. No ROS.
 """
 
 from __future__ import annotations
@@ -27,7 +31,9 @@ from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_ran
 from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
 from linkage_kinematics.loops.newton import Refusal
 from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
+from linkage_kinematics.loops.robot_transmission import OutputEfforts, plan_transmissions
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.transmission import TransmissionSingular
 from linkage_kinematics.loops.tree import MotionKind
 
 # Why a closure group refused a sample, as the message's drop reason
@@ -52,8 +58,11 @@ class LoopSample:
 
     ``joints`` holds every measured and published solved joint's position (for /tf);
     ``estimates`` how each measured joint's velocity was obtained; ``known_values`` each
-    loop's known joint value (URDF units), by constraint. A value, not frozen: a frozen
-    dataclass's seven ``object.__setattr__`` cost four times its plain ``__init__`` per sample.
+    loop's known joint value (URDF units), by constraint. ``efforts``: each published joint's
+    effort (N·m or N), empty without output joints or without the actuators' efforts;
+    ``withheld``: the group whose transmission was too near a singular configuration to give
+    them (None: not withheld). A value, not frozen: a frozen dataclass's
+    ``object.__setattr__`` per field costs four times its plain ``__init__`` per sample.
     """
 
     stamp_ns: int
@@ -63,6 +72,8 @@ class LoopSample:
     joints: dict[str, float]
     estimates: dict[str, Estimate]
     known_values: dict[str, float]
+    efforts: tuple[float, ...] = ()
+    withheld: str | None = None
 
 
 class RobotLoopsFollower:
@@ -74,15 +85,21 @@ class RobotLoopsFollower:
     and cannot close the loops; without them the loop joints the first message carries are
     planned then (``follow`` raises LoopError then). ``assemblies``: joint → start value, to
     assemble a group of the general closure nearer another assembly (``RobotLoops.plan``).
+    ``outputs``: the output joints (``loops.output_joints``; empty: none), checked with the
+    plan: TransmissionError (one line) where they cannot be its groups'.
     """
 
     def __init__(self, loops: RobotLoops, measured: Sequence[str],
                  branches: Mapping[str, int], max_jump: float,
-                 assemblies: Mapping[str, float] | None = None) -> None:
+                 assemblies: Mapping[str, float] | None = None,
+                 outputs: Sequence[str] = ()) -> None:
         self.loops = loops
         self._max_jump = max_jump
         self._branches = dict(branches)
         self._assemblies = dict(assemblies or {})
+        self._outputs = tuple(outputs)
+        # the published joints' efforts, with output joints
+        self.output_efforts: OutputEfforts | None = None
         tree = loops.tree
         self.loop_joints = frozenset(
             [name for loop in loops.loops for name in loop.names]
@@ -112,7 +129,10 @@ class RobotLoopsFollower:
 
     def _plan(self, measured: tuple[str, ...]) -> None:
         plan = self.loops.plan(measured, self._branches, self._assemblies)
+        output_efforts = (OutputEfforts(plan, plan_transmissions(plan, self._outputs))
+                          if self._outputs else None)
         self.solver = LoopSolver(plan)
+        self.output_efforts = output_efforts
         # resolved once per plan rather than per message: the revolute measured joints (the
         # intake unwraps them), each loop's constraint and known joint, the loops and groups
         # each feeds
@@ -142,12 +162,14 @@ class RobotLoopsFollower:
         return tuple(constraint for name in names for constraint in self._feeds[name])
 
     def follow(self, stamp_ns: int, names: Sequence[str], positions: Sequence[float],
-               velocities: Sequence[float]) -> LoopSample | LoopDrop | None:
+               velocities: Sequence[float],
+               efforts: Sequence[float] = ()) -> LoopSample | LoopDrop | None:
         """
         Return the passive joints at one message, or why it was dropped.
 
         None for a message that carries none of the measured joints (with none known, none of
         the loop joints), e.g. this node's own output heard back: ignored, not counted.
+        ``efforts``: the message's (empty: none, or not read).
         """
         if self.solver is None:
             carried = tuple(name for name in names if name in self.loop_joints)
@@ -170,9 +192,19 @@ class RobotLoopsFollower:
         measured = self._measured
         joints = dict(zip(measured, values))
         joints.update(zip(self._passive, solved))
-        return LoopSample(
+        sample = LoopSample(
             stamp_ns, self._passive, solved, solved_rates, joints, dict(zip(measured, estimates)),
             {constraint: joints[known] for constraint, known in self._known})
+        output_efforts = self.output_efforts
+        if efforts and output_efforts is not None:
+            taken_efforts = self._intake.efforts(efforts, output_efforts.actuators)
+            if taken_efforts is not None:
+                try:
+                    sample.efforts = output_efforts.efforts(values, solved,
+                                                            self.solver.groups, taken_efforts)
+                except TransmissionSingular as singular:
+                    sample.withheld = singular.group
+        return sample
 
 
 def dead_point_distances(plan: LoopPlan,

@@ -12,6 +12,7 @@ joint across whole turns to within π of its last value and refuses it further t
 ``measured.max_jump`` from there, and gives each joint's velocity: the message's own, or the
 backward difference over the header stamps (``joint_velocity``, 0 for a first sample). A
 follower ``keep``s a sample once it has used it, so that a refused one leaves nothing behind.
+``Intake.efforts`` gives some joints' efforts in the message last taken, where it carries them.
 
 ``DropReason`` is the one set of reasons a measured message is dropped for, in either mode; its
 texts are what diagnostics show. No ROS.
@@ -223,3 +224,21 @@ class Intake:
             rates.append(rate)
             estimates.append(estimate)
         return measured, values, rates, estimates
+
+    def efforts(self, efforts: Sequence[float], places: Sequence[int]) -> list[float] | None:
+        """
+        Return the efforts of the joints at ``places`` (of ``joints``) in the message last taken.
+
+        ``efforts``: that message's (N·m or N, as measured). None unless each of those joints has
+        one and it is finite: a JointState without efforts, or with NaN where a joint has no
+        effort interface (ros2_control's joint_state_broadcaster), carries none to use.
+        """
+        indices = self._indices
+        count = len(efforts)
+        found = []
+        for place in places:
+            index = indices[place]
+            if index >= count or not math.isfinite(value := efforts[index]):
+                return None
+            found.append(value)
+        return found

@@ -9,9 +9,13 @@ The measured source of ``loops:=robot_description``: every loop of a lab's URDF,
 publishes it) with its closure file (the parameter ``robot_description_closures``, for every
 description), feeds each ``measured_joint_states`` message (``measured_input.MeasuredInput``)
 to a ``loops.follower`` ``RobotLoopsFollower`` and publishes the passive joints it solves on
-``joint_states``, stamped as the input. The node publishes no URDF, ``linkage/state`` or
-markers of its own then: those describe its own four-bar. Its bag holds the input, the
-completed joint states, the description and its closure file, and the /tf
+``joint_states``, stamped as the input. With ``loops.output_joints`` it reads the input's
+efforts too, and a message whose actuators carry them gives every published joint its effort
+(``loops.robot_transmission``); output joints that cannot be the groups' stop the node at start
+(a description from the parameter) or make the status ERROR (one from the topic, or one planned
+at the first message), as a description whose loops cannot be closed does. The node publishes
+no URDF, ``linkage/state`` or markers of its own then: those describe its own four-bar. Its bag
+holds the input, the completed joint states, the description and its closure file, and the /tf
 robot_state_publisher would publish for the whole robot.
 """
 
@@ -29,6 +33,7 @@ from linkage_kinematics.loops.follower import LoopDrop, RobotLoopsFollower
 from linkage_kinematics.loops.intake import DropReason
 from linkage_kinematics.loops.plan import GroupPlan, read_loops
 from linkage_kinematics.loops.solver import GroupStep
+from linkage_kinematics.loops.transmission import TransmissionError
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
 from linkage_kinematics.ros.measured_input import MeasuredInput
 from linkage_kinematics.ros.messages import RobotStateTransforms
@@ -39,7 +44,7 @@ from linkage_kinematics.ros.outputs import (
     StartupError,
 )
 from linkage_kinematics.ros.source import SourceHost
-from linkage_kinematics.run.configuration import RunConfiguration
+from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration
 from linkage_kinematics.run.control import ServiceAnswer
 from linkage_kinematics.run.diagnostics import RateMeter, Status, StatusInputs, StatusSchedule
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
@@ -55,6 +60,12 @@ class LoopsHost(SourceHost, Protocol):
 
 # What reading a description may refuse, each with its one line.
 DESCRIPTION_ERRORS = (LoopError, UrdfError, ClosureError)
+OUTPUT_JOINTS = 'loops.output_joints'
+
+
+def output_joints_problem(error: TransmissionError) -> str:
+    """Return the line of output joints that cannot be the description's groups'."""
+    return f'{OUTPUT_JOINTS}: {error}'
 
 
 class ClosedRobot:
@@ -65,7 +76,8 @@ class ClosedRobot:
         Read ``urdf`` and the configured closure file, if any.
 
         LoopError, UrdfError or ClosureError, one line naming the problem, if they cannot be
-        closed.
+        closed; TransmissionError if the measured joints are known and the output joints
+        cannot be the groups'.
         """
         tree = read_urdf(urdf)  # once, for the loops and for robot_state_publisher's TF
         self.urdf = urdf
@@ -73,7 +85,7 @@ class ClosedRobot:
         self.follower = RobotLoopsFollower(
             read_loops(tree, self.closures or None), config.loops.measured_joints,
             dict(config.loops.branches), config.measured.max_jump,
-            dict(config.loops.assemblies))
+            dict(config.loops.assemblies), config.loops.output_joints)
         self.transforms = RobotStateTransforms(tree, config.outputs.frame_prefix)
         # robot_state_publisher's /tf is of every movable joint; mimic joints follow theirs.
         self.tree_joints = self.transforms.driven_joints
@@ -160,7 +172,9 @@ def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
     """
     Return the robot of the ``robot_description`` parameter, None when it is empty (the topic).
 
-    Raises StartupError, one line naming the problem, for a description that cannot be closed.
+    Raises StartupError, one line naming the problem, for a description that cannot be closed,
+    and ConfigurationError of ``loops.output_joints`` for output joints that cannot be its
+    groups'.
     """
     if not config.loops.robot_description:
         return None
@@ -169,6 +183,8 @@ def robot_from_parameter(config: RunConfiguration) -> ClosedRobot | None:
     except DESCRIPTION_ERRORS as error:
         raise StartupError('cannot close the loops of parameter robot_description: '
                            + str(error).replace('\n', '; ')) from None
+    except TransmissionError as error:
+        raise ConfigurationError(OUTPUT_JOINTS, str(error)) from None
 
 
 class RobotLoopsSubscription(MeasuredInput):
@@ -197,7 +213,8 @@ class RobotLoopsSubscription(MeasuredInput):
         if robot is None:  # subscribed before the input, as the node always was
             host.create_subscription(String, ROBOT_DESCRIPTION_TOPIC, self._on_description,
                                      ROBOT_DESCRIPTION_QOS)
-        super().__init__(host, self._loops_health)
+        # the input's efforts are read only where output joints give them a use
+        super().__init__(host, self._loops_health, bool(host.config.loops.output_joints))
         if robot is not None:
             self._take(robot)
         self._show_activity()
@@ -272,10 +289,11 @@ class RobotLoopsSubscription(MeasuredInput):
         """Read a description afresh; one that cannot be closed leaves the last one followed."""
         try:
             robot = ClosedRobot(message.data, self._host.config)
-        except DESCRIPTION_ERRORS as error:
+        except (*DESCRIPTION_ERRORS, TransmissionError) as error:
+            problem = (output_joints_problem(error) if isinstance(error, TransmissionError)
+                       else str(error).replace('\n', '; '))
             self._report(f'cannot close the loops of the robot description on '
-                         f'{self._outputs.description_topic}: '
-                         + str(error).replace('\n', '; '))
+                         f'{self._outputs.description_topic}: {problem}')
             return
         self._take(robot)
         self._show_activity()
@@ -293,7 +311,8 @@ class RobotLoopsSubscription(MeasuredInput):
                       plan=None if robot is None else robot.follower.plan,
                       health=self._loops_health,
                       groups=(() if robot is None or robot.follower.solver is None
-                              else robot.follower.solver.groups)))
+                              else robot.follower.solver.groups),
+                      transmissions=None if robot is None else robot.follower.output_efforts))
 
     def reconfigure(self, new: RunConfiguration) -> None:
         """Take the node's new configuration: the thresholds (timeout, jump)."""
@@ -322,7 +341,7 @@ class RobotLoopsSubscription(MeasuredInput):
         if host.control.paused:
             return  # ~/pause: not followed, not counted
         try:
-            stamp_ns, names, positions, velocities = self._decoder.decode(data)
+            stamp_ns, names, positions, velocities, efforts = self._decoder.decode(data)
         except ValueError:  # not logged: it has no stamp, and readers would refuse it
             self._loops_health.drop(DropReason.MALFORMED)
             return
@@ -334,12 +353,13 @@ class RobotLoopsSubscription(MeasuredInput):
         follower = robot.follower
         planned = follower.plan is not None
         try:
-            followed = follower.follow(stamp_ns, names, positions, velocities)
-        except LoopError as error:
+            followed = follower.follow(stamp_ns, names, positions, velocities, efforts)
+        except (LoopError, TransmissionError) as error:
             self._outputs.record_input(data, stamp_ns)
             self._loops_health.drop(DropReason.NOT_PLANNED)
-            self._report('the measured joints cannot close the loops: '
-                         + str(error).replace('\n', '; '))
+            self._report('the measured joints cannot close the loops: ' + (
+                output_joints_problem(error) if isinstance(error, TransmissionError)
+                else str(error).replace('\n', '; ')))
             return
         if followed is None:
             return  # none of the measured joints: e.g. this node's own output, heard back
@@ -356,7 +376,7 @@ class RobotLoopsSubscription(MeasuredInput):
         first = not self._following
         self._following, self.stale = True, False
         self._outputs.publish_joint_states(followed.names, followed.positions,
-                                           followed.velocities, stamp_ns)
+                                           followed.velocities, stamp_ns, followed.efforts)
         # The whole robot as robot_state_publisher would pose it.
         self._outputs.record_tf(self._tree.at_sample(followed.joints), stamp_ns)
         if first:

@@ -37,11 +37,12 @@ class MeasuredInput(ABC):
     paused_answer: str
     resumed_answer: str
 
-    def __init__(self, host: SourceHost, health: Freshness) -> None:
+    def __init__(self, host: SourceHost, health: Freshness, efforts: bool = False) -> None:
+        """``efforts``: whether the source reads the input's efforts (``JointStateDecoder``)."""
         self._host = host
         self._health = health
         self.stale = False  # no valid sample within measured.timeout
-        self._decoder = JointStateDecoder()
+        self._decoder = JointStateDecoder(efforts)
         host.create_subscription(JointState, MEASURED_TOPIC, self._on_message, MEASURED_QOS,
                                  raw=True)
         self._timeout = host.config.measured.timeout

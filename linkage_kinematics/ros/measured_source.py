@@ -77,11 +77,11 @@ class MeasuredSubscription(MeasuredInput):
         if self._host.control.paused:
             return  # ~/pause: not followed, not counted
         try:
-            fields = self._decoder.decode(data)
+            stamp_ns, names, positions, velocities, _ = self._decoder.decode(data)
         except ValueError:
             self.health.drop(DropReason.MALFORMED)
             return
-        followed = self._follower.follow(*fields)
+        followed = self._follower.follow(stamp_ns, names, positions, velocities)
         if followed is None:
             return  # this node's own joint states, heard back
         if isinstance(followed, DropReason):

@@ -78,6 +78,23 @@ class JointStateEncoder:
         return self._encoder.encode((*divmod(stamp_ns, 1_000_000_000), *positions, *velocities))
 
 
+class JointStateEffortEncoder:
+    """``JointStateEncoder``'s bytes with one effort per joint (N·m or N)."""
+
+    def __init__(self, names: Sequence[str]) -> None:
+        count = len(names)
+        template = JointState(name=list(names), position=[0.0] * count, velocity=[0.0] * count,
+                              effort=[0.0] * count)
+        self._encoder = FixedShapeEncoder(template, [*_stamp_paths(''), 'position', 'velocity',
+                                                     'effort'])
+
+    def encode(self, stamp_ns: int, positions: Sequence[float], velocities: Sequence[float],
+               efforts: Sequence[float]) -> bytes:
+        """Return the message of the joints at ``positions``, ``velocities``, ``efforts``."""
+        return self._encoder.encode((*divmod(stamp_ns, 1_000_000_000), *positions, *velocities,
+                                     *efforts))
+
+
 class LinkageStateEncoder:
     """
     The bytes of ``linkage/state`` of one linkage and frame, straight from a state.

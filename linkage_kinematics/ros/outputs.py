@@ -133,7 +133,8 @@ class NodeOutputs:
         self._encoded: FourBar | None = None
         self._streamed: JointMap | None = None
         self._robot_transforms: messages.RobotStateTransforms | None = None
-        self._loop_joint_names: tuple[str, ...] | None = None  # publish_joint_states's encoder's
+        self._loop_joint_names: tuple[str, ...] | None = None  # publish_joint_states's encoders'
+        self._loop_effort_encoder: messages.JointStateEffortEncoder | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = config.outputs.frame_prefix + config.outputs.frame_id
         self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
@@ -251,15 +252,26 @@ class NodeOutputs:
     # loops robot_description: the lab's description, its closed loops and their input
 
     def publish_joint_states(self, names: tuple[str, ...], positions: tuple[float, ...],
-                             velocities: tuple[float, ...], stamp_ns: int) -> None:
-        """Publish (and log) one ``joint_states`` message of ``names``, stamped ``stamp_ns``."""
+                             velocities: tuple[float, ...], stamp_ns: int,
+                             efforts: tuple[float, ...] = ()) -> None:
+        """
+        Publish (and log) one ``joint_states`` message of ``names``, stamped ``stamp_ns``.
+
+        ``efforts``: one per joint, or none (the message's effort array empty).
+        """
         if names != self._loop_joint_names:
-            # The names are the plan's, the same message after message: one encoder per plan.
+            # The names are the plan's, the same message after message: one encoder per plan
+            # (the one with efforts made when a message first has them).
             self._loop_joint_state_encoder = messages.JointStateEncoder(names)
+            self._loop_effort_encoder = None
             self._loop_joint_names = names
-        self.send(self._publishers.joint_states,
-                  self._loop_joint_state_encoder.encode(stamp_ns, positions, velocities),
-                  stamp_ns)
+        if efforts:
+            if self._loop_effort_encoder is None:
+                self._loop_effort_encoder = messages.JointStateEffortEncoder(names)
+            data = self._loop_effort_encoder.encode(stamp_ns, positions, velocities, efforts)
+        else:
+            data = self._loop_joint_state_encoder.encode(stamp_ns, positions, velocities)
+        self.send(self._publishers.joint_states, data, stamp_ns)
 
     def record_input(self, data: bytes, stamp_ns: int) -> None:
         """Log one input message's bytes as received, at its stamp."""

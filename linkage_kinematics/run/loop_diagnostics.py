@@ -12,7 +12,11 @@ planar loop (its kind, its known joint, what is estimated, its drops, the distan
 joint to its nearest dead point) and one per closure group of the general closure (its
 closures, degrees of freedom, known and solved joints, how it is solved, its idle freedoms and
 unpublished coordinates, its assembly, the conditioning and the distance to the nearest
-singular configuration at the last sample, its drops), in ``diagnostics``' style.
+singular configuration at the last sample, its drops), and with output joints one per group
+that has them (``transmission <group>``: its actuators and output joints, its mechanical
+advantage at the last sample, whether that sample's efforts were published, and how many
+samples' efforts were withheld near a singular configuration of the transmission), in
+``diagnostics``' style.
 """
 
 from __future__ import annotations
@@ -24,8 +28,10 @@ from linkage_kinematics.kinematics.planar_loop import JointKind
 from linkage_kinematics.loops.follower import dead_point_distances, LoopSample
 from linkage_kinematics.loops.intake import DropReason, Estimate, LOOPS_DROPS
 from linkage_kinematics.loops.plan import LoopPlan, PlannedLoop
+from linkage_kinematics.loops.robot_transmission import GroupTransmission, OutputEfforts
 from linkage_kinematics.loops.solver import GroupStep
 from linkage_kinematics.loops.structure import GroupKind
+from linkage_kinematics.loops.transmission import MechanicalAdvantage, TransmissionSingular
 from linkage_kinematics.run.diagnostics import (
     Freshness,
     Level,
@@ -51,7 +57,8 @@ class LoopsHealth(Freshness):
     Dropped messages by reason (overall and per loop), and how fresh the data is.
 
     Drops since the previous status make the node's status (and the loops they concern) WARN;
-    stale data (``Freshness``) makes the node's status ERROR.
+    stale data (``Freshness``) makes the node's status ERROR. ``withheld``: per group, the
+    samples whose efforts its transmission withheld (too near a singular configuration).
     """
 
     def __init__(self, start_ns: int) -> None:
@@ -59,6 +66,7 @@ class LoopsHealth(Freshness):
         self.per_loop: dict[str, dict[DropReason, int]] = {}
         self._loop_window: dict[str, dict[DropReason, int]] = {}
         self.last: LoopSample | None = None
+        self.withheld: dict[str, int] = {}
 
     def drop(self, reason: DropReason, constraints: tuple[str, ...] = ()) -> None:
         """Count a dropped message, for the node and for each loop it concerned."""
@@ -71,6 +79,8 @@ class LoopsHealth(Freshness):
         """Note a message followed at node-clock time ``now_ns``."""
         self._accepted_at(now_ns)
         self.last = sample
+        if sample.withheld is not None:
+            self.withheld[sample.withheld] = self.withheld.get(sample.withheld, 0) + 1
 
     def problem(self, now_ns: int, timeout: float) -> str | None:
         """Return the ERROR message when the data is stale, else None."""
@@ -97,6 +107,8 @@ class LoopsView:
     health: LoopsHealth
     # the plan's groups of the general closure as followed (solver.LoopSolver.groups)
     groups: tuple[GroupStep, ...] = ()
+    # with output joints: the groups' transmissions (follower.RobotLoopsFollower.output_efforts)
+    transmissions: OutputEfforts | None = None
 
 
 def _estimated_joints(plan: LoopPlan, sample: LoopSample | None) -> set[str]:
@@ -238,6 +250,55 @@ def _group_status(inputs: StatusInputs, view: LoopsView, step: GroupStep,
     return Status(f'group {plan.name}', f'robot {view.robot_name}', level, message, values)
 
 
+def _ratio_text(advantage: MechanicalAdvantage) -> str:
+    """Return M = ∂m/∂o row by row: one row per actuator, one column per output joint."""
+    return '; '.join(f'{actuator}: ' + ', '.join(f'{value:.6g}' for value in row)
+                     for actuator, row in zip(advantage.actuators, advantage.ratio))
+
+
+def _efforts_text(sample: LoopSample | None, found: GroupTransmission,
+                  transmissions: OutputEfforts) -> str:
+    """Return what became of the last sample's efforts, as this group's status says it."""
+    if sample is None:
+        return 'not followed yet'
+    if sample.efforts:
+        return ("published: each output joint Mᵀ·(the actuators' measured efforts), every other "
+                'published joint 0')
+    if sample.withheld == found.group.name:
+        return 'withheld: the transmission is too near a singular configuration'
+    if sample.withheld is not None:
+        return (f'withheld: the transmission of group {sample.withheld} is too near a singular '
+                'configuration')
+    actuators = sorted({name for group in transmissions.groups
+                        for name in group.transmission.actuators})
+    return ('not published: the input does not carry a finite effort of each of '
+            + ', '.join(actuators))
+
+
+def _transmission_status(view: LoopsView, found: GroupTransmission,
+                         advantage: MechanicalAdvantage | TransmissionSingular | None) -> Status:
+    """Return one group's transmission status (with output joints)."""
+    transmission, sample = found.transmission, view.health.last
+    values = {
+        'actuators': ', '.join(transmission.actuators),
+        'output joints': ', '.join(transmission.outputs),
+        'efforts': _efforts_text(sample, found, view.transmissions),
+        'efforts withheld (samples)': str(view.health.withheld.get(found.group.name, 0)),
+    }
+    outputs = ', '.join(transmission.outputs)
+    if isinstance(advantage, MechanicalAdvantage):
+        values['mechanical advantage'] = advantage.describe()
+        values['d(actuators)/d(outputs)'] = _ratio_text(advantage)
+        level, message = Level.OK, f'{outputs} from {", ".join(transmission.actuators)}'
+    else:
+        text = 'not followed yet' if advantage is None else f'none: {advantage}'
+        values['mechanical advantage'] = values['d(actuators)/d(outputs)'] = text
+        level, message = ((Level.OK, f'waiting for {", ".join(transmission.actuators)}')
+                          if advantage is None else (Level.WARN, str(advantage)))
+    return Status(f'transmission {found.group.name}', f'robot {view.robot_name}', level, message,
+                  values)
+
+
 def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
     """Return the node's status's key values."""
     health, plan = view.health, view.plan
@@ -274,7 +335,7 @@ def _node_values(inputs: StatusInputs, view: LoopsView) -> dict[str, str]:
 
 def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
     """
-    Return the node's status, one per planar loop, one per group (docs/parameters.md).
+    Return the node's status and one per planar loop, group and transmission (parameters.md).
 
     The node's: ERROR for ``inputs.problem`` (a description that cannot be closed, the log
     failed) or stale data, WARN for drops since the last status, else OK with the activity.
@@ -302,4 +363,11 @@ def loop_statuses(inputs: StatusInputs, view: LoopsView) -> tuple[Status, ...]:
                      for planned in view.plan.loops]
         statuses += [_group_status(inputs, view, step, loop_warnings.get(step.plan.name, ()))
                      for step in view.groups]
+    transmissions = view.transmissions
+    if transmissions is not None:
+        sample = health.last
+        advantages = ((None,) * len(transmissions.groups) if sample is None
+                      else transmissions.advantages(sample.joints, view.groups))
+        statuses += [_transmission_status(view, found, advantage)
+                     for found, advantage in zip(transmissions.groups, advantages)]
     return tuple(statuses)

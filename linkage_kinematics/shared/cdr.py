@@ -21,7 +21,8 @@ than the message's encoding (after an empty ``effort`` in a JointState; rosbags 
 messages), and leaves padding bytes as it finds them.
 
 ``JointStateDecoder`` reads the measured sources' input the other way, straight from the bytes
-of their raw subscriptions, in a sixth of ``deserialize_message``'s time (both endiannesses).
+of their raw subscriptions, in a sixth of ``deserialize_message``'s time (both endiannesses),
+the efforts too where a follower asks for them.
 """
 from __future__ import annotations
 
@@ -327,28 +328,34 @@ class FixedShapeEncoder:
 # is not how a JointState is written.
 _BYTE_ORDERS = {b'\x00\x00': '>', b'\x00\x01': '<'}
 _COUNTS = {order: struct.Struct(order + 'I').unpack_from for order in '<>'}  # lengths, counts
-JointStateFields = tuple[int, tuple[str, ...], tuple[float, ...], tuple[float, ...]]
+JointStateFields = tuple[int, tuple[str, ...], tuple[float, ...], tuple[float, ...],
+                         tuple[float, ...]]
 
 
 class JointStateDecoder:
     """
     The fields a follower needs of a ``sensor_msgs/JointState`` received as CDR bytes.
 
-    ``decode`` returns (header stamp in ns, names, positions, velocities) as rclpy's
+    ``decode`` returns (header stamp in ns, names, positions, velocities, efforts) as rclpy's
     ``deserialize_message`` gives them, or raises ValueError naming what is wrong with the
     bytes: an encapsulation other than XCDR1, a length past the end, a string without its NUL or
-    not UTF-8. The efforts are checked, not read; bytes after them are allowed (rclpy's
-    serializer can leave some). A source sends the same names message after message: the
-    decoder keeps the last names' bytes and returns the same tuple while they repeat.
+    not UTF-8. Bytes after the efforts are allowed (rclpy's serializer can leave some). A source
+    sends the same names message after message: the decoder keeps the last names' bytes and
+    returns the same tuple while they repeat.
+
+    The efforts are checked, and read only by a decoder made with ``efforts=True``: unpacking
+    them would cost every message of a follower that has no use for them; to the others they
+    are always empty.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, efforts: bool = False) -> None:
         # the last names: their byte order, where they start and their bytes
         self._names_key: tuple[str, int, bytes] | None = None
         self._names: tuple[str, ...] = ()
+        self._sequences = _WITH_EFFORTS if efforts else _WITHOUT_EFFORTS
 
     def decode(self, data: bytes) -> JointStateFields:
-        """Return the stamp (ns), names, positions and velocities; ValueError if malformed."""
+        """Return the stamp (ns), names, positions, velocities and efforts; ValueError if bad."""
         order = _BYTE_ORDERS.get(data[:2])
         if order is None:
             raise ValueError(f'unknown CDR encapsulation {data[:2].hex() or "(none)"}: not '
@@ -368,8 +375,8 @@ class JointStateDecoder:
             names, offset = _strings(body, order, start)
             self._names_key = (order, start, body[start:offset])
             self._names = names
-        positions, velocities = _positions_and_velocities(body, order, offset)
-        return sec * 1_000_000_000 + nanosec, names, positions, velocities
+        positions, velocities, efforts = _float_sequences(body, order, offset, self._sequences)
+        return sec * 1_000_000_000 + nanosec, names, positions, velocities, efforts
 
 
 def _string_end(body: bytes, offset: int, length: int, field: str) -> int:
@@ -408,17 +415,20 @@ def _strings(body: bytes, order: str, offset: int) -> tuple[tuple[str, ...], int
     return tuple(names), offset
 
 
-# the float64 sequences after the names, and whether each is read (the efforts are not needed)
-_FLOAT_SEQUENCES = (('position', True), ('velocity', True), ('effort', False))
+# the float64 sequences after the names, and whether each is read: without the efforts (what
+# most followers need) and with them
+_WITHOUT_EFFORTS = (('position', True), ('velocity', True), ('effort', False))
+_WITH_EFFORTS = (('position', True), ('velocity', True), ('effort', True))
 
 
-def _positions_and_velocities(body: bytes, order: str, offset: int
-                              ) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Return the float64 sequences at ``offset`` but the efforts, which are only checked."""
+def _float_sequences(body: bytes, order: str, offset: int,
+                     sequences: tuple[tuple[str, bool], ...]
+                     ) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+    """Return the float64 sequences at ``offset``; one not read (``sequences``) is checked, ()."""
     unpack_count = _COUNTS[order]
     end = len(body)
     values = []
-    for field, read in _FLOAT_SEQUENCES:
+    for field, read in sequences:
         offset += -offset & 3
         if offset + 4 > end:
             raise ValueError(f'JointState ends before the length of its {field}')
@@ -429,9 +439,8 @@ def _positions_and_velocities(body: bytes, order: str, offset: int
             if offset + 8 * count > end:
                 raise ValueError(f'JointState {field} of {count} values goes past the end '
                                  f'({end} bytes)')
-            if read:
-                values.append(struct.unpack_from(f'{order}{count}d', body, offset))
+            values.append(struct.unpack_from(f'{order}{count}d', body, offset) if read else ())
             offset += 8 * count
-        elif read:
+        else:
             values.append(())
-    return values[0], values[1]
+    return values[0], values[1], values[2]
