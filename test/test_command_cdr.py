@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-``shared.command_cdr``: the relay's JointTrajectory and Float64MultiArray bytes, as rclpy and
-rosbags read and write them.
+``shared.command_cdr``: the relay's JointTrajectory and Float64MultiArray bytes.
+
+As rclpy and rosbags read and write them.
 
 Random messages (no points, points of unequal array lengths, arrays empty, non-ASCII names and
 frames of every length mod 8, NaN and ±inf, layouts with dimensions) serialized by rclpy (little

@@ -40,8 +40,8 @@ def test_the_description_s_command_direction_is_the_reference_s_and_returns(name
     assert set(names) == set(robot.measured)
     for sample in range(0, 400, 10):
         wanted = {output: value for output, (value, _, _) in motion(name, sample).items()}
-        found = command.convert(robot.outputs, JointPoint(tuple(wanted[n]
-                                                                 for n in robot.outputs)))
+        found = command.convert(robot.outputs,
+                                JointPoint(tuple(wanted[n] for n in robot.outputs)))
         actuators = dict(zip(names, found.positions))
         returned = follower.follow(1_000_000_000 + sample, names, found.positions,
                                    (0.0,) * len(names))
@@ -75,7 +75,7 @@ def test_a_planar_loop_s_branch_is_the_one_the_loops_node_is_given():
 
 
 @pytest.mark.parametrize(('outputs', 'problem'), [
-    ([], "group knee_output_pin: output joints []: 0 joints for 1 degrees of freedom that move "
+    ([], 'group knee_output_pin: output joints []: 0 joints for 1 degrees of freedom that move '
          "it (as many as its actuators ['knee_motor'])"),
     (['knee_motor'], "group knee_output_pin: output joints ['knee_motor']: ['knee_motor'] are "
                      "measured; an output joint is one the actuators ['knee_motor'] move"),

@@ -246,7 +246,7 @@ def plan_command(loops: RobotLoops, measured: Sequence[str], outputs: Sequence[s
         try:
             solved, _ = planar.solve(zeros, zeros)
         except LoopSampleError as error:
-            raise TransmissionError(f'the planar loops do not close at the actuators\' zero '
+            raise TransmissionError("the planar loops do not close at the actuators' zero "
                                     f'values: {error}') from None
         for name, value in solved.items():
             values[tree.index[name]] = value

@@ -2,8 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The command relay's messages as CDR bytes: ``trajectory_msgs/JointTrajectory`` both ways,
-``std_msgs/Float64MultiArray`` in (its bytes out are a ``cdr.FixedShapeEncoder``'s).
+The command relay's messages as CDR bytes: JointTrajectory both ways, Float64MultiArray in.
+
+``trajectory_msgs/JointTrajectory`` is decoded and encoded, ``std_msgs/Float64MultiArray``
+decoded (its bytes out are a ``cdr.FixedShapeEncoder``'s).
 
 The relay subscribes and publishes raw bytes, as the loops source does (``cdr``'s
 ``JointStateDecoder``): rclpy's ``deserialize_message`` and ``serialize_message`` would build
@@ -146,8 +148,9 @@ def decode_joint_trajectory(data: bytes) -> TrajectoryMessage:
 @functools.cache
 def _point_format(phase: int, lengths: tuple[int, int, int, int]) -> tuple[str, int]:
     """
-    Return the struct codes of a point of these array lengths starting at ``phase`` (offset
-    mod 8), and the bytes it takes.
+    Return the struct codes of a point of these array lengths, and the bytes it takes.
+
+    From its start at ``phase`` (its offset mod 8).
     """
     codes, offset = [], phase
     for count in lengths:
