@@ -178,7 +178,7 @@ def test_a_knee_s_relay_commands_its_motor_and_refuses_what_its_loop_cannot_reac
     assert refused.value.reason in (CommandRefusal.UNREACHABLE, CommandRefusal.SINGULAR)
 
 
-def test_the_record_counts_and_logs_a_refusal_a_second_per_input():
+def test_the_record_counts_and_logs_a_refusal_a_second_per_input_and_reason():
     record = RelayRecord()
     limit = CommandRefused(CommandRefusal.LIMIT, 'motor')
     assert record.refuse(MessageKind.COMMANDS, limit.reason, str(limit), SECOND) == (
@@ -186,9 +186,11 @@ def test_the_record_counts_and_logs_a_refusal_a_second_per_input():
     for step in range(1, 5):  # within the second: counted, not logged
         assert record.refuse(MessageKind.COMMANDS, limit.reason, str(limit),
                              SECOND + step) is None
-    # the other input has its own lines
+    # another input or another reason has its own lines
     assert record.refuse(MessageKind.TRAJECTORY, RelayRefusal.MALFORMED, 'x', SECOND + 9) == (
         'refused joint_trajectory: x')
+    assert record.refuse(MessageKind.COMMANDS, RelayRefusal.MALFORMED, 'y', SECOND + 10) == (
+        'refused commands: y')
     assert record.refuse(MessageKind.COMMANDS, limit.reason, str(limit), 2 * SECOND) == (
         'refused commands: an actuator would leave its URDF <limit>: motor (4 more refused '
         'since the last such line)')
@@ -208,10 +210,10 @@ def test_the_record_counts_and_logs_a_refusal_a_second_per_input():
                      log_size=None)
     status = relay_status(record, view)
     assert status.level is Level.WARN
-    assert status.message == ('refused 7 messages since the last status: an actuator would '
-                              'leave its URDF <limit> (6); its bytes are not such a message (1)')
+    assert status.message == ('refused 8 messages since the last status: an actuator would '
+                              'leave its URDF <limit> (6); its bytes are not such a message (2)')
     assert status.values['relayed commands'] == '2'
-    assert status.values['refused commands'] == '6'
+    assert status.values['refused commands'] == '7'
     assert status.values['refused trajectories'] == '1'
     assert status.values['refused: an actuator would leave its URDF <limit>'] == '6'
     assert status.values['conversion per command (µs)'] == '50.0'

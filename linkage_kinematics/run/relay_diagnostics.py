@@ -6,9 +6,10 @@ What the command relay counts, logs and reports, without ROS.
 
 ``RelayRecord`` counts the messages relayed (trajectories and their points, forward commands)
 and refused (by kind and reason), keeps the last refusal and the conversion time per message
-and per point since the last status, and decides which refusals get a log line: the first, then
-at most one a second per kind, saying how many were refused meanwhile (a 1 kHz stream of
-refusals would otherwise be a 1 kHz stream of lines; the counts say them all).
+and per point since the last status, and decides which refusals get a log line: the first of
+each input and reason, then at most one a second of that input and reason, saying how many were
+refused meanwhile (a 1 kHz stream of refusals would otherwise be a 1 kHz stream of lines; the
+counts say them all).
 ``relay_status`` is the node's one status in ``diagnostics``' style: ERROR with a problem (no
 description closes, the log failed), WARN when messages were refused since the last status
 (each reason and its count), else OK with what the relay does; its key values give the counts,
@@ -25,7 +26,7 @@ from linkage_kinematics.run.diagnostics import Level, LOG_DISABLED, Status
 from linkage_kinematics.run.relay import GroupLine, MessageKind, REFUSALS, RelayRefusal
 
 RELAY_TASK = 'command relay'
-LOG_INTERVAL_NS = 1_000_000_000  # refusal lines of one kind at most this often
+LOG_INTERVAL_NS = 1_000_000_000  # refusal lines of one input and reason at most this often
 
 
 def _plural(count: int, word: str) -> str:
@@ -41,8 +42,9 @@ class RelayRecord:
         self.refused = {kind: dict.fromkeys(REFUSALS, 0) for kind in MessageKind}
         self.last_refusal: str | None = None
         self._window = dict.fromkeys(REFUSALS, 0)
-        self._logged_ns: dict[MessageKind, int | None] = dict.fromkeys(MessageKind)
-        self._unlogged = dict.fromkeys(MessageKind, 0)
+        # per input and reason: when its last line was logged, how many were not since
+        self._logged_ns: dict[tuple[MessageKind, CommandRefusal | RelayRefusal], int] = {}
+        self._unlogged: dict[tuple[MessageKind, CommandRefusal | RelayRefusal], int] = {}
         # conversion time (ns) and count since the last status: per command, per point
         self._times = {MessageKind.COMMANDS: [0, 0], MessageKind.TRAJECTORY: [0, 0]}
         self.mean_times: dict[MessageKind, float | None] = dict.fromkeys(MessageKind)
@@ -61,20 +63,21 @@ class RelayRecord:
     def refuse(self, kind: MessageKind, reason: CommandRefusal | RelayRefusal, text: str,
                now_ns: int) -> str | None:
         """
-        Count a refused message; return its log line, or None within a second of the last.
+        Count a refused message; return its log line, None within a second of the last alike.
 
-        ``text``: the refusal in full (reason and detail); the line names the topic's kind.
+        ``text``: the refusal in full (reason and detail); the line names the input.
         """
         self.refused[kind][reason] += 1
         self._window[reason] += 1
         line = f'refused {kind.value}: {text}'
         self.last_refusal = line
-        logged = self._logged_ns[kind]
+        key = (kind, reason)
+        logged = self._logged_ns.get(key)
         if logged is not None and now_ns - logged < LOG_INTERVAL_NS:
-            self._unlogged[kind] += 1
+            self._unlogged[key] += 1
             return None
-        unlogged, self._unlogged[kind] = self._unlogged[kind], 0
-        self._logged_ns[kind] = now_ns
+        unlogged, self._unlogged[key] = self._unlogged.get(key, 0), 0
+        self._logged_ns[key] = now_ns
         if unlogged:
             line += f' ({unlogged} more refused since the last such line)'
         return line
