@@ -38,6 +38,7 @@ setup(
     entry_points={
         'console_scripts': [
             'linkage_node = linkage_kinematics.ros.node:main',
+            'linkage_command_node = linkage_kinematics.ros.command_node:main',
             'linkage-sweep = linkage_kinematics.cli.sweep:main',
             'linkage-replay = linkage_kinematics.cli.replay:main',
             'linkage-demo = linkage_kinematics.cli.demo:main',

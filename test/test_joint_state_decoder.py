@@ -170,7 +170,7 @@ EMPTY_SEQUENCES = bytes(3) + struct.pack('<III', 0, 0, 0)  # padding, then three
     (little_endian(b'\x00', [b'a\x00', b''], EMPTY_SEQUENCES), r'name\[1\] has length 0'),
     (little_endian(b'\x00', [b'a\x00'] * 3)[:-1], r'name\[2\] of 2 bytes .* past the end'),
     (little_endian(b'\x00', [])[:-4] + struct.pack('<I', 1_000_000) + bytes(40),
-     'claims 1000000 names in 40 bytes'),
+     'name claims 1000000 strings in 40 bytes'),
     (little_endian(b'\x00', [b'a\x00'], bytes(2) + struct.pack('<I', 10**9) + bytes(8)),
      'position of 1000000000 values goes past the end'),
     (little_endian(b'\x00', [b'a\x00'], bytes(2) + struct.pack('<I', 0)),

@@ -15,13 +15,17 @@ output joints given in part, a name given twice, an array neither empty nor one 
 joint, accelerations without velocities, loop outputs without positions; and NaN or inf
 anywhere (``NOT_FINITE``). A trajectory's points are converted in order, continuing from the
 last accepted point, and refused whole, naming the first point refused: the groups are then as
-before it. A forward command is a trajectory of one point. Pure: no ROS.
+before it. A forward command is a trajectory of one point.
+
+``plan_command`` builds one from a robot description's loops as the loops node plans them (the
+same measured joints, branches and assemblies), each group's output joints from
+``loops.output_joints``. Pure: no ROS.
 """
 
 from __future__ import annotations
 
-from collections.abc import Collection, Sequence
-from dataclasses import dataclass
+from collections.abc import Collection, Mapping, Sequence
+from dataclasses import dataclass, replace
 import math
 
 from linkage_kinematics.loops.command import (
@@ -30,6 +34,14 @@ from linkage_kinematics.loops.command import (
     CommandRefused,
     CommandState,
     JointPoint,
+)
+from linkage_kinematics.loops.plan import RobotLoops
+from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.structure import analyse
+from linkage_kinematics.loops.transmission import (
+    assign_outputs,
+    Transmission,
+    TransmissionError,
 )
 
 # lists of names whose conversion is kept
@@ -202,3 +214,53 @@ class _Layout:
 def _at_point(refusal: CommandRefused, number: int) -> CommandRefused:
     """Return the refusal with the point's number before its detail."""
     return CommandRefused(refusal.reason, f'point {number}: {refusal.detail}')
+
+
+def plan_command(loops: RobotLoops, measured: Sequence[str], outputs: Sequence[str],
+                 branches: Mapping[str, int] | None = None,
+                 assemblies: Mapping[str, float] | None = None) -> RobotCommand:
+    """
+    Return the command direction of a robot's loops: ``measured`` the actuators.
+
+    The loops planned as the loops node plans them (``RobotLoops.plan``: LoopError, one line per
+    problem), each group assembled as there: a general group at its zero-pose assembly, a
+    planar group's loops on their planned branches (``branches``, else the zero pose's) at the
+    actuators' zero values; each group's output joints from ``outputs`` (every group needs its
+    own: ``transmission.assign_outputs`` and ``check_outputs``; TransmissionError, one line per
+    problem), and its ``CommandGroup`` (PlanError where the assembled pose is a singular
+    configuration of the transmission).
+    """
+    plan = loops.plan(measured, branches, assemblies)
+    tree = plan.tree
+    assigned, problems = assign_outputs(tree, [group.group for group in plan.groups], outputs)
+    problems = list(problems)
+    values = [0.0] * len(tree.names)
+    for group in plan.general:
+        for index in group.group.coordinates:
+            values[index] = group.zero.assembly.values[index]
+    if plan.loops:
+        # the planar loops alone, closed in closed form at the actuators' zero values
+        planar = LoopSolver(replace(plan, groups=tuple(group for group in plan.groups
+                                                       if group.zero is None)))
+        zeros = dict.fromkeys(plan.measured, 0.0)
+        try:
+            solved, _ = planar.solve(zeros, zeros)
+        except LoopSampleError as error:
+            raise TransmissionError("the planar loops do not close at the actuators' zero "
+                                    f'values: {error}') from None
+        for name, value in solved.items():
+            values[tree.index[name]] = value
+    commands = []
+    for group in plan.groups:
+        structure = (group.zero.structure if group.zero is not None
+                     else analyse(tree, group.group, values))
+        try:
+            transmission = Transmission(tree, group.group, structure, assigned[group.name],
+                                        values)
+        except TransmissionError as error:
+            problems.append(str(error))
+            continue
+        commands.append(CommandGroup(tree, transmission, values, loops.loops))
+    if problems:
+        raise TransmissionError('; '.join(problems))
+    return RobotCommand(commands, loops.joint_names)

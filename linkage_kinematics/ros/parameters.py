@@ -11,6 +11,7 @@ meaning, unit and range.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from linkage_kinematics.kinematics.geometry import GeometryError
@@ -20,6 +21,7 @@ from linkage_kinematics.run.parameter_specs import (
     parameter_specs,
     ParameterSpec,
     REAL_PARAMETERS,
+    relay_parameter_specs,
 )
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
@@ -72,17 +74,28 @@ def declare_parameters(node: Node) -> tuple[ParameterSpec, ...]:
         specs = parameter_specs(preset_name)
     except GeometryError as error:
         raise ConfigurationError('preset', str(error)) from None
-    for spec in specs[1:]:
+    _declare(node, specs[1:])
+    return specs
+
+
+def declare_relay_parameters(node: Node) -> tuple[ParameterSpec, ...]:
+    """Declare the command relay's parameters on ``node`` (without ranges, ``add_ranges``)."""
+    specs = relay_parameter_specs()
+    _declare(node, specs)
+    return specs
+
+
+def _declare(node: Node, specs: Sequence[ParameterSpec]) -> None:
+    for spec in specs:
         node.declare_parameter(spec.name, spec.default,
                                parameter_descriptor(spec, with_range=False))
     # A whole number given for a real parameter (`-p rate_hz:=50`) is stored as that real.
     whole_numbers = [
-        node.get_parameter(name) for name in REAL_PARAMETERS
-        if node.get_parameter(name).type_ == Parameter.Type.INTEGER
+        node.get_parameter(spec.name) for spec in specs if spec.name in REAL_PARAMETERS
+        and node.get_parameter(spec.name).type_ == Parameter.Type.INTEGER
     ]
     if whole_numbers:
         node.set_parameters(keep_declared_types(whole_numbers))
-    return specs
 
 
 def add_ranges(node: Node, specs: tuple[ParameterSpec, ...]) -> None:
@@ -98,6 +111,6 @@ def add_ranges(node: Node, specs: tuple[ParameterSpec, ...]) -> None:
             node.set_descriptor(spec.name, parameter_descriptor(spec))
 
 
-def parameter_values(node: Node) -> dict[str, Any]:
-    """Return the current values of the node's own parameters (name → value)."""
-    return {name: node.get_parameter(name).value for name in PARAMETER_NAMES}
+def parameter_values(node: Node, names: Sequence[str] = PARAMETER_NAMES) -> dict[str, Any]:
+    """Return the current values of the node's own parameters ``names`` (name → value)."""
+    return {name: node.get_parameter(name).value for name in names}

@@ -13,7 +13,9 @@ validate through it. docs/parameters.md documents each parameter.
 A ``RunConfiguration`` holds the values in the groups ``parameter_specs`` declares them in, one
 frozen dataclass each: ``geometry``, ``motion`` (with the pass it implies), ``outputs``,
 ``logging`` (with cpu_affinity, as its group has it), ``joints`` (the source, its driver, the
-lab's joints), ``measured`` and ``loops``; and ``autostart``.
+lab's joints), ``measured`` and ``loops``; and ``autostart``. The command relay's values
+(``build_relay_configuration``) are a ``RelayConfiguration``: the same ``loops``, ``measured``
+and ``logging`` groups, built by the same functions, and its ``commands``.
 """
 
 from __future__ import annotations
@@ -39,12 +41,14 @@ from linkage_kinematics.kinematics.solver import continued_branch, DeadPointErro
 from linkage_kinematics.model.joints import Driver, JointMap, JointMapping, Link
 from linkage_kinematics.run.limits import MIN_PASS_DURATION
 from linkage_kinematics.run.parameter_specs import (
+    CommandInterface,
     EndBehavior,
     Kind,
     LoopsSource,
     MotionMode,
     NODE_NAME,
     ParameterSpec,
+    RELAY_SPECS,
     SourceKind,
     SPECS,
 )
@@ -177,6 +181,31 @@ class Loops:
 
 
 @dataclass(frozen=True)
+class Commands:
+    """
+    The relay's forward commands (``commands.*``).
+
+    ``interface``: what ~/commands carries; ``joints``: its joints in order (output joints and
+    joints passed through); ``controller_joints``: the actuators/commands message's joints in
+    order (empty: the joints passed through, then each group's actuators).
+    """
+
+    interface: CommandInterface
+    joints: tuple[str, ...]
+    controller_joints: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class RelayConfiguration:
+    """The command relay's validated parameters, by group (``build_relay_configuration``)."""
+
+    loops: Loops
+    commands: Commands
+    measured: Measured
+    logging: Logging
+
+
+@dataclass(frozen=True)
 class RunConfiguration:
     """Validated parameters plus the motion they imply, by group; replaced whole, never mutated."""
 
@@ -298,15 +327,16 @@ _CHECKS = {
 }
 
 
-def parameter_value(values: Mapping[str, Any], name: str) -> Any:
+def parameter_value(values: Mapping[str, Any], name: str,
+                    specs: Mapping[str, ParameterSpec] = SPECS) -> Any:
     """
-    Return parameter ``name``'s value in ``values``, checked against its spec.
+    Return parameter ``name``'s value in ``values``, checked against its spec in ``specs``.
 
     A real comes back as a float (a whole number is accepted), a choice as its enum member.
     Raises ConfigurationError naming the parameter and what its spec asks for (a missing value
     is refused as ``no value``).
     """
-    spec = SPECS[name]
+    spec = specs[name]
     return _CHECKS[spec.kind](spec, values.get(name))
 
 
@@ -506,34 +536,74 @@ def build_configuration(values: Mapping[str, Any]) -> RunConfiguration:
             min_transmission_angle=checked['diagnostics.min_transmission_angle'],
             dead_point_warning=checked['diagnostics.dead_point_warning'],
         ),
-        logging=Logging(
-            enabled=checked['log.enabled'],
-            folder=Path(checked['log.folder']),
-            max_bag_size=checked['log.max_bag_size'],
-            max_bag_duration=checked['log.max_bag_duration'],
-            cpu_affinity=checked['cpu_affinity'],
-        ),
+        logging=_logging(checked),
         joints=Joints(
             source=checked['source'],
             driver=driver,
             lab=joints,
             publish_robot_description=checked['publish_robot_description'],
         ),
-        measured=Measured(
-            timeout=checked['measured.timeout'],
-            max_jump=checked['measured.max_jump'],
-            acceleration_time_constant=checked['measured.acceleration_time_constant'],
-        ),
-        loops=Loops(
-            source=checked['loops'],
-            measured_joints=tuple(checked['loops.measured_joints']),
-            branches=_loop_branches(checked['loops.branches']),
-            robot_description=checked['robot_description'],
-            assemblies=_loop_assemblies(checked['loops.assemblies']),
-            robot_description_closures=checked['robot_description_closures'],
-            output_joints=tuple(checked['loops.output_joints']),
-        ),
+        measured=_measured(checked),
+        loops=_loops(checked),
         autostart=checked['autostart'],
+    )
+
+
+def _logging(checked: Mapping[str, Any]) -> Logging:
+    return Logging(
+        enabled=checked['log.enabled'],
+        folder=Path(checked['log.folder']),
+        max_bag_size=checked['log.max_bag_size'],
+        max_bag_duration=checked['log.max_bag_duration'],
+        cpu_affinity=checked['cpu_affinity'],
+    )
+
+
+def _measured(checked: Mapping[str, Any]) -> Measured:
+    return Measured(
+        timeout=checked['measured.timeout'],
+        max_jump=checked['measured.max_jump'],
+        # the relay has no acceleration estimate
+        acceleration_time_constant=checked.get('measured.acceleration_time_constant', 0.0),
+    )
+
+
+def _loops(checked: Mapping[str, Any]) -> Loops:
+    return Loops(
+        # the relay always closes a description's loops
+        source=checked.get('loops', LoopsSource.ROBOT_DESCRIPTION),
+        measured_joints=tuple(checked['loops.measured_joints']),
+        branches=_loop_branches(checked['loops.branches']),
+        robot_description=checked['robot_description'],
+        assemblies=_loop_assemblies(checked['loops.assemblies']),
+        robot_description_closures=checked['robot_description_closures'],
+        output_joints=tuple(checked['loops.output_joints']),
+    )
+
+
+def build_relay_configuration(values: Mapping[str, Any]) -> RelayConfiguration:
+    """
+    Validate the command relay's parameter values (name → value) into a RelayConfiguration.
+
+    Each value on its own (``RELAY_SPECS``, in declaration order), then what the relay needs:
+    output joints to write commands in, and ``commands.joints`` among them or outside the
+    loops (checked against the description when it is read). ConfigurationError names the first
+    bad parameter.
+    """
+    checked = {name: parameter_value(values, name, RELAY_SPECS) for name in RELAY_SPECS}
+    if not checked['loops.output_joints']:
+        raise ConfigurationError('loops.output_joints', 'the command relay needs the output '
+                                 "joints commands are written in (each closure group's, as "
+                                 'many as its degrees of freedom)')
+    return RelayConfiguration(
+        loops=_loops(checked),
+        commands=Commands(
+            interface=checked['commands.interface_name'],
+            joints=tuple(checked['commands.joints'] or checked['loops.output_joints']),
+            controller_joints=tuple(checked['commands.controller_joints']),
+        ),
+        measured=_measured(checked),
+        logging=_logging(checked),
     )
 
 

@@ -8,15 +8,20 @@ Pure, no ROS: one small function per group of parameters (geometry, motion, outp
 measured input and joints), in the order the node declares them. Each spec says what a value
 must be (its kind, unit, range, the choices of a closed set) once: ``configuration`` checks
 values against it and ``ros.parameters`` turns it into the ROS descriptor. The closed sets of
-values (``EndBehavior``, ``MotionMode``, ``SourceKind``, ``LoopsSource``) are defined here, with
-the parameters they are the values of, so that ``configuration`` imports this module and not the
-other way round.
+values (``EndBehavior``, ``MotionMode``, ``SourceKind``, ``LoopsSource``, ``CommandInterface``)
+are defined here, with the parameters they are the values of, so that ``configuration`` imports
+this module and not the other way round.
+
+The command relay (``linkage_command_node``) declares ``relay_parameter_specs``: the loops
+node's robot description, closure file and ``loops.*`` settings (the same specs, their texts
+without "with loops robot_description"), its logging and measured-pose thresholds, and its own
+``commands.*``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Collection, Iterable
-from dataclasses import dataclass
+from collections.abc import Collection, Iterable, Mapping
+from dataclasses import dataclass, replace
 import difflib
 from enum import Enum, StrEnum
 import math
@@ -42,6 +47,7 @@ from linkage_kinematics.run.limits import (
 from linkage_kinematics.shared.rosbag2_split import MIN_SPLIT_SIZE, NO_SPLIT
 
 NODE_NAME = 'linkage_node'
+RELAY_NODE_NAME = 'linkage_command_node'
 
 
 class EndBehavior(StrEnum):
@@ -71,6 +77,18 @@ class LoopsSource(StrEnum):
 
     PARAMETERS = 'parameters'  # the node's own four-bar, from the geometry parameters
     ROBOT_DESCRIPTION = 'robot_description'  # every loop of a lab's URDF (and closure file)
+
+
+class CommandInterface(StrEnum):
+    """
+    What the relay's forward commands carry: ``commands.interface_name``, by its value.
+
+    forward_command_controller's ``interface_name``: the command interface of every joint.
+    """
+
+    POSITION = 'position'
+    VELOCITY = 'velocity'
+    EFFORT = 'effort'
 
 
 class Kind(Enum):
@@ -327,6 +345,10 @@ def _measured_specs() -> tuple[ParameterSpec, ...]:
     )
 
 
+# How the loops node's specs of a robot's loops begin; the relay's texts are without it.
+LOOPS_ONLY = 'with loops robot_description: '
+
+
 def _loop_specs() -> tuple[ParameterSpec, ...]:
     """Return which loops the measured source closes, and how (docs/following_loops.md)."""
     return (
@@ -336,31 +358,31 @@ def _loop_specs() -> tuple[ParameterSpec, ...]:
                       'only)',
                       Kind.CHOICE, read_only=True, choices=LoopsSource),
         ParameterSpec('loops.measured_joints', [],
-                      'with loops robot_description: the measured joints; empty: the closure '
+                      LOOPS_ONLY + 'the measured joints; empty: the closure '
                       "file's actuated joints (name_mot), else the loop joints the first "
                       'measured_joint_states message carries',
                       Kind.TEXTS, read_only=True),
         ParameterSpec('loops.branches', [],
-                      'with loops robot_description: CONSTRAINT=1 or CONSTRAINT=-1, the assembly '
+                      LOOPS_ONLY + 'CONSTRAINT=1 or CONSTRAINT=-1, the assembly '
                       "branch of that planar loop; by default the zero pose's",
                       Kind.TEXTS, read_only=True),
         ParameterSpec('loops.assemblies', [],
-                      'with loops robot_description: JOINT=VALUE (rad or m), a start value of a '
+                      LOOPS_ONLY + 'JOINT=VALUE (rad or m), a start value of a '
                       'joint a closure group solves, assembling its group nearer another '
                       'assembly; by default the one nearest the zero pose',
                       Kind.TEXTS, read_only=True),
         ParameterSpec('loops.output_joints', [],
-                      "with loops robot_description: each closure group's independent joints as "
+                      LOOPS_ONLY + "each closure group's independent joints as "
                       "the lab's controllers see them (as many as the group's degrees of freedom, "
                       'none measured), whose efforts and commands the transmission gives; empty: '
                       'none',
                       Kind.TEXTS, read_only=True),
         ParameterSpec('robot_description', '',
-                      "with loops robot_description: the robot's URDF (as robot_state_publisher's "
+                      LOOPS_ONLY + "the robot's URDF (as robot_state_publisher's "
                       "parameter); '': from the robot_description topic",
                       Kind.TEXT, read_only=True, allow_empty=True),
         ParameterSpec('robot_description_closures', '',
-                      "with loops robot_description: the text of the URDF's closure file "
+                      LOOPS_ONLY + "the text of the URDF's closure file "
                       "(toolbox-parallel-robots' YAML: closed_loop, type, name_mot, joint_name, "
                       "joint_type), for every description; '': none",
                       Kind.TEXT, read_only=True, allow_empty=True),
@@ -391,17 +413,74 @@ PARAMETER_NAMES = tuple(SPECS)
 REAL_PARAMETERS = frozenset(name for name, spec in SPECS.items() if spec.kind is Kind.REAL)
 
 
-def unknown_parameters(given: Iterable[str], declared: Collection[str]) -> list[str]:
+def _command_specs() -> tuple[ParameterSpec, ...]:
+    """Return the relay's forward commands: their interface and joint orders each side."""
+    return (
+        ParameterSpec('commands.interface_name', CommandInterface.POSITION.value,
+                      "what ~/commands carries, as the actuators' forward_command_controller's "
+                      'interface_name: position, velocity or effort (velocity and effort at the '
+                      'pose measured on measured_joint_states)',
+                      Kind.CHOICE, read_only=True, choices=CommandInterface),
+        ParameterSpec('commands.joints', [],
+                      'the joints of each ~/commands message, in order: output joints (every '
+                      'output joint of a group commanded) and joints outside the loops, passed '
+                      'through; empty: loops.output_joints',
+                      Kind.TEXTS, read_only=True),
+        ParameterSpec('commands.controller_joints', [],
+                      "the joints of each actuators/commands message, in order: the actuators' "
+                      "forward_command_controller's joints parameter (the groups' actuators and "
+                      'the joints passed through); empty: the joints passed through, then each '
+                      "group's actuators",
+                      Kind.TEXTS, read_only=True),
+    )
+
+
+def relay_parameter_specs() -> tuple[ParameterSpec, ...]:
+    """
+    Return the command relay's parameters, in the order it declares them.
+
+    The loops node's specs where the relay reads the same setting (each contract defined once,
+    only the text changed where the relay reads it otherwise), then its own.
+    """
+    texts = {
+        'loops.measured_joints': "the actuators (the loops node's measured joints); empty: the "
+                                 "closure file's actuated joints (name_mot)",
+        'measured.timeout': 'velocity and effort commands are refused when the pose measured on '
+                            'measured_joint_states is older than this (s), greater than 0',
+        'measured.max_jump': 'a measured revolute actuator further than this from the last '
+                             'sample used is dropped (rad, greater than 0; π drops none)',
+        'log.enabled': 'record every message received and published to a bag',
+    }
+    by_name = {spec.name: spec for spec in parameter_specs('')}
+    shared = [replace(by_name[name], description=texts.get(
+        name, by_name[name].description.removeprefix(LOOPS_ONLY))) for name in _RELAY_SHARED]
+    commands = _command_specs()
+    return (*shared[:_RELAY_LOOPS], *commands, *shared[_RELAY_LOOPS:])
+
+
+# The loops node's parameters the relay reads too, in the relay's order: its robot and loops
+# (the first _RELAY_LOOPS), then after its own commands.* the measured pose and the log.
+_RELAY_SHARED = ('robot_description', 'robot_description_closures', 'loops.measured_joints',
+                 'loops.output_joints', 'loops.branches', 'loops.assemblies',
+                 'measured.timeout', 'measured.max_jump', 'log.enabled', 'log.folder',
+                 'log.max_bag_size', 'log.max_bag_duration', 'cpu_affinity')
+_RELAY_LOOPS = 6
+RELAY_SPECS = {spec.name: spec for spec in relay_parameter_specs()}
+
+
+def unknown_parameters(given: Iterable[str], declared: Collection[str],
+                       node_name: str = NODE_NAME,
+                       specs: Mapping[str, ParameterSpec] = SPECS) -> list[str]:
     """
     Return one warning per parameter in ``given`` that is not in ``declared``, sorted by name.
 
-    Each names the parameter and the closest of the node's own parameters, if one is close
-    (``rate`` → ``rate_hz``).
+    Each names the parameter and the closest of the node's own parameters (``specs``), if one
+    is close (``rate`` → ``rate_hz``).
     """
     warnings = []
     for name in sorted(set(given) - set(declared)):
-        closest = difflib.get_close_matches(name, PARAMETER_NAMES, n=1)
+        closest = difflib.get_close_matches(name, tuple(specs), n=1)
         hint = f"; did you mean '{closest[0]}'?" if closest else ''
-        warnings.append(f"unknown parameter '{name}' ignored: {NODE_NAME} has no such "
+        warnings.append(f"unknown parameter '{name}' ignored: {node_name} has no such "
                         f'parameter{hint}')
     return warnings

@@ -356,63 +356,81 @@ class JointStateDecoder:
 
     def decode(self, data: bytes) -> JointStateFields:
         """Return the stamp (ns), names, positions, velocities and efforts; ValueError if bad."""
-        order = _BYTE_ORDERS.get(data[:2])
-        if order is None:
-            raise ValueError(f'unknown CDR encapsulation {data[:2].hex() or "(none)"}: not '
-                             'XCDR1 (00 00 big endian, 00 01 little endian)')
-        body = data[len(ENCAPSULATION_HEADER):]  # CDR aligns relative to the body's start
+        order, body = cdr_body(data)
         end = len(body)
         if end < 12:
             raise ValueError(f'JointState of {end} bytes ends within its header')
         sec, nanosec, length = struct.unpack_from(order + 'iII', body)
-        offset = _string_end(body, 12, length, 'header.frame_id')
+        offset = string_end(body, 12, length, 'JointState header.frame_id')
         start = offset + (-offset & 3)
         key = self._names_key
         if (key is not None and key[0] == order and key[1] == start
                 and body[start:start + len(key[2])] == key[2]):
             names, offset = self._names, start + len(key[2])
         else:
-            names, offset = _strings(body, order, start)
+            names, offset = read_strings(body, order, start, 'JointState name')
             self._names_key = (order, start, body[start:offset])
             self._names = names
         positions, velocities, efforts = _float_sequences(body, order, offset, self._sequences)
         return sec * 1_000_000_000 + nanosec, names, positions, velocities, efforts
 
 
-def _string_end(body: bytes, offset: int, length: int, field: str) -> int:
-    """Check the string of ``length`` bytes (its NUL counted) at ``offset``; return its end."""
+def cdr_body(data: bytes) -> tuple[str, bytes]:
+    """
+    Return a message's struct byte order and its body (after the encapsulation header).
+
+    CDR aligns relative to the body's start. ValueError for an encapsulation other than XCDR1.
+    """
+    order = _BYTE_ORDERS.get(data[:2])
+    if order is None:
+        raise ValueError(f'unknown CDR encapsulation {data[:2].hex() or "(none)"}: not '
+                         'XCDR1 (00 00 big endian, 00 01 little endian)')
+    return order, data[len(ENCAPSULATION_HEADER):]
+
+
+def string_end(body: bytes, offset: int, length: int, field: str) -> int:
+    """
+    Check the string of ``length`` bytes (its NUL counted) at ``offset``; return its end.
+
+    ``field`` names it in the ValueError (``JointState header.frame_id``).
+    """
     if length == 0:
-        raise ValueError(f'JointState {field} has length 0 (a CDR string counts its NUL)')
+        raise ValueError(f'{field} has length 0 (a CDR string counts its NUL)')
     if offset + length > len(body):
-        raise ValueError(f'JointState {field} of {length} bytes at byte {offset} goes past '
-                         f'the end ({len(body)} bytes)')
+        raise ValueError(f'{field} of {length} bytes at byte {offset} goes past the end '
+                         f'({len(body)} bytes)')
     if body[offset + length - 1]:
-        raise ValueError(f'JointState {field} does not end in a NUL')
+        raise ValueError(f'{field} does not end in a NUL')
     return offset + length
 
 
-def _strings(body: bytes, order: str, offset: int) -> tuple[tuple[str, ...], int]:
-    """Return the names sequence at ``offset`` and where it ends."""
+def read_strings(body: bytes, order: str, offset: int,
+                 field: str) -> tuple[tuple[str, ...], int]:
+    """
+    Return the sequence of strings at ``offset`` and where it ends.
+
+    ``field`` names it in the ValueError (``JointState name``).
+    """
     unpack_length = _COUNTS[order]
     offset += -offset & 3
     if offset + 4 > len(body):
-        raise ValueError('JointState ends before the length of its name')
+        raise ValueError(f'{field} ends before its length')
     count = unpack_length(body, offset)[0]
     offset += 4
-    if count * 5 > len(body) - offset:  # each name takes at least a length and its NUL
-        raise ValueError(f'JointState claims {count} names in {len(body) - offset} bytes')
-    names = []
+    if count * 5 > len(body) - offset:  # each string takes at least a length and its NUL
+        raise ValueError(f'{field} claims {count} strings in {len(body) - offset} bytes')
+    strings = []
     for index in range(count):
         offset += -offset & 3
         if offset + 4 > len(body):
-            raise ValueError(f'JointState ends before the length of name[{index}]')
+            raise ValueError(f'{field}[{index}] ends before its length')
         start = offset + 4
-        offset = _string_end(body, start, unpack_length(body, offset)[0], f'name[{index}]')
+        offset = string_end(body, start, unpack_length(body, offset)[0], f'{field}[{index}]')
         try:
-            names.append(str(body[start:offset - 1], 'utf-8'))
+            strings.append(str(body[start:offset - 1], 'utf-8'))
         except UnicodeDecodeError as error:
-            raise ValueError(f'JointState name[{index}] is not UTF-8: {error}') from None
-    return tuple(names), offset
+            raise ValueError(f'{field}[{index}] is not UTF-8: {error}') from None
+    return tuple(strings), offset
 
 
 # the float64 sequences after the names, and whether each is read: without the efforts (what
