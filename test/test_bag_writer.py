@@ -75,10 +75,9 @@ def sample_messages() -> list[Any]:
             state, stamp_ns, 0.1), JointTrajectory),
         deserialize_message(messages.MarkerArrayEncoder(paper.geometry, 'linkage_base').encode(
             state, stamp_ns), MarkerArray),
-        messages.diagnostic_array(
-            time_msg(stamp_ns), 'linkage_node: crank motion', 'four-bar', DiagnosticStatus.WARN,
-            '1.2° from a dead point', {'α (deg)': '12.5', 'empty': ''},
-        ),
+        deserialize_message(messages.diagnostics_message(stamp_ns, [messages.DiagnosticEntry(
+            'linkage_node: crank motion', 'four-bar', 1, '1.2° from a dead point',
+            {'α (deg)': '12.5', 'empty': ''})]), DiagnosticArray),
         String(data="<robot name='ü'/>"),
         String(data=''),
     ]
@@ -338,6 +337,37 @@ def test_the_nodes_encoders_write_each_message_exactly_as_the_independent_reader
     assert (disk.pose.orientation.z, disk.pose.orientation.w) == messages.disk_orientation(state)
     assert disk.scale.x == disk.scale.y == 2.0 * linkage.crank_length
     assert rgba(disk.color) == float32(*scene.DISK_COLOR[:3], scene.DISK_MARKER_ALPHA)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    stamp=st.integers(0, 2**31 * 10**9 - 1),
+    statuses=st.lists(st.tuples(st.integers(0, 3), st.lists(ros_text, min_size=3, max_size=3),
+                                st.dictionaries(ros_text, ros_text, max_size=4)),
+                      min_size=1, max_size=3),
+)
+def test_the_diagnostics_written_from_their_texts_are_encode_cdr_of_the_message(
+    stamp: int, statuses: list[tuple[int, list[str], dict[str, str]]],
+) -> None:
+    """
+    ``diagnostics_message`` writes the bytes ``encode_cdr`` writes of the rclpy message.
+
+    Texts of any length (UTF-8 of any width) shift the alignment of everything after them.
+    """
+    entries = [messages.DiagnosticEntry(name, hardware_id, level, text, values)
+               for level, (name, hardware_id, text), values in statuses]
+    message = DiagnosticArray(status=[
+        DiagnosticStatus(level=bytes([entry.level]), name=entry.name, message=entry.message,
+                         hardware_id=entry.hardware_id,
+                         values=[KeyValue(key=key, value=value)
+                                 for key, value in entry.values.items()])
+        for entry in entries])
+    message.header.stamp = time_msg(stamp)
+    data = messages.diagnostics_message(stamp, entries)
+    assert data == encode_cdr(message)
+    decoded = assert_one_encoding(data, DiagnosticArray)
+    assert [(status.name, status.message, status.hardware_id) for status in decoded.status] == [
+        (entry.name, entry.message, entry.hardware_id) for entry in entries]
 
 
 def test_a_fixed_shape_encoder_of_one_field_and_one_naming_no_field() -> None:

@@ -2,10 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-cpu_affinity.
+cpu_affinity, and when the node's threads wake.
 
 The node's threads on one CPU and its bag writer process on the others, set at start-up and at run
-time; a CPU the process may not use is refused naming the parameter.
+time; a CPU the process may not use is refused naming the parameter. The node's timed waits end
+on time (1 ns of timer slack, which the executor's timer thread inherits).
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(
             assert len(node_threads) > 3
             assert all(cpus == {NODE_CPU} for cpus in node_threads.values()), node_threads
             assert all(cpus == WRITER_CPUS for cpus in thread_cpus(writer).values())
+            assert Path(f'/proc/{process.pid}/timerslack_ns').read_text() == '1\n'
 
             successful, reason = set_parameter(client, listener, 'cpu_affinity', NOT_AVAILABLE)
             assert not successful

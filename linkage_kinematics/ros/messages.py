@@ -8,19 +8,20 @@ The per-tick messages and the scene are never built as rclpy messages: their enc
 (``JointStateEncoder``, ``LinkageStateEncoder``, ``MarkerArrayEncoder``) write their CDR bytes
 straight from the state into a layout prepared once per geometry from a template message
 (``shared.cdr.FixedShapeEncoder``), the bytes ``encode_cdr`` would write of the message they
-describe. The diagnostics are built (``diagnostic_array``) and encoded by ``encode_cdr``. None
-of this computes any kinematics: the values come from the value functions here
-(``joints.JointStream``, ``disk_orientation``) and from
-``bag.state_layout``. Colours and sizes come from ``scene``.
+describe; the diagnostics (``diagnostics_message``) are written straight from their texts the
+same way. None of this computes any kinematics: the values come from the value functions here
+(``joints.JointStream``, ``disk_orientation``) and from ``bag.state_layout``. Colours and sizes
+come from ``scene``.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 import math
+import struct
+from typing import NamedTuple
 
 from builtin_interfaces.msg import Time
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import Point, TransformStamped
 from linkage_kinematics.bag.state_layout import state_coordinates, STATE_JOINT_NAMES
 from linkage_kinematics.kinematics.geometry import FourBar
@@ -32,7 +33,7 @@ from linkage_kinematics.model.robot_transforms import (
     Transform,
 )
 from linkage_kinematics.model.urdf_reader import UrdfTree
-from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder
+from linkage_kinematics.shared.cdr import ENCAPSULATION_HEADER, encode_cdr, FixedShapeEncoder
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
 from std_msgs.msg import ColorRGBA
@@ -209,25 +210,53 @@ def _new_marker_array(linkage: FourBar, frame_id: str) -> MarkerArray:
     return MarkerArray(markers=[disk, bars, *pins, *pivots])
 
 
-def diagnostic_array(
-    stamp: Time,
-    name: str,
-    hardware_id: str,
-    level: bytes,
-    message: str,
-    values: Mapping[str, str],
-) -> DiagnosticArray:
-    """/diagnostics with one status, in diagnostic_updater's layout (name "<node>: <task>")."""
-    status = DiagnosticStatus(
-        level=level,
-        name=name,
-        message=message,
-        hardware_id=hardware_id,
-        values=[KeyValue(key=key, value=value) for key, value in values.items()],
-    )
-    array = DiagnosticArray(status=[status])
-    array.header.stamp = stamp
-    return array
+class DiagnosticEntry(NamedTuple):
+    """One diagnostic_msgs/DiagnosticStatus, in diagnostic_updater's layout."""
+
+    name: str  # "<node>: <task>"
+    hardware_id: str
+    level: int  # a diagnostic_msgs/DiagnosticStatus level
+    message: str
+    values: Mapping[str, str]
+
+
+# A DiagnosticArray up to its statuses: the header's stamp, its empty frame_id (a length of 1,
+# the NUL) and three bytes that align the statuses' count to 4, the count.
+_DIAGNOSTICS_HEADER = struct.Struct('<iII4xI')
+_STRING_LENGTH = struct.Struct('<I')
+_ALIGN_4 = (b'', b'\0', b'\0\0', b'\0\0\0')  # by the offset's -offset & 3
+
+
+def diagnostics_message(stamp_ns: int, statuses: Sequence[DiagnosticEntry]) -> bytes:
+    """
+    Return /diagnostics (a DiagnosticArray of ``statuses``, stamped ``stamp_ns``) as bytes.
+
+    The bytes ``encode_cdr`` writes of that message with an empty frame_id, written straight
+    from the texts: a status goes out with the states ten times a second of mechanism time, and
+    building the rclpy messages to walk them took longer than a timer period at 5 kHz.
+    """
+    sec, nanosec = divmod(stamp_ns, 1_000_000_000)
+    body = bytearray(_DIAGNOSTICS_HEADER.pack(sec, nanosec, 1, len(statuses)))
+    for status in statuses:
+        body.append(status.level)
+        _add_string(body, status.name)
+        _add_string(body, status.message)
+        _add_string(body, status.hardware_id)
+        body += _ALIGN_4[-len(body) & 3]
+        body += _STRING_LENGTH.pack(len(status.values))
+        for key, value in status.values.items():
+            _add_string(body, key)
+            _add_string(body, value)
+    return ENCAPSULATION_HEADER + body
+
+
+def _add_string(body: bytearray, text: str) -> None:
+    """Append a CDR string (its length aligned to 4, counting the NUL, then its UTF-8 bytes)."""
+    encoded = text.encode('utf-8')
+    body += _ALIGN_4[-len(body) & 3]
+    body += _STRING_LENGTH.pack(len(encoded) + 1)
+    body += encoded
+    body += b'\0'
 
 
 class TFMessage:

@@ -4,9 +4,10 @@
 """
 The node's outputs: its publishers and its log, one place that publishes and records.
 
-Every message is encoded once (``encode_cdr``, or for the per-state messages and the scene an
-encoder that writes the same bytes straight from the state), published, and the very same bytes
-logged at the message's stamp, so subscribers receive exactly what the bag holds.
+Every message is encoded once (``encode_cdr``, or for the per-state messages, the scene and the
+diagnostics an encoder that writes the same bytes straight from the state or the texts),
+published, and the very same bytes logged at the message's stamp, so subscribers receive exactly
+what the bag holds.
 """
 
 from __future__ import annotations
@@ -16,7 +17,6 @@ import json
 import time
 from typing import Any, NamedTuple
 
-from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
@@ -110,6 +110,7 @@ class NodeOutputs:
     def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
                  bag_writer_cpus: set[int] | None) -> None:
         self._node = node
+        self._node_name = node.get_name()
         self.config = config
         four_bar = config.loops.source is LoopsSource.PARAMETERS
         self._publishers = Publishers(
@@ -298,28 +299,18 @@ class NodeOutputs:
 
     def publish_statuses(self, stamp_ns: int, statuses: tuple[Status, ...]) -> None:
         """Publish several statuses in one array, each named '<node>: <task>'."""
-        stamp = Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000)
-        arrays = [messages.diagnostic_array(stamp, f'{self._node.get_name()}: {status.task}',
-                                            status.hardware_id, bytes([status.level]),
-                                            status.message, status.values)
-                  for status in statuses]
-        message = arrays[0]
-        message.status = [status for array in arrays for status in array.status]
-        self.send(self._publishers.diagnostics, encode_cdr(message), stamp_ns)
+        self.send(self._publishers.diagnostics, messages.diagnostics_message(stamp_ns, [
+            messages.DiagnosticEntry(f'{self._node_name}: {status.task}', status.hardware_id,
+                                     status.level, status.message, status.values)
+            for status in statuses]), stamp_ns)
 
     def publish_diagnostics(self, stamp_ns: int, level: Level, text: str,
                             values: dict[str, str]) -> None:
         """Publish one status in diagnostic_updater's layout, stamped ``stamp_ns``."""
-        config = self.config
-        message = messages.diagnostic_array(
-            Time(sec=stamp_ns // 1_000_000_000, nanosec=stamp_ns % 1_000_000_000),
-            f'{self._node.get_name()}: crank motion',
-            f"four-bar linkage ({config.geometry.preset or 'explicit geometry'})",
-            bytes([level]),
-            text,
-            values,
-        )
-        self.send(self._publishers.diagnostics, encode_cdr(message), stamp_ns)
+        hardware_id = f"four-bar linkage ({self.config.geometry.preset or 'explicit geometry'})"
+        self.send(self._publishers.diagnostics, messages.diagnostics_message(stamp_ns, [
+            messages.DiagnosticEntry(f'{self._node_name}: crank motion', hardware_id, level,
+                                     text, values)]), stamp_ns)
 
     def flush_log(self) -> None:
         """
