@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import math
 
 from linkage_kinematics.loops.equations import LoopEquations, RowKind
-from linkage_kinematics.loops.linear import condition, inverse, solve
+from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
 from linkage_kinematics.loops.structure import (
     analyse,
@@ -356,10 +356,10 @@ class _Square:
         """
         columns = self.columns
         matrix = [[row[c] for c in columns] for row in jacobian] + self.idle
-        found = inverse(matrix)
-        if found is None or found[1] == 0.0:
+        factors = factor(matrix)
+        if factors is None or factors.determinant == 0.0:
             return [], 0.0, math.inf
-        inverse_matrix, det = found
+        inverse_matrix, det = factors.inverse(), factors.determinant
         rows, scales = self.row_scale, self.column_scale
         if len(columns) == 1:
             return inverse_matrix, det, 1.0
@@ -406,5 +406,5 @@ def actuator_efforts(ratio: Sequence[Sequence[float]],
                      output_efforts: Sequence[float]) -> tuple[float, ...] | None:
     """Return τ_m = M⁻ᵀ·τ_o for M = ``ratio``; None where M is exactly singular."""
     transposed = [list(column) for column in zip(*ratio)]
-    found = solve(transposed, list(output_efforts))
-    return None if found is None else tuple(found)
+    factors = factor(transposed)
+    return None if factors is None else tuple(factors.solve(list(output_efforts)))
