@@ -132,7 +132,7 @@ class PerSamplePath:
         self.decoder = JointStateDecoder()
         self.fields = [self.decoder.decode(data) for data in self.received]
         # the follower's samples of the period, after a first period to assemble the ankles
-        for stamp_ns, names, positions, velocities in self.fields:
+        for stamp_ns, names, positions, velocities, _ in self.fields:
             self.follower.follow(stamp_ns, names, positions, velocities)
         self.runs = 1
         self.samples = [self._follow(fields) for fields in self.fields]
@@ -143,7 +143,7 @@ class PerSamplePath:
         self.measured_values = [[sample.joints[name] for name in plan.measured]
                                 for sample in self.samples]
         self.measured_rates = [[velocities[names.index(name)] for name in plan.measured]
-                               for _, names, _, velocities in self.fields]
+                               for _, names, _, velocities, _ in self.fields]
         full = LoopSolver(plan)
         self.knees = {plan.groups[index].name: LoopSolver(planar_only(plan, index))
                       for index, group in enumerate(plan.groups) if group.zero is None}
@@ -168,7 +168,7 @@ class PerSamplePath:
         self.recorder.close()
 
     def _follow(self, fields: tuple) -> LoopSample:
-        stamp_ns, names, positions, velocities = fields
+        stamp_ns, names, positions, velocities, _ = fields
         followed = self.follower.follow(stamp_ns + self.runs * SAMPLES * PERIOD_NS, names,
                                         positions, velocities)
         if not isinstance(followed, LoopSample):
@@ -193,7 +193,7 @@ class PerSamplePath:
             offset = self.runs * SAMPLES * PERIOD_NS
             self.runs += 1
             take, keep = self.intake.take, self.intake.keep
-            for stamp_ns, names, positions, velocities in self.fields:
+            for stamp_ns, names, positions, velocities, _ in self.fields:
                 taken = take(stamp_ns + offset, names, positions, velocities)
                 keep(stamp_ns + offset, taken[1])
             return count
@@ -246,7 +246,7 @@ class PerSamplePath:
             self.runs += 1
             record = self.recorder.record
             for data in self.received:
-                stamp_ns, names, positions, velocities = self.decoder.decode(data)
+                stamp_ns, names, positions, velocities, _ = self.decoder.decode(data)
                 stamp_ns += offset
                 followed = self.follower.follow(stamp_ns, names, positions, velocities)
                 record('/biped/measured_joint_states', data, stamp_ns)
@@ -257,22 +257,6 @@ class PerSamplePath:
                     stamp_ns, followed.positions, followed.velocities), stamp_ns)
                 record('/tf', self.transforms.tree_message(self.tree.at_sample(followed.joints),
                                                            stamp_ns), stamp_ns)
-            return count
-
-        def relay_callback() -> int:
-            # minimal_relay.py's callback, with rclpy's deserialisation before it (the take)
-            # and its serialisation after it (the publish)
-            for data in self.received:
-                measured = deserialize_message(data, JointState)
-                index = measured.name.index('crank_joint')
-                angle = measured.position[index]
-                rate = measured.velocity[index] if len(measured.velocity) > index else 0.0
-                message = JointState()
-                message.header.stamp = measured.header.stamp
-                message.name = ['coupler_joint', 'rocker_joint']
-                message.position = [-0.3 * angle, 0.5 * angle]
-                message.velocity = [-0.3 * rate, 0.5 * rate]
-                serialize_message(message)
             return count
 
         parts: dict[str, Callable[[], int]] = {
@@ -290,9 +274,30 @@ class PerSamplePath:
             "all of it, as the node's callback (without rclpy's take and publish)":
                 node_callback,
             "the hand relay's callback with rclpy's deserialisation and serialisation":
-                relay_callback,
+                lambda: hand_relay_callback(self.received),
         })
         return parts
+
+
+def hand_relay_callback(received: list[bytes]) -> int:
+    """
+    Run minimal_relay.py's callback on each of ``received``; return how many.
+
+    With rclpy's deserialisation before it (the take) and its serialisation after it (the
+    publish).
+    """
+    for data in received:
+        measured = deserialize_message(data, JointState)
+        index = measured.name.index('crank_joint')
+        angle = measured.position[index]
+        rate = measured.velocity[index] if len(measured.velocity) > index else 0.0
+        message = JointState()
+        message.header.stamp = measured.header.stamp
+        message.name = ['coupler_joint', 'rocker_joint']
+        message.position = [-0.3 * angle, 0.5 * angle]
+        message.velocity = [-0.3 * rate, 0.5 * rate]
+        serialize_message(message)
+    return len(received)
 
 
 def instructions() -> dict[str, float] | None:

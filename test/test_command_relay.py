@@ -22,9 +22,10 @@ from linkage_kinematics.loops.command import CommandRefusal, CommandRefused, Joi
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.loops.robot_command import plan_command
 from linkage_kinematics.model.urdf_reader import read_urdf
-from linkage_kinematics.run.configuration import build_relay_configuration, ConfigurationError
+from linkage_kinematics.run.configuration import build_relay_configuration
 from linkage_kinematics.run.diagnostics import Level
 from linkage_kinematics.run.parameter_specs import relay_parameter_specs
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.run.relay import (
     MessageKind,
     read_relay,

@@ -23,7 +23,7 @@ from linkage_kinematics.bag.reader import bag_files, iter_messages, read_states
 from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.kinematics.solver import solve
-from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.motion import (
     dead_point_problem,
     met_dead_point,
@@ -31,6 +31,7 @@ from linkage_kinematics.run.motion import (
     sample_at_time,
 )
 from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, parameter_specs
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from node_process import (
     configuration_values,
     expected_state_point,

@@ -21,11 +21,7 @@ from linkage_kinematics.model.joints import Link
 from linkage_kinematics.model.urdf import urdf_text
 from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
 from linkage_kinematics.ros.parameters import parameter_descriptor
-from linkage_kinematics.run.configuration import (
-    build_configuration,
-    ConfigurationError,
-    parameter_value,
-)
+from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.parameter_specs import (
     Kind,
     PARAMETER_NAMES,
@@ -33,6 +29,7 @@ from linkage_kinematics.run.parameter_specs import (
     ParameterSpec,
     unknown_parameters,
 )
+from linkage_kinematics.run.parameter_values import ConfigurationError, parameter_value
 from node_process import (
     configuration_values,
     get_parameter,

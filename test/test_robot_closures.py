@@ -37,11 +37,12 @@ from linkage_kinematics.loops.solver import LoopSolver
 from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.model.urdf_reader import read_urdf
 from linkage_kinematics.ros.loop_source import assembly_line, ClosedRobot, group_plan_line
-from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
 from linkage_kinematics.run.parameter_specs import parameter_specs
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from loop_robots import ROBOTS
 import pytest
 from test_closure_assembly import mirrored_distal_angles

@@ -22,12 +22,13 @@ from linkage_kinematics.loops.follower import (
 from linkage_kinematics.loops.intake import DropReason, Estimate
 from linkage_kinematics.loops.plan import read_loops
 from linkage_kinematics.model.urdf_reader import read_urdf
-from linkage_kinematics.run.configuration import build_configuration, ConfigurationError
+from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.control import RunState
 from linkage_kinematics.run.diagnostics import Level, StatusInputs
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
 from linkage_kinematics.run.measured import MeasuredFollower
 from linkage_kinematics.run.parameter_specs import parameter_specs
+from linkage_kinematics.run.parameter_values import ConfigurationError
 import loop_reference
 from loop_robots import ROBOTS
 import pytest

@@ -52,13 +52,14 @@ from linkage_kinematics.ros.parameters import (
     keep_declared_types,
     parameter_values,
 )
-from linkage_kinematics.run.configuration import build_relay_configuration, ConfigurationError
+from linkage_kinematics.run.configuration import build_relay_configuration
 from linkage_kinematics.run.parameter_specs import (
     CommandInterface,
     RELAY_NODE_NAME,
     RELAY_SPECS,
     unknown_parameters,
 )
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.run.placement import CpuPlacement
 from linkage_kinematics.run.relay import (
     MessageKind,

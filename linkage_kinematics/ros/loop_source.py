@@ -44,10 +44,11 @@ from linkage_kinematics.ros.outputs import (
     StartupError,
 )
 from linkage_kinematics.ros.source import SourceHost
-from linkage_kinematics.run.configuration import ConfigurationError, RunConfiguration
+from linkage_kinematics.run.configuration import RunConfiguration
 from linkage_kinematics.run.control import ServiceAnswer
 from linkage_kinematics.run.diagnostics import RateMeter, Status, StatusInputs, StatusSchedule
 from linkage_kinematics.run.loop_diagnostics import loop_statuses, LoopsHealth, LoopsView
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from std_msgs.msg import String
 
 

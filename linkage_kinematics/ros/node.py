@@ -43,7 +43,6 @@ from linkage_kinematics.ros.parameters import (
 from linkage_kinematics.ros.source import RunStatus, Source
 from linkage_kinematics.run.configuration import (
     build_configuration,
-    ConfigurationError,
     LoopsSource,
     NODE_NAME,
     RunConfiguration,
@@ -53,6 +52,7 @@ from linkage_kinematics.run.control import RunControl, ServiceAnswer
 from linkage_kinematics.run.diagnostics import RateMeter, report, StatusInputs, StatusSchedule
 from linkage_kinematics.run.motion import blocked_note
 from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, unknown_parameters
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.run.placement import CpuPlacement
 from rcl_interfaces.msg import SetParametersResult
 import rclpy
@@ -293,11 +293,7 @@ class LinkageNode(RunStatus, Node):
             now_ns=now_ns,
         )
         statuses = self._source.statuses(inputs)
-        if statuses is not None:
-            self.outputs.publish_statuses(at_ns, statuses)
-            return
-        level, text, values = report(inputs)
-        self.outputs.publish_diagnostics(at_ns, level, text, values)
+        self.outputs.publish_statuses(at_ns, (report(inputs),) if statuses is None else statuses)
 
 
 # --- process ------------------------------------------------------------------------------

@@ -26,13 +26,9 @@ from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream, TreeValues
 from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.ros import messages
-from linkage_kinematics.run.configuration import (
-    ConfigurationError,
-    LoopsSource,
-    RunConfiguration,
-    SourceKind,
-)
-from linkage_kinematics.run.diagnostics import Level, Status
+from linkage_kinematics.run.configuration import LoopsSource, RunConfiguration, SourceKind
+from linkage_kinematics.run.diagnostics import Status
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.shared.cdr import encode_cdr
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -303,14 +299,6 @@ class NodeOutputs:
             messages.DiagnosticEntry(f'{self._node_name}: {status.task}', status.hardware_id,
                                      status.level, status.message, status.values)
             for status in statuses]), stamp_ns)
-
-    def publish_diagnostics(self, stamp_ns: int, level: Level, text: str,
-                            values: dict[str, str]) -> None:
-        """Publish one status in diagnostic_updater's layout, stamped ``stamp_ns``."""
-        hardware_id = f"four-bar linkage ({self.config.geometry.preset or 'explicit geometry'})"
-        self.send(self._publishers.diagnostics, messages.diagnostics_message(stamp_ns, [
-            messages.DiagnosticEntry(f'{self._node_name}: crank motion', hardware_id, level,
-                                     text, values)]), stamp_ns)
 
     def flush_log(self) -> None:
         """

@@ -15,7 +15,6 @@ from collections.abc import Sequence
 from typing import Any
 
 from linkage_kinematics.kinematics.geometry import GeometryError
-from linkage_kinematics.run.configuration import ConfigurationError, parameter_value
 from linkage_kinematics.run.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
@@ -23,6 +22,7 @@ from linkage_kinematics.run.parameter_specs import (
     REAL_PARAMETERS,
     relay_parameter_specs,
 )
+from linkage_kinematics.run.parameter_values import ConfigurationError, parameter_value
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter

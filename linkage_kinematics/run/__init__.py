@@ -5,7 +5,9 @@
 One run of the node, as pure Python (no rclpy): what the node decides, without ROS.
 
 ``parameter_specs`` (each parameter's default, descriptor text and contract: kind, unit, range
-from ``limits``), ``configuration`` (values checked against it into a RunConfiguration), the
+from ``limits``), ``parameter_values`` (one value checked against its spec, and the
+``ConfigurationError`` naming a bad one), ``configuration`` (all values into a
+RunConfiguration), the
 four-bar's two sources ``motion`` (the drive law in time) and ``measured`` (a measured joint
 completed), ``control`` (~/pause, ~/resume, ~/reset), ``diagnostics`` (the four-bar's status,
 the ``Status`` every source reports in, and the measured samples' ``Freshness``) and

@@ -241,9 +241,9 @@ def assess(
     return Level.OK, activity
 
 
-def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
+def report(inputs: StatusInputs) -> Status:
     """
-    Return the level, message and key values of one status (docs/parameters.md, Diagnostics).
+    Return the four-bar's status, 'crank motion' (docs/parameters.md, Diagnostics).
 
     A measured source's drops since the last status make it WARN and its staleness ERROR.
     """
@@ -255,7 +255,8 @@ def report(inputs: StatusInputs) -> tuple[Level, str, dict[str, str]]:
         problem = problem or health.problem(inputs.now_ns, config.measured.timeout, driver_name)
     values = key_values(inputs)
     level, text = assess(config, inputs.state, problem, inputs.activity, warnings)
-    return level, text, values
+    hardware_id = f"four-bar linkage ({config.geometry.preset or 'explicit geometry'})"
+    return Status('crank motion', hardware_id, level, text, values)
 
 
 class Freshness:

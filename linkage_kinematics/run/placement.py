@@ -13,8 +13,8 @@ from __future__ import annotations
 
 import os
 
-from linkage_kinematics.run.configuration import ConfigurationError
 from linkage_kinematics.run.limits import NO_CPU_AFFINITY
+from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.shared.affinity import set_process_affinity
 
 
