@@ -71,7 +71,7 @@ def _message_class(slot_type: NamespacedType) -> type:
 # of a fixed run, by offset mod 8; the code and size of a primitive sequence's elements), the
 # element getter or message class of a sequence or message, and whether a length comes first.
 _Entry = tuple[Callable[[Any], Any], int, Any, Any, bool]
-_PADDING = ('',) + tuple(f'{n}x' for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
+PADDING = ('',) + tuple(f'{n}x' for n in range(1, 8))  # struct codes of 0 to 7 zero bytes
 
 
 def _fields(msg_type: type) -> list[tuple[str, Any]]:
@@ -111,7 +111,7 @@ def _fixed_entry(leaves: list[tuple[str, str, int]]) -> tuple[Callable[[Any], tu
         codes, offset = [], phase
         for _, code, size in leaves:
             padding = -offset % size
-            codes.append(_PADDING[padding] + code)
+            codes.append(PADDING[padding] + code)
             offset += padding + size
         layouts.append((''.join(codes), offset - phase))
     paths = [path for path, _, _ in leaves]
@@ -183,20 +183,20 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
             values.extend(value)
             offset += length
         elif kind == _STRING:
-            offset = _add_string(value, codes, values, offset)
+            offset = add_string(value, codes, values, offset)
         elif kind == _MESSAGE:
             offset = _walk(value, _plan(extra), codes, values, offset)
         else:
             if counted:
                 padding = -offset % 4
-                codes.append(_PADDING[padding] + 'I')
+                codes.append(PADDING[padding] + 'I')
                 values.append(len(value))
                 offset += padding + 4
             if kind == _PRIMITIVE_LIST:
                 if len(value):  # a fixed-size array is a numpy array
                     code, size = detail
                     padding = -offset % size
-                    codes.append(f'{_PADDING[padding]}{len(value)}{code}')
+                    codes.append(f'{PADDING[padding]}{len(value)}{code}')
                     values.extend(value)
                     offset += padding + len(value) * size
             elif kind == _FIXED_LIST:
@@ -207,7 +207,7 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
                     offset += length
             elif kind == _STRING_LIST:
                 for text in value:
-                    offset = _add_string(text, codes, values, offset)
+                    offset = add_string(text, codes, values, offset)
             else:
                 element_plan = _plan(extra)
                 for element in value:
@@ -215,11 +215,17 @@ def _walk(message: Any, plan: tuple[_Entry, ...], codes: list[str], values: list
     return offset
 
 
-def _add_string(text: str, codes: list[str], values: list[Any], offset: int) -> int:
+def add_string(text: str, codes: list[str], values: list[Any], offset: int) -> int:
+    """
+    Append a CDR string's struct codes and values at ``offset`` (from the body's start).
+
+    Its alignment padding, its length (the terminating NUL counted) and its bytes; return the
+    offset after it.
+    """
     encoded = text.encode('utf-8')
     padding = -offset % 4
     length = len(encoded) + 1  # with the terminating NUL, which struct adds
-    codes.append(f'{_PADDING[padding]}I{length}s')
+    codes.append(f'{PADDING[padding]}I{length}s')
     values.extend((length, encoded))
     return offset + padding + 4 + length
 

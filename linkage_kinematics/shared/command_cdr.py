@@ -26,8 +26,10 @@ import functools
 import struct
 
 from linkage_kinematics.shared.cdr import (
+    add_string,
     cdr_body,
     ENCAPSULATION_HEADER,
+    PADDING,
     read_strings,
     string_end,
 )
@@ -36,7 +38,6 @@ from linkage_kinematics.shared.cdr import (
 POINT_ARRAYS = ('positions', 'velocities', 'accelerations', 'effort')
 # the least bytes a trajectory point takes: four counts and a Duration
 _POINT_MINIMUM = 4 * 4 + 8
-_PADDING = ('',) + tuple(f'{n}x' for n in range(1, 8))
 
 
 @dataclass(frozen=True)
@@ -155,25 +156,16 @@ def _point_format(phase: int, lengths: tuple[int, int, int, int]) -> tuple[str, 
     codes, offset = [], phase
     for count in lengths:
         padding = -offset % 4
-        codes.append(_PADDING[padding] + 'I')
+        codes.append(PADDING[padding] + 'I')
         offset += padding + 4
         if count:
             padding = -offset % 8
-            codes.append(f'{_PADDING[padding]}{count}d')
+            codes.append(f'{PADDING[padding]}{count}d')
             offset += padding + 8 * count
     padding = -offset % 4
-    codes.append(_PADDING[padding] + 'iI')
+    codes.append(PADDING[padding] + 'iI')
     offset += padding + 8
     return ''.join(codes), offset - phase
-
-
-def _string(text: str, codes: list[str], values: list, offset: int) -> int:
-    encoded = text.encode('utf-8')
-    padding = -offset % 4
-    length = len(encoded) + 1  # with the terminating NUL, which struct adds
-    codes.append(f'{_PADDING[padding]}I{length}s')
-    values.extend((length, encoded))
-    return offset + padding + 4 + length
 
 
 def encode_joint_trajectory(sec: int, nanosec: int, frame_id: str, joint_names: Sequence[str],
@@ -181,15 +173,15 @@ def encode_joint_trajectory(sec: int, nanosec: int, frame_id: str, joint_names: 
     """Return the little-endian XCDR1 bytes of a ``JointTrajectory`` (with its header)."""
     codes = ['<iI']
     values: list = [sec, nanosec]
-    offset = _string(frame_id, codes, values, 8)
+    offset = add_string(frame_id, codes, values, 8)
     padding = -offset % 4
-    codes.append(_PADDING[padding] + 'I')
+    codes.append(PADDING[padding] + 'I')
     values.append(len(joint_names))
     offset += padding + 4
     for name in joint_names:
-        offset = _string(name, codes, values, offset)
+        offset = add_string(name, codes, values, offset)
     padding = -offset % 4
-    codes.append(_PADDING[padding] + 'I')
+    codes.append(PADDING[padding] + 'I')
     values.append(len(points))
     offset += padding + 4
     for point in points:
