@@ -33,6 +33,7 @@ from linkage_kinematics.model.robot_transforms import (
     Transform,
 )
 from linkage_kinematics.model.urdf_reader import UrdfTree
+from linkage_kinematics.run.diagnostics import Status
 from linkage_kinematics.shared.cdr import ENCAPSULATION_HEADER, encode_cdr, FixedShapeEncoder
 from rosidl_parser.definition import NamespacedType, UnboundedSequence
 from sensor_msgs.msg import JointState
@@ -248,6 +249,14 @@ def diagnostics_message(stamp_ns: int, statuses: Sequence[DiagnosticEntry]) -> b
             _add_string(body, key)
             _add_string(body, value)
     return ENCAPSULATION_HEADER + body
+
+
+def statuses_message(stamp_ns: int, node_name: str, statuses: Sequence[Status]) -> bytes:
+    """Return /diagnostics of a node's ``statuses``, each named '<node>: <task>'."""
+    return diagnostics_message(stamp_ns, [
+        DiagnosticEntry(f'{node_name}: {status.task}', status.hardware_id, status.level,
+                        status.message, status.values)
+        for status in statuses])
 
 
 def _add_string(body: bytearray, text: str) -> None:

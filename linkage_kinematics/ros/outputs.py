@@ -295,10 +295,8 @@ class NodeOutputs:
 
     def publish_statuses(self, stamp_ns: int, statuses: tuple[Status, ...]) -> None:
         """Publish several statuses in one array, each named '<node>: <task>'."""
-        self.send(self._publishers.diagnostics, messages.diagnostics_message(stamp_ns, [
-            messages.DiagnosticEntry(f'{self._node_name}: {status.task}', status.hardware_id,
-                                     status.level, status.message, status.values)
-            for status in statuses]), stamp_ns)
+        self.send(self._publishers.diagnostics,
+                  messages.statuses_message(stamp_ns, self._node_name, statuses), stamp_ns)
 
     def flush_log(self) -> None:
         """
