@@ -2,17 +2,36 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-A robot's closed loops: read from its description, ordered, closed sample by sample and followed.
+A robot's closed loops: read from its description, structured, closed sample by sample, followed.
 
-Pure (numpy, urdf_parser_py, lxml, PyYAML; no ROS). ``closures`` is the one model of a loop
-closure, whichever of the three encodings it was read from: ``constraint_element`` (urdfdom PR
-#264's ``<constraint>``), ``loop_joint_element`` (Isaac Sim's ``<loop_joint>``) and
-``closure_file`` (toolbox-parallel-robots' YAML side file) read them, ``encodings`` a whole
-description's. ``description`` (a URDF's tree at the zero pose and its ``<constraint>``
-elements), ``planar`` (one constraint's loop as a ``PlanarLoop``, with its joints' signs),
-``plan`` (the robot's loops ordered from the measured joints), ``solver`` (the plan closed
-sample by sample), ``intake`` (the one sample intake of both measured modes, and the one set of
-reasons a message is dropped for) and ``follower`` (a JointState in, every passive loop joint
-out, or why the message was dropped). Imports only ``kinematics`` and ``model``; every
-description comes in parsed (``model.urdf_reader.UrdfTree``).
+Pure (numpy, urdf_parser_py, lxml, PyYAML; no ROS); every description comes in parsed
+(``model.urdf_reader.UrdfTree``). Imports only ``kinematics`` and ``model``. Modules:
+
+- reading: ``closures`` (the one closure model: pin, ball, weld, its two sides, its encoding),
+  one reader per encoding, ``constraint_element`` (urdfdom PR #264's ``<constraint>``),
+  ``loop_joint_element`` (Isaac Sim's ``<loop_joint>``) and ``closure_file``
+  (toolbox-parallel-robots' YAML side file), with ``xml_values`` (the two elements' links and
+  numbers); ``encodings`` (a description's closures in all three); ``description`` (the URDF's
+  tree at the zero pose);
+- planar loops: ``planar`` (a pin's four-joint loop as a ``PlanarLoop``), ``plan`` (the robot's
+  closures grouped and planned from the measured joints), ``solver`` (the plan closed sample by
+  sample);
+- the general closure: ``tree`` (the kinematic tree: coordinates, overrides, mimics),
+  ``frames`` (its moving frames per sample), ``spatial`` (rigid motions in plain floats),
+  ``equations`` (the closures' residuals, exact Jacobian and its rate), ``linear`` (small LU
+  factors), ``structure`` (groups, degrees of freedom, idle freedoms, determinacy),
+  ``reduction`` (welded rods and collinear pins rewritten smaller), ``assembly`` (the assembled
+  pose nearest a start), ``newton`` (a group closed per sample: Newton to rounding, its
+  refusals), ``closed_forms`` (the planar five-bar, a crank–rod–ball leg's inverse, the
+  delta's three spheres, a universal joint's and a ball's angles) and ``reach`` (each known
+  joint's reach, for the checker);
+- the transmission: ``transmission`` (a group between its actuators and output joints: M =
+  ∂m/∂o, efforts), ``robot_transmission`` (a robot's, with names: the output joints' efforts),
+  ``transmission_range`` (the mechanical advantage over the reachable range, for the checker),
+  ``command`` (a group's command direction, its refusals), ``command_parts`` (one command group
+  by its method) and ``robot_command`` (a robot's command direction, with names: what the relay
+  converts);
+- following: ``intake`` (the one sample intake of both measured modes, and the one set of
+  reasons a message is dropped for) and ``follower`` (a JointState in, every passive loop joint
+  out, or why the message was dropped).
 """

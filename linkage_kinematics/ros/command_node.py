@@ -16,8 +16,8 @@ the same ``loops.*`` parameters; velocity and effort commands are converted at t
 loops node's follower closes from ``measured_joint_states``. Messages go in and out as CDR
 bytes (``shared.command_cdr``); a refused message is logged (``run.relay_diagnostics``: at most
 a line a second per input), counted in ``/diagnostics`` and not relayed; the node keeps
-running. Its bag holds every message received and published. docs/command_relay.md documents
-it.
+running. Its bag holds every message received and published. docs/following_loops.md ("The
+command direction") and docs/parameters.md ("linkage_command_node") document it.
 """
 
 from __future__ import annotations
@@ -105,7 +105,7 @@ REFUSAL_STATUS_NS = 100_000_000  # a refusal's status at once, at most this ofte
 
 class CommandNode(Node):
     """
-    The command relay (module docstring; docs/command_relay.md).
+    The command relay (module docstring; docs/following_loops.md, "The command direction").
 
     Construction raises ConfigurationError for bad parameters and StartupError for a description
     given as a parameter that cannot be relayed (or a log that cannot be written), before
