@@ -24,8 +24,8 @@ the identity, and a pin reads its axis from ``<parent_axis>``; the child frame t
 same axis (as a URDF joint's child frame turns about the joint's axis), so without a
 ``<child_axis>`` the child's axis has the parent's coordinates. Without any axis the pin turns
 about its loop's first revolute joint's axis, as the planar loops have always read it (the PR
-takes (1, 0, 0) there; this package's planar readers never did). The attributes are read as
-``model.loop_urdf`` reads them, with the same refusals.
+takes (1, 0, 0) there; this package's planar readers never did). The attributes are read by
+``xml_values``, with the refusals the planar loops have always had.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ TYPES = {
 
 
 def _axis(element: lxml.etree._Element | None, where: str) -> Vector | None:
-    """Return an axis element's unit xyz, (1, 0, 0) without one (as loop_urdf); None if absent."""
+    """Return an axis element's unit xyz, (1, 0, 0) without one; None if absent."""
     if element is None:
         return None
     return unit_axis(three_numbers(element.get('xyz'), (1.0, 0.0, 0.0), where), where)

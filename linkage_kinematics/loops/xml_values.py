@@ -6,7 +6,7 @@ The links and numbers of the closure elements a URDF may hold (``<constraint>``,
 
 urdf_parser_py reads neither element, so their attributes are read here from the XML tree it
 read, as finite as ``model.urdf_reader`` asks a joint's numbers to be, with the one-line
-refusals ``model.loop_urdf`` has always given for a ``<constraint>``. Each refusal is a
+refusals the planar loops have always had for a ``<constraint>``. Each refusal is a
 ``ClosureError`` whose message starts with ``where``, the element's name for people.
 """
 
