@@ -437,7 +437,7 @@ def _command_specs() -> tuple[ParameterSpec, ...]:
 
 def relay_parameter_specs() -> tuple[ParameterSpec, ...]:
     """
-    Return the command relay's parameters, in the order it declares them.
+    Return the command relay's parameters, in the order it declares them, every one read-only.
 
     The loops node's specs where the relay reads the same setting (each contract defined once,
     only the text changed where the relay reads it otherwise), then its own.
@@ -452,7 +452,9 @@ def relay_parameter_specs() -> tuple[ParameterSpec, ...]:
         'log.enabled': 'record every message received and published to a bag',
     }
     by_name = {spec.name: spec for spec in parameter_specs('')}
-    shared = [replace(by_name[name], description=texts.get(
+    # read-only all: the relay reads its settings once, at start (the loops node changes its
+    # measured.* and cpu_affinity while it runs; a set that the relay ignored would mislead)
+    shared = [replace(by_name[name], read_only=True, description=texts.get(
         name, by_name[name].description.removeprefix(LOOPS_ONLY))) for name in _RELAY_SHARED]
     commands = _command_specs()
     return (*shared[:_RELAY_LOOPS], *commands, *shared[_RELAY_LOOPS:])
