@@ -196,21 +196,39 @@ def _command_structures(tree: KinematicTree, group: ClosureGroup, structure: Gro
     return structures, None
 
 
-@dataclass(frozen=True)
 class Linearization:
     """
     The transmission at one pose, both directions' square systems (module docstring).
 
     ``ratio``: M = ∂m/∂o (actuators × outputs); the orientation (sign of det) and conditioning
     κ₁ of A (actuators known) and A' (outputs known). An orientation that changes between two
-    poses of a motion means it crossed a singular configuration of that direction.
+    poses of a motion means it crossed a singular configuration of that direction. One is made
+    per commanded point, where a relay of positions needs the orientations and conditionings
+    alone: M is worked out when first asked for, from the Jacobian and A'⁻¹ kept (a slotted
+    class rather than a frozen dataclass for that; ``Transmission.linearize`` makes them).
     """
 
-    ratio: tuple[tuple[float, ...], ...]
-    measured_orientation: int
-    measured_conditioning: float
-    command_orientation: int
-    command_conditioning: float
+    __slots__ = ('measured_orientation', 'measured_conditioning', 'command_orientation',
+                 'command_conditioning', '_ratio', '_factors')
+
+    def __init__(self, measured_orientation: int, measured_conditioning: float,
+                 command_orientation: int, command_conditioning: float,
+                 factors: tuple[Transmission, list[list[float]], list[list[float]]]) -> None:
+        """``factors``: the transmission, its Jacobian's rows J and A'⁻¹ (empty: singular)."""
+        self.measured_orientation = measured_orientation
+        self.measured_conditioning = measured_conditioning
+        self.command_orientation = command_orientation
+        self.command_conditioning = command_conditioning
+        self._ratio: tuple[tuple[float, ...], ...] | None = None
+        self._factors = factors
+
+    @property
+    def ratio(self) -> tuple[tuple[float, ...], ...]:
+        """Return M = ∂m/∂o (inf throughout where A' is exactly singular)."""
+        if self._ratio is None:
+            transmission, jacobian, inverse_matrix = self._factors
+            self._ratio = transmission.ratio_from(jacobian, inverse_matrix)
+        return self._ratio
 
 
 class Transmission:
@@ -329,10 +347,15 @@ class Transmission:
         jacobian = self._jacobian(local)
         inverse_matrix, det, conditioning = self._command.factor(jacobian)
         _, measured_det, measured_conditioning = self._measured.factor(jacobian)
-        ratio = (self._ratio(jacobian, inverse_matrix) if inverse_matrix
-                 else tuple((math.inf,) * len(self.outputs) for _ in self.actuators))
-        return Linearization(ratio, _sign(measured_det), measured_conditioning, _sign(det),
-                             conditioning)
+        return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
+                             conditioning, (self, jacobian, inverse_matrix))
+
+    def ratio_from(self, jacobian: Sequence[Sequence[float]],
+                   inverse_matrix: Sequence[Sequence[float]]) -> tuple[tuple[float, ...], ...]:
+        """Return M from ``linearize``'s J and A'⁻¹ (inf throughout without an inverse)."""
+        if not inverse_matrix:
+            return tuple((math.inf,) * len(self.outputs) for _ in self.actuators)
+        return self._ratio(jacobian, inverse_matrix)
 
 
 class _Square:
