@@ -57,7 +57,9 @@ import math
 import operator
 from typing import NamedTuple
 
-from linkage_kinematics.loops.command_parts import command_part
+from linkage_kinematics.loops.closed_forms import LegPositions
+from linkage_kinematics.loops.command_parts import command_part, LegPart
+from linkage_kinematics.loops.equations import Evaluation
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.planar import Loop
 from linkage_kinematics.loops.structure import GroupKind
@@ -181,6 +183,27 @@ class CommandGroup:
         self._columns = [index[name] for name in transmission.columns]
         self._turns = [index[name] for name in transmission.solved
                        if tree.coordinates[index[name]].kind is MotionKind.TURN]
+        # the turns the lean path writes (the others keep their last value exactly)
+        lean = {column for part, _ in self._parts for column in part.lean_columns}
+        self._lean_turns = [column for column in self._turns if column in lean]
+        # A group of crank–rod–ball legs alone (the ankle): on the lean path the legs' cranks
+        # are solved on the transmission's equations, posed once for both legs and for the
+        # linearization, rather than on each leg's own equations and the transmission's again
+        # (a third of the ankle's cost per point). Per leg: its part, its closed form there
+        # and its crank's place among the transmission's columns. The legs are separate
+        # command groups, so that one leg's crank moves nothing the other's closed form reads.
+        self._legs: list[tuple[LegPart, LegPositions, int]] | None = None
+        self._cranks: frozenset[int] = frozenset()  # the legs' places among the columns
+        equations = transmission.equations
+        closures = [name for name, _, _ in equations.closure_rows]
+        if len(equations.row_kinds) == len(closures) and all(  # every rod reduced
+                isinstance(part, LegPart) and part.group.closures[0].name in closures
+                for part, _ in self._parts):
+            self._legs = []
+            for part, _ in self._parts:
+                bound = part.bound(equations, closures.index(part.group.closures[0].name))
+                self._legs.append((part, bound, bound.column))
+            self._cranks = frozenset(place for _, _, place in self._legs)
         # whole-tree values → a tuple of some of them, in one C call per point
         self._get_actuators = getter(self._actuators)
         self._get_passive = getter(self._passive)
@@ -293,6 +316,25 @@ class CommandGroup:
                     found_accelerations[column] = value
         return rates, found_accelerations
 
+    def _solve_legs(self, values: list[float], before: Sequence[float]) -> Evaluation:
+        """
+        Solve every leg's crank into ``values`` (whole tree) on the transmission's equations.
+
+        Each crank within π of its last value (``before``), as ``_step`` keeps every turn;
+        return the equations posed there, for ``linearize``.
+        """
+        columns = self._columns
+        equations = self.transmission.equations
+        local = list(self._get_columns(values))
+        evaluation = equations.evaluate(local)
+        for part, bound, place in self._legs:
+            part.crank_at(bound, local, evaluation)
+            column = columns[place]
+            last = before[column]
+            local[place] = values[column] = last + math.remainder(local[place] - last,
+                                                                  2.0 * math.pi)
+        return equations.evaluate(local, evaluation, self._cranks)
+
     def _step(self, positions: Sequence[float], velocities: Sequence[float],
               accelerations: Sequence[float], efforts: Sequence[float],
               full: bool) -> GroupCommand:
@@ -301,9 +343,14 @@ class CommandGroup:
         values = list(last.values)
         for column, value in zip(self._outputs, positions):
             values[column] = value
+        evaluation = None
         try:
-            rates, found_accelerations = self._solve_parts(values, velocities, accelerations,
-                                                           full)
+            if self._legs is not None and not full:
+                evaluation = self._solve_legs(values, last.values)
+                rates, found_accelerations = [], []
+            else:
+                rates, found_accelerations = self._solve_parts(values, velocities,
+                                                               accelerations, full)
         except SampleRefused as refusal:
             reason = (CommandRefusal.UNREACHABLE if refusal.reason is Refusal.UNREACHABLE
                       else CommandRefusal.SINGULAR)
@@ -312,10 +359,10 @@ class CommandGroup:
                       else f'group {self.name}, {refusal}')
             raise CommandRefused(reason, detail) from None
         remainder, turn = math.remainder, 2.0 * math.pi
-        for column in self._turns:
+        for column in self._turns if full else self._lean_turns:
             before = last.values[column]
             values[column] = before + remainder(values[column] - before, turn)
-        linearization = self.transmission.linearize(self._get_columns(values))
+        linearization = self.transmission.linearize(self._get_columns(values), evaluation)
         orientations = self._check_singular(linearization, last.orientations)
         # M (``linearization.ratio``) is worked out only where velocities or efforts need it
         actuators = JointPoint(

@@ -11,14 +11,16 @@ One command group (a group the output joints known make) solved by the method it
   branch at the zero pose the one whose motion reaches the assembled pose;
 * ``LegPart``: one crank–rod–ball leg's inverse (``closed_forms.LegPositions``); where only the
   actuators are asked, the crank alone from the closed form, without the rod's angles and the
-  solver's rates (a quarter of the cost: the forward-command relay's case);
+  solver's rates (a quarter of the cost: the forward-command relay's case); ``bound`` and
+  ``crank_at`` do that on a transmission's equations, where a group's legs are posed at once;
 * ``NewtonPart``: ``newton.GroupSolver`` (Newton, or the five-bar's closed form it dispatches
   to).
 
 Each part: ``positions`` (the lean path: at least the joints the transmission's equations
-need, written into a whole-tree value list), ``solve`` (every solved joint's position and
-velocity), ``accelerations`` (``newton.Derivatives``, after ``solve``), ``restore`` (back to a
-pose). Each raises ``newton.SampleRefused``. Pure: no ROS.
+need, written into a whole-tree value list; ``lean_columns`` are those it writes),
+``solve`` (every solved joint's position and velocity), ``accelerations``
+(``newton.Derivatives``, after ``solve``), ``restore`` (back to a pose). Each raises
+``newton.SampleRefused``. Pure: no ROS.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import math
 from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
 from linkage_kinematics.loops.assembly import Assembly
 from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
-from linkage_kinematics.loops.equations import LoopEquations
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations
 from linkage_kinematics.loops.newton import (
     Derivatives,
     GroupSolver,
@@ -62,6 +64,7 @@ class NewtonPart:
         self.solver = GroupSolver(tree, group, structure, assembly, kind)
         self.kind = kind
         self.columns = [tree.index[name] for name in structure.solved]
+        self.lean_columns = self.columns
         self.known = [tree.index[name] for name in structure.known]
 
     def positions(self, values: list[float]) -> None:
@@ -94,10 +97,12 @@ class LegPart(NewtonPart):
                  values: Sequence[float]) -> None:
         super().__init__(tree, group, structure, values, GroupKind.LEG_INVERSE)
         rods = reducible_rods(tree, group, structure)
+        self.tree, self.group, self.rod = tree, group, next(iter(rods.values()))
         self.equations = LoopEquations(tree, group.closures, rods)
-        self.closed_form = LegPositions(tree, group, self.equations, next(iter(rods.values())))
+        self.closed_form = LegPositions(tree, group, self.equations, self.rod)
         self.closed_form.reset([values[i] for i in self.equations.coordinates])
         self.crank = self.equations.coordinates[self.closed_form.column]
+        self.lean_columns = [self.crank]
         # the solver's pose is not the last one after a lean step: put it there before solving
         self.behind = False
 
@@ -109,6 +114,24 @@ class LegPart(NewtonPart):
         except OutOfReach as error:
             raise SampleRefused(self.solver.name, Refusal.UNREACHABLE, str(error)) from None
         values[self.crank] = local[self.closed_form.column]
+        self.behind = True
+
+    def bound(self, equations: LoopEquations, closure: int) -> LegPositions:
+        """
+        Return the leg's closed form on other ``equations``, its branch, for ``crank_at``.
+
+        ``equations`` hold the leg's closure as number ``closure``, its rod reduced.
+        """
+        found = LegPositions(self.tree, self.group, equations, self.rod, closure)
+        found.branch = self.closed_form.branch
+        return found
+
+    def crank_at(self, bound: LegPositions, local: list[float], evaluation: Evaluation) -> None:
+        """Set the crank in ``local`` (``bound``'s equations' values, posed as ``evaluation``)."""
+        try:
+            bound.move_at(local, evaluation, bound.branch)
+        except OutOfReach as error:
+            raise SampleRefused(self.solver.name, Refusal.UNREACHABLE, str(error)) from None
         self.behind = True
 
     def solve(self, values: list[float],
@@ -129,6 +152,7 @@ class PlanarPart:
         self.names = structure.solved
         self.known_names = structure.known
         self.columns = [tree.index[name] for name in structure.solved]
+        self.lean_columns = self.columns
         self.known = [tree.index[name] for name in structure.known]
         robot = RobotLoops('', frozenset(name for loop in loops for name in loop.names),
                            tuple(loops), (), closures=group.closures, tree=tree)

@@ -53,7 +53,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.loops.equations import LoopEquations, RowKind
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
 from linkage_kinematics.loops.structure import (
@@ -297,8 +297,11 @@ class Transmission:
         sources = (known, solved)
         return [sources[source][place] for source, place in self._sources]
 
-    def _jacobian(self, local: Sequence[float]) -> list[list[float]]:
-        jacobian = self.equations.jacobian(self.equations.evaluate(local))
+    def _jacobian(self, local: Sequence[float],
+                  evaluation: Evaluation | None = None) -> list[list[float]]:
+        if evaluation is None:
+            evaluation = self.equations.evaluate(local)
+        jacobian = self.equations.jacobian(evaluation)
         return [jacobian[row] for row in self._rows]
 
     def _ratio(self, jacobian: Sequence[Sequence[float]],
@@ -342,9 +345,14 @@ class Transmission:
         return mechanical_advantage(self.actuators, self.outputs,
                                     self.ratio(self.local(known, solved)))
 
-    def linearize(self, local: Sequence[float]) -> Linearization:
-        """Return both directions' systems at a pose (over ``columns``), singular or not."""
-        jacobian = self._jacobian(local)
+    def linearize(self, local: Sequence[float],
+                  evaluation: Evaluation | None = None) -> Linearization:
+        """
+        Return both directions' systems at a pose (over ``columns``), singular or not.
+
+        ``evaluation``: ``equations``' at ``local``, where the caller posed them already.
+        """
+        jacobian = self._jacobian(local, evaluation)
         inverse_matrix, det, conditioning = self._command.factor(jacobian)
         _, measured_det, measured_conditioning = self._measured.factor(jacobian)
         return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
