@@ -266,6 +266,9 @@ class Transmission:
                               for i in columns]
         local = [float(values[i]) for i in columns]
         self._rows = independent_rows(scaled_jacobian(equations, tree, local, size))
+        # asked of the equations' Jacobian, which then skips the closures' rows left out (a
+        # planar pin's two angle rows: the knee's are a third of its linearization)
+        self._row_set = frozenset(self._rows)
         row_scale = [1.0 / size if equations.row_kinds[row] is RowKind.LENGTH else 1.0
                      for row in self._rows]
         # U: every column but the actuators; U': every column but the outputs
@@ -301,7 +304,7 @@ class Transmission:
                   evaluation: Evaluation | None = None) -> list[list[float]]:
         if evaluation is None:
             evaluation = self.equations.evaluate(local)
-        jacobian = self.equations.jacobian(evaluation)
+        jacobian = self.equations.jacobian(evaluation, rows=self._row_set)
         return [jacobian[row] for row in self._rows]
 
     def _ratio(self, jacobian: Sequence[Sequence[float]],
