@@ -57,8 +57,7 @@ import math
 import operator
 from typing import NamedTuple
 
-from linkage_kinematics.loops.closed_forms import LegPositions
-from linkage_kinematics.loops.command_parts import command_part, LegPart
+from linkage_kinematics.loops.command_parts import command_part, TransmissionLegs
 from linkage_kinematics.loops.equations import Evaluation
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.planar import Loop
@@ -186,24 +185,9 @@ class CommandGroup:
         # the turns the lean path writes (the others keep their last value exactly)
         lean = {column for part, _ in self._parts for column in part.lean_columns}
         self._lean_turns = [column for column in self._turns if column in lean]
-        # A group of crank–rod–ball legs alone (the ankle): on the lean path the legs' cranks
-        # are solved on the transmission's equations, posed once for both legs and for the
-        # linearization, rather than on each leg's own equations and the transmission's again
-        # (a third of the ankle's cost per point). Per leg: its part, its closed form there
-        # and its crank's place among the transmission's columns. The legs are separate
-        # command groups, so that one leg's crank moves nothing the other's closed form reads.
-        self._legs: list[tuple[LegPart, LegPositions, int]] | None = None
-        self._cranks: frozenset[int] = frozenset()  # the legs' places among the columns
-        equations = transmission.equations
-        closures = [name for name, _, _ in equations.closure_rows]
-        if len(equations.row_kinds) == len(closures) and all(  # every rod reduced
-                isinstance(part, LegPart) and part.group.closures[0].name in closures
-                for part, _ in self._parts):
-            self._legs = []
-            for part, _ in self._parts:
-                bound = part.bound(equations, closures.index(part.group.closures[0].name))
-                self._legs.append((part, bound, bound.column))
-            self._cranks = frozenset(place for _, _, place in self._legs)
+        # the ankle's lean path (command_parts.TransmissionLegs), None for other groups
+        self._legs = TransmissionLegs.of([part for part, _ in self._parts],
+                                         transmission.equations, self._columns)
         # whole-tree values → a tuple of some of them, in one C call per point
         self._get_actuators = getter(self._actuators)
         self._get_passive = getter(self._passive)
@@ -316,25 +300,6 @@ class CommandGroup:
                     found_accelerations[column] = value
         return rates, found_accelerations
 
-    def _solve_legs(self, values: list[float], before: Sequence[float]) -> Evaluation:
-        """
-        Solve every leg's crank into ``values`` (whole tree) on the transmission's equations.
-
-        Each crank within π of its last value (``before``), as ``_step`` keeps every turn;
-        return the equations posed there, for ``linearize``.
-        """
-        columns = self._columns
-        equations = self.transmission.equations
-        local = list(self._get_columns(values))
-        evaluation = equations.evaluate(local)
-        for part, bound, place in self._legs:
-            part.crank_at(bound, local, evaluation)
-            column = columns[place]
-            last = before[column]
-            local[place] = values[column] = last + math.remainder(local[place] - last,
-                                                                  2.0 * math.pi)
-        return equations.evaluate(local, evaluation, self._cranks)
-
     def _step(self, positions: Sequence[float], velocities: Sequence[float],
               accelerations: Sequence[float], efforts: Sequence[float],
               full: bool) -> GroupCommand:
@@ -343,10 +308,10 @@ class CommandGroup:
         values = list(last.values)
         for column, value in zip(self._outputs, positions):
             values[column] = value
-        evaluation = None
+        evaluation: Evaluation | None = None  # the legs give the equations posed
         try:
             if self._legs is not None and not full:
-                evaluation = self._solve_legs(values, last.values)
+                evaluation = self._legs.positions(values, last.values)
                 rates, found_accelerations = [], []
             else:
                 rates, found_accelerations = self._solve_parts(values, velocities,

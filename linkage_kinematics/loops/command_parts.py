@@ -11,8 +11,8 @@ One command group (a group the output joints known make) solved by the method it
   branch at the zero pose the one whose motion reaches the assembled pose;
 * ``LegPart``: one crank–rod–ball leg's inverse (``closed_forms.LegPositions``); where only the
   actuators are asked, the crank alone from the closed form, without the rod's angles and the
-  solver's rates (a quarter of the cost: the forward-command relay's case); ``bound`` and
-  ``crank_at`` do that on a transmission's equations, where a group's legs are posed at once;
+  solver's rates (a quarter of the cost: the forward-command relay's case);
+  ``TransmissionLegs`` does that for a group of legs alone on its transmission's equations;
 * ``NewtonPart``: ``newton.GroupSolver`` (Newton, or the five-bar's closed form it dispatches
   to).
 
@@ -116,24 +116,6 @@ class LegPart(NewtonPart):
         values[self.crank] = local[self.closed_form.column]
         self.behind = True
 
-    def bound(self, equations: LoopEquations, closure: int) -> LegPositions:
-        """
-        Return the leg's closed form on other ``equations``, its branch, for ``crank_at``.
-
-        ``equations`` hold the leg's closure as number ``closure``, its rod reduced.
-        """
-        found = LegPositions(self.tree, self.group, equations, self.rod, closure)
-        found.branch = self.closed_form.branch
-        return found
-
-    def crank_at(self, bound: LegPositions, local: list[float], evaluation: Evaluation) -> None:
-        """Set the crank in ``local`` (``bound``'s equations' values, posed as ``evaluation``)."""
-        try:
-            bound.move_at(local, evaluation, bound.branch)
-        except OutOfReach as error:
-            raise SampleRefused(self.solver.name, Refusal.UNREACHABLE, str(error)) from None
-        self.behind = True
-
     def solve(self, values: list[float],
               rates: Sequence[float]) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """Return the solved joints' positions and velocities (``rates``: the known ones')."""
@@ -213,6 +195,66 @@ class PlanarPart:
         """Start the closed form afresh and take it to the known joints' ``values``."""
         self.solver = LoopSolver(self.plan)
         self._closed(values, [0.0] * len(self.known))
+
+
+class TransmissionLegs:
+    """
+    A group of crank–rod–ball legs alone (the ankle), its cranks on its transmission's equations.
+
+    On the lean path the transmission's equations are posed once at the commanded outputs; each
+    leg's closed form reads its ball and centre there, and only the cranks' frames are posed
+    again, for the linearization: rather than each leg's own equations and the transmission's
+    again (a third of the ankle's cost per point). The legs are separate command groups, so one
+    leg's crank moves nothing another's closed form reads. ``of`` returns None for any other
+    group.
+    """
+
+    def __init__(self, legs: Sequence[LegPart], equations: LoopEquations,
+                 columns: Sequence[int]) -> None:
+        self.equations = equations
+        self.columns = columns  # the equations' coordinates (tree columns)
+        closures = [name for name, _, _ in equations.closure_rows]
+        self.legs: list[tuple[LegPart, LegPositions]] = []
+        for leg in legs:
+            # the leg's closed form, its rod reduced, as closure number so-and-so there
+            found = LegPositions(leg.tree, leg.group, equations, leg.rod,
+                                 closures.index(leg.group.closures[0].name))
+            found.branch = leg.closed_form.branch
+            self.legs.append((leg, found))
+        self.cranks = frozenset(found.column for _, found in self.legs)
+
+    @staticmethod
+    def of(parts: Sequence[NewtonPart | PlanarPart],
+           equations: LoopEquations, columns: Sequence[int]) -> TransmissionLegs | None:
+        """Return the legs of a group whose ``parts`` are legs alone, every rod reduced."""
+        closures = [name for name, _, _ in equations.closure_rows]
+        if len(equations.row_kinds) != len(closures) or not all(
+                isinstance(part, LegPart) and part.group.closures[0].name in closures
+                for part in parts):
+            return None
+        return TransmissionLegs(parts, equations, columns)
+
+    def positions(self, values: list[float], before: Sequence[float]) -> Evaluation:
+        """
+        Write every crank for the outputs in ``values`` (whole tree) into it.
+
+        Each crank within π of its last value (``before``), as the group keeps every turn;
+        return the equations posed there, for ``Transmission.linearize``.
+        """
+        columns = self.columns
+        local = [values[c] for c in columns]
+        evaluation = self.equations.evaluate(local)
+        for leg, found in self.legs:
+            try:
+                found.move_at(local, evaluation, found.branch)
+            except OutOfReach as error:
+                raise SampleRefused(leg.solver.name, Refusal.UNREACHABLE, str(error)) from None
+            leg.behind = True
+            place = found.column
+            last = before[columns[place]]
+            local[place] = values[columns[place]] = last + math.remainder(local[place] - last,
+                                                                          2.0 * math.pi)
+        return self.equations.evaluate(local, evaluation, self.cranks)
 
 
 def _turned(value: float, near: float, tree: KinematicTree, column: int) -> float:
