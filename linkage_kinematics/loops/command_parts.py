@@ -216,7 +216,7 @@ class TransmissionLegs:
         closures = [name for name, _, _ in equations.closure_rows]
         self.legs: list[tuple[LegPart, LegPositions]] = []
         for leg in legs:
-            # the leg's closed form, its rod reduced, as closure number so-and-so there
+            # the leg's closed form on these equations, which number its closure otherwise
             found = LegPositions(leg.tree, leg.group, equations, leg.rod,
                                  closures.index(leg.group.closures[0].name))
             found.branch = leg.closed_form.branch
@@ -238,8 +238,8 @@ class TransmissionLegs:
         """
         Write every crank for the outputs in ``values`` (whole tree) into it.
 
-        Each crank within π of its last value (``before``), as the group keeps every turn;
-        return the equations posed there, for ``Transmission.linearize``.
+        Each turning crank within π of its last value (``before``), as the group keeps every
+        turn; return the equations posed there, for ``Transmission.linearize``.
         """
         columns = self.columns
         local = [values[c] for c in columns]
@@ -251,9 +251,10 @@ class TransmissionLegs:
                 raise SampleRefused(leg.solver.name, Refusal.UNREACHABLE, str(error)) from None
             leg.behind = True
             place = found.column
-            last = before[columns[place]]
-            local[place] = values[columns[place]] = last + math.remainder(local[place] - last,
-                                                                          2.0 * math.pi)
+            if found.turn:  # a turning crank within π of its last value; a sliding one as is
+                last = before[columns[place]]
+                local[place] = last + math.remainder(local[place] - last, 2.0 * math.pi)
+            values[columns[place]] = local[place]
         return self.equations.evaluate(local, evaluation, self.cranks)
 
 
