@@ -139,6 +139,29 @@ SECTIONS = {
         "≤ 1.0× the relay's, p99 latency ≤ the relay's + 0.5 ms, no sample lost by the node.",
         ('The per-sample path in this process, part by part',
          'Side by side with the relay')),
+    'relay': Section(
+        "Commands relayed to a biped's actuators: issue 30's cost goal",
+        '`linkage_command_node` on `urdf/biped.urdf` (per leg three hip joints passed through, '
+        "the knee through a planar four-bar to its motor, the ankle's pitch and roll to its two "
+        'motors: four closure groups, twelve joints in and out; `bench/relay_bench.py`). First '
+        "the relay's work per message in this process, bytes in to bytes out as the node does "
+        "it: one forward command (`Float64MultiArray`, positions) beside the hand relay's "
+        "callback with rclpy's deserialisation and serialisation (the yardstick's own Python "
+        'work), and a 1000-point '
+        '`JointTrajectory` at 100 Hz converted whole, with positions, velocities and '
+        'accelerations as a planner sends them and with positions alone; the goal is the whole '
+        "trajectory in less time than its first point's time_from_start, 10 ms, that is under "
+        '10 µs per point. Then `bench/commander.py` publishes forward commands at 1 kHz, and '
+        '`linkage_command_node` (logging on) and `bench/minimal_command_relay.py` (what a lab '
+        "writes by hand: each value times a constant ratio, rclpy's default executor) relay "
+        'them at once; `bench/command_listener.py`, a third process, receives both outputs. CPU '
+        "over the listener's window (the node's with its bag writer's), latency from just before "
+        'the commander published to the listener, a command lost when it was published within '
+        "the window and its answer never arrived; the node's own bag says which commands it "
+        "received and relayed. The goals: CPU ≤ 1.0× the hand relay's, p99 latency ≤ the hand "
+        "relay's + 0.5 ms, no command lost. Figures measured while other work ran on the "
+        "machine are provisional: the run's line gives the load.",
+        ("The relay's work per message in this process", 'Side by side with the hand relay')),
     'parallel': Section(
         'Parallel robots closed per sample, against the peers',
         "The package's general closure (`loops.newton.GroupSolver`, built as the node builds "
@@ -286,7 +309,7 @@ rewrites only its part. Earlier figures are in this file's git history
 ./dev bench                        # every section, written here
 ./dev bench --quick                # about 7 minutes: fewer angles, shorter runs
 ./dev bench --only cost            # one section (kinematics, drive, tf, node, cost, measured,
-                                   # loops, biped, parallel, memory)
+                                   # loops, biped, relay, parallel, memory)
 ./dev bench --only node --no-document   # print only
 ```
 

@@ -11,9 +11,11 @@ hand-written rclpy publisher, its highest sustained rate with the default placem
 cpu_affinity:=0), measured and loops (the measured source, and a URDF's four loops closed, each
 against a minimal hand-written rclpy relay), biped (issue 29's cost goal: a biped's two knees
 and two parallel ankles closed at 1 kHz beside the relay, and its per-sample path part by part),
-parallel (parallel robots' loops closed per sample by the package and beside it by
-toolbox-parallel-robots, Pinocchio with Gauss–Newton and PlaCo, which it installs on first use:
-bench/peers.py) and memory (the node's resident memory over a long 1 kHz run). Every section
+relay (issue 30's cost goal: linkage_command_node relaying the biped's forward commands at
+1 kHz beside a hand-written relay, and a 1000-point trajectory converted), parallel (parallel
+robots' loops closed per sample by the package and beside it by toolbox-parallel-robots,
+Pinocchio with Gauss–Newton and PlaCo, which it installs on first use: bench/peers.py) and
+memory (the node's resident memory over a long 1 kHz run). Every section
 prints markdown tables, which the run writes into docs/benchmarks.md (bench/document.py); the
 kinematics section also draws docs/benchmark_speed_error.png, the cost section
 docs/benchmark_cost_rate.png, the parallel section docs/benchmark_parallel.png.
@@ -38,11 +40,11 @@ import document  # noqa: E402
 from ros_domains import domain_lease  # noqa: E402
 from timing import machine_description  # noqa: E402
 
-SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'biped',
+SECTIONS = ('kinematics', 'drive', 'tf', 'node', 'cost', 'measured', 'loops', 'biped', 'relay',
             'parallel', 'memory')
 # The sections that run nodes, each kind of run on its own ROS_DOMAIN_ID: the first one and the
 # four after it (node_bench's DOMAIN_* offsets).
-ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'biped', 'memory')
+ROS_SECTIONS = ('node', 'cost', 'measured', 'loops', 'biped', 'relay', 'memory')
 DOMAIN_COUNT = 5
 
 
@@ -71,8 +73,8 @@ def main(argv: list[str] | None = None) -> int:
                              '(default 10, 0.5 with --quick)')
     parser.add_argument('--ros-domain', type=int, default=None,
                         help='first of the five ROS_DOMAIN_IDs the node, cost, measured, loops, '
-                             'biped and memory sections use (default: five in a row that no '
-                             'test or other benchmark run holds)')
+                             'biped, relay and memory sections use (default: five in a row that '
+                             'no test or other benchmark run holds)')
     arguments = parser.parse_args(argv)
     if arguments.repetitions is not None and arguments.repetitions < 1:
         parser.error('--repetitions must be at least 1')
@@ -165,6 +167,11 @@ def run_sections(arguments: argparse.Namespace, sections: Collection[str],
 
             parts = (biped_bench.path_run(arguments.quick, repetitions),
                      biped_bench.run(arguments.quick, ros_domain))
+        elif key == 'relay':
+            import relay_bench
+
+            parts = (relay_bench.path_run(arguments.quick, repetitions),
+                     relay_bench.run(arguments.quick, ros_domain))
         elif key == 'parallel':
             import parallel_bench
             import peers

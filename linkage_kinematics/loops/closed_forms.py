@@ -263,10 +263,15 @@ def _wrap(angle: float) -> float:
 
 
 class LegPositions:
-    """One crank–rod–ball leg's inverse: the crank's value in closed form (closed_forms)."""
+    """
+    One crank–rod–ball leg's inverse: the crank's value in closed form (closed_forms).
+
+    ``equations`` hold the leg's closure, its rod reduced to a distance, as closure number
+    ``closure``: the leg's own, or a group's with both legs (a transmission's, posed once).
+    """
 
     def __init__(self, tree: KinematicTree, group: ClosureGroup, equations: LoopEquations,
-                 rod) -> None:
+                 rod, closure: int = 0) -> None:
         loop = tree.loop(group.closures[0])
         crank = next(step for step in loop.paths[rod.side] if step not in rod.steps
                      and tree.steps[step].coordinate not in group.known)
@@ -276,14 +281,18 @@ class LegPositions:
         self.multiplier = tree.steps[crank].multiplier
         self.turn = tree.steps[crank].kind is MotionKind.TURN
         self.length = rod.length
+        self.closure = closure
         self.branch = 1
 
     def move(self, values: list[float], branch: int) -> None:
         """Set the crank's value in ``values`` to the solution on ``branch``."""
-        evaluation = self.equations.evaluate(values)
+        self.move_at(values, self.equations.evaluate(values), branch)
+
+    def move_at(self, values: list[float], evaluation: Evaluation, branch: int) -> None:
+        """As ``move``, from ``evaluation``: the equations' at ``values``."""
         axis, origin = self.equations.step_axis(self.step, evaluation)
-        ball = self.equations.point(0, 0, evaluation)
-        center = self.equations.point(0, 1, evaluation)
+        ball = self.equations.point(self.closure, 0, evaluation)
+        center = self.equations.point(self.closure, 1, evaluation)
         if self.turn:
             change = crank_to_sphere(origin, axis, center, ball, self.length, branch)
         else:

@@ -51,12 +51,14 @@ ROS.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 import enum
 import math
+import operator
+from typing import NamedTuple
 
-from linkage_kinematics.loops.command_parts import command_part
+from linkage_kinematics.loops.command_parts import command_part, TransmissionLegs
+from linkage_kinematics.loops.equations import Evaluation
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.planar import Loop
 from linkage_kinematics.loops.structure import GroupKind
@@ -89,12 +91,13 @@ class CommandRefused(ValueError):
         self.detail = detail
 
 
-@dataclass(frozen=True)
-class JointPoint:
+class JointPoint(NamedTuple):
     """
     Values of named joints, as a trajectory point holds them (SI units; rad or m).
 
     Each array is empty or has one value per joint (``JointTrajectoryPoint``'s convention).
+    The per-point values (this, ``GroupCommand``, ``CommandState``) are named tuples: made at
+    every point of a 1 kHz relay, where a frozen dataclass's ``__init__`` costs twice as much.
     """
 
     positions: tuple[float, ...] = ()
@@ -103,8 +106,7 @@ class JointPoint:
     efforts: tuple[float, ...] = ()
 
 
-@dataclass(frozen=True)
-class GroupCommand:
+class GroupCommand(NamedTuple):
     """
     One group's converted point.
 
@@ -120,8 +122,7 @@ class GroupCommand:
     linearization: Linearization
 
 
-@dataclass(frozen=True)
-class CommandState:
+class CommandState(NamedTuple):
     """
     A command group's last accepted point.
 
@@ -133,11 +134,24 @@ class CommandState:
     orientations: tuple[int, int]
 
 
-@dataclass(frozen=True)
-class _Limits:
+class _Limits(NamedTuple):
     position: tuple[float, float] | None
     velocity: float | None
     effort: float | None
+
+
+# the passive joints of the lean path: none
+_NONE = JointPoint()
+
+
+def getter(indices: Sequence[int]) -> Callable[[Sequence[float]], tuple[float, ...]]:
+    """Return a function of a list that gives a tuple of its items at ``indices``, in order."""
+    if len(indices) > 1:
+        return operator.itemgetter(*indices)
+    if indices:
+        index = indices[0]
+        return lambda values: (values[index],)
+    return lambda values: ()
 
 
 class CommandGroup:
@@ -168,6 +182,17 @@ class CommandGroup:
         self._columns = [index[name] for name in transmission.columns]
         self._turns = [index[name] for name in transmission.solved
                        if tree.coordinates[index[name]].kind is MotionKind.TURN]
+        # the turns the lean path writes (the others keep their last value exactly)
+        lean = {column for part, _ in self._parts for column in part.lean_columns}
+        self._lean_turns = [column for column in self._turns if column in lean]
+        # the ankle's lean path (command_parts.TransmissionLegs), None for other groups
+        self._legs = TransmissionLegs.of([part for part, _ in self._parts],
+                                         transmission.equations, self._columns)
+        # whole-tree values → a tuple of some of them, in one C call per point
+        self._get_actuators = getter(self._actuators)
+        self._get_passive = getter(self._passive)
+        self._get_columns = getter(self._columns)
+        self._get_outputs = getter(self._outputs)
         joints = {joint.name: joint for joint in tree.joint_above.values()}
         self._steps = []  # per output: its scale, and whether it goes the short way
         for name in self.outputs:
@@ -226,14 +251,17 @@ class CommandGroup:
         (accelerations need velocities, and take the full path, as ``passive`` does).
         CommandRefused whole, the state as it was.
         """
+        isfinite = math.isfinite
         for what, array in (('position', positions), ('velocity', velocities),
                             ('acceleration', accelerations), ('effort', efforts)):
+            if all(map(isfinite, array)):
+                continue
             for name, value in zip(self.outputs, array):
-                if not math.isfinite(value):
+                if not isfinite(value):
                     raise CommandRefused(CommandRefusal.NOT_FINITE,
                                          f'output joint {name!r}: {what} {value!r}')
         before = self._state
-        last = [before.values[c] for c in self._outputs]
+        last = self._get_outputs(before.values)
         changes = [math.remainder(target - value, 2.0 * math.pi) if wraps else target - value
                    for (_, wraps), target, value in zip(self._steps, positions, last)]
         steps = max(1, math.ceil(max(abs(c) / scale for c, (scale, _)
@@ -252,12 +280,12 @@ class CommandGroup:
                      accelerations: Sequence[float], full: bool
                      ) -> tuple[list[float], list[float]]:
         """Solve every part into ``values``; return the rates and accelerations (full path)."""
-        rates = [0.0] * len(values)
-        found_accelerations = [0.0] * len(values)
         if not full:
             for part, _ in self._parts:
                 part.positions(values)
-            return rates, found_accelerations
+            return [], []
+        rates = [0.0] * len(values)
+        found_accelerations = [0.0] * len(values)
         given = velocities or (0.0,) * len(self.outputs)
         for column, rate in zip(self._outputs, given):
             rates[column] = rate
@@ -280,9 +308,14 @@ class CommandGroup:
         values = list(last.values)
         for column, value in zip(self._outputs, positions):
             values[column] = value
+        evaluation: Evaluation | None = None  # the legs give the equations posed
         try:
-            rates, found_accelerations = self._solve_parts(values, velocities, accelerations,
-                                                           full)
+            if self._legs is not None and not full:
+                evaluation = self._legs.positions(values, last.values)
+                rates, found_accelerations = [], []
+            else:
+                rates, found_accelerations = self._solve_parts(values, velocities,
+                                                               accelerations, full)
         except SampleRefused as refusal:
             reason = (CommandRefusal.UNREACHABLE if refusal.reason is Refusal.UNREACHABLE
                       else CommandRefusal.SINGULAR)
@@ -290,23 +323,24 @@ class CommandGroup:
             detail = (str(refusal) if refusal.group == self.name
                       else f'group {self.name}, {refusal}')
             raise CommandRefused(reason, detail) from None
-        for column in self._turns:
+        remainder, turn = math.remainder, 2.0 * math.pi
+        for column in self._turns if full else self._lean_turns:
             before = last.values[column]
-            values[column] = before + math.remainder(values[column] - before, 2.0 * math.pi)
-        linearization = self.transmission.linearize([values[i] for i in self._columns])
+            values[column] = before + remainder(values[column] - before, turn)
+        linearization = self.transmission.linearize(self._get_columns(values), evaluation)
         orientations = self._check_singular(linearization, last.orientations)
-        ratio = linearization.ratio
+        # M (``linearization.ratio``) is worked out only where velocities or efforts need it
         actuators = JointPoint(
-            tuple(values[c] for c in self._actuators),
-            tuple(math.fsum([m * v for m, v in zip(row, velocities)]) for row in ratio)
-            if velocities else (),
-            tuple(found_accelerations[c] for c in self._actuators) if accelerations else (),
-            self._efforts(ratio, efforts) if efforts else ())
+            self._get_actuators(values),
+            tuple(math.fsum([m * v for m, v in zip(row, velocities)])
+                  for row in linearization.ratio) if velocities else (),
+            self._get_actuators(found_accelerations) if accelerations else (),
+            self._efforts(linearization.ratio, efforts) if efforts else ())
         self._check_limits(actuators)
         passive_joints = JointPoint(
-            tuple(values[c] for c in self._passive) if full else (),
-            tuple(rates[c] for c in self._passive) if full and velocities else (),
-            tuple(found_accelerations[c] for c in self._passive) if accelerations else ())
+            self._get_passive(values), self._get_passive(rates) if velocities else (),
+            self._get_passive(found_accelerations) if accelerations else ()
+        ) if full else _NONE
         self._state = CommandState(tuple(values), orientations)
         return GroupCommand(actuators, passive_joints, linearization)
 

@@ -12,13 +12,15 @@ One command group (a group the output joints known make) solved by the method it
 * ``LegPart``: one crank–rod–ball leg's inverse (``closed_forms.LegPositions``); where only the
   actuators are asked, the crank alone from the closed form, without the rod's angles and the
   solver's rates (a quarter of the cost: the forward-command relay's case);
+  ``TransmissionLegs`` does that for a group of legs alone on its transmission's equations;
 * ``NewtonPart``: ``newton.GroupSolver`` (Newton, or the five-bar's closed form it dispatches
   to).
 
 Each part: ``positions`` (the lean path: at least the joints the transmission's equations
-need, written into a whole-tree value list), ``solve`` (every solved joint's position and
-velocity), ``accelerations`` (``newton.Derivatives``, after ``solve``), ``restore`` (back to a
-pose). Each raises ``newton.SampleRefused``. Pure: no ROS.
+need, written into a whole-tree value list; ``lean_columns`` are those it writes),
+``solve`` (every solved joint's position and velocity), ``accelerations``
+(``newton.Derivatives``, after ``solve``), ``restore`` (back to a pose). Each raises
+``newton.SampleRefused``. Pure: no ROS.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ import math
 from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
 from linkage_kinematics.loops.assembly import Assembly
 from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
-from linkage_kinematics.loops.equations import LoopEquations
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations
 from linkage_kinematics.loops.newton import (
     Derivatives,
     GroupSolver,
@@ -62,6 +64,7 @@ class NewtonPart:
         self.solver = GroupSolver(tree, group, structure, assembly, kind)
         self.kind = kind
         self.columns = [tree.index[name] for name in structure.solved]
+        self.lean_columns = self.columns
         self.known = [tree.index[name] for name in structure.known]
 
     def positions(self, values: list[float]) -> None:
@@ -94,10 +97,12 @@ class LegPart(NewtonPart):
                  values: Sequence[float]) -> None:
         super().__init__(tree, group, structure, values, GroupKind.LEG_INVERSE)
         rods = reducible_rods(tree, group, structure)
+        self.tree, self.group, self.rod = tree, group, next(iter(rods.values()))
         self.equations = LoopEquations(tree, group.closures, rods)
-        self.closed_form = LegPositions(tree, group, self.equations, next(iter(rods.values())))
+        self.closed_form = LegPositions(tree, group, self.equations, self.rod)
         self.closed_form.reset([values[i] for i in self.equations.coordinates])
         self.crank = self.equations.coordinates[self.closed_form.column]
+        self.lean_columns = [self.crank]
         # the solver's pose is not the last one after a lean step: put it there before solving
         self.behind = False
 
@@ -129,6 +134,7 @@ class PlanarPart:
         self.names = structure.solved
         self.known_names = structure.known
         self.columns = [tree.index[name] for name in structure.solved]
+        self.lean_columns = self.columns
         self.known = [tree.index[name] for name in structure.known]
         robot = RobotLoops('', frozenset(name for loop in loops for name in loop.names),
                            tuple(loops), (), closures=group.closures, tree=tree)
@@ -189,6 +195,67 @@ class PlanarPart:
         """Start the closed form afresh and take it to the known joints' ``values``."""
         self.solver = LoopSolver(self.plan)
         self._closed(values, [0.0] * len(self.known))
+
+
+class TransmissionLegs:
+    """
+    A group of crank–rod–ball legs alone (the ankle), its cranks on its transmission's equations.
+
+    On the lean path the transmission's equations are posed once at the commanded outputs; each
+    leg's closed form reads its ball and centre there, and only the cranks' frames are posed
+    again, for the linearization: rather than each leg's own equations and the transmission's
+    again (a third of the ankle's cost per point). The legs are separate command groups, so one
+    leg's crank moves nothing another's closed form reads. ``of`` returns None for any other
+    group.
+    """
+
+    def __init__(self, legs: Sequence[LegPart], equations: LoopEquations,
+                 columns: Sequence[int]) -> None:
+        self.equations = equations
+        self.columns = columns  # the equations' coordinates (tree columns)
+        closures = [name for name, _, _ in equations.closure_rows]
+        self.legs: list[tuple[LegPart, LegPositions]] = []
+        for leg in legs:
+            # the leg's closed form on these equations, which number its closure otherwise
+            found = LegPositions(leg.tree, leg.group, equations, leg.rod,
+                                 closures.index(leg.group.closures[0].name))
+            found.branch = leg.closed_form.branch
+            self.legs.append((leg, found))
+        self.cranks = frozenset(found.column for _, found in self.legs)
+
+    @staticmethod
+    def of(parts: Sequence[NewtonPart | PlanarPart],
+           equations: LoopEquations, columns: Sequence[int]) -> TransmissionLegs | None:
+        """Return the legs of a group whose ``parts`` are legs alone, every rod reduced."""
+        closures = [name for name, _, _ in equations.closure_rows]
+        if len(equations.row_kinds) != len(closures) or not all(
+                isinstance(part, LegPart) and part.group.closures[0].name in closures
+                for part in parts):
+            return None
+        return TransmissionLegs(parts, equations, columns)
+
+    def positions(self, values: list[float], before: Sequence[float]) -> Evaluation:
+        """
+        Write every crank for the outputs in ``values`` (whole tree) into it.
+
+        Each turning crank within π of its last value (``before``), as the group keeps every
+        turn; return the equations posed there, for ``Transmission.linearize``.
+        """
+        columns = self.columns
+        local = [values[c] for c in columns]
+        evaluation = self.equations.evaluate(local)
+        for leg, found in self.legs:
+            try:
+                found.move_at(local, evaluation, found.branch)
+            except OutOfReach as error:
+                raise SampleRefused(leg.solver.name, Refusal.UNREACHABLE, str(error)) from None
+            leg.behind = True
+            place = found.column
+            if found.turn:  # a turning crank within π of its last value; a sliding one as is
+                last = before[columns[place]]
+                local[place] = last + math.remainder(local[place] - last, 2.0 * math.pi)
+            values[columns[place]] = local[place]
+        return self.equations.evaluate(local, evaluation, self.cranks)
 
 
 def _turned(value: float, near: float, tree: KinematicTree, column: int) -> float:

@@ -24,7 +24,7 @@ same measured joints, branches and assemblies), each group's output joints from
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
 import math
 
@@ -33,6 +33,7 @@ from linkage_kinematics.loops.command import (
     CommandRefusal,
     CommandRefused,
     CommandState,
+    getter,
     JointPoint,
 )
 from linkage_kinematics.loops.plan import RobotLoops
@@ -122,8 +123,9 @@ class RobotCommand:
         return _Layout(
             tuple(passing) + tuple(name for number in commanded
                                    for name in self.groups[number].actuators),
-            commanded, tuple(names.index(name) for name in passing),
-            tuple(tuple(names.index(name) for name in self.groups[number].outputs)
+            commanded, getter([names.index(name) for name in passing]) if passing else None,
+            tuple((self.groups[number],
+                   getter([names.index(name) for name in self.groups[number].outputs]))
                   for number in commanded))
 
     def _check(self, names: Sequence[str], point: JointPoint, commanded: bool) -> None:
@@ -189,26 +191,33 @@ class RobotCommand:
                 self.groups[number].restore(state)
 
     def _point(self, layout: _Layout, point: JointPoint) -> JointPoint:
-        arrays = (point.positions, point.velocities, point.accelerations, point.efforts)
-        out = [[array[place] for place in layout.passing] if array else [] for array in arrays]
-        for number, places in zip(layout.commanded, layout.outputs):
-            found = self.groups[number].solve(
-                *([array[place] for place in places] if array else [] for array in arrays)
-            ).actuators
-            for target, array in zip(out, (found.positions, found.velocities,
-                                           found.accelerations, found.efforts)):
+        """Return the point converted: the joints passed through, then each group's."""
+        passing = layout.passing
+        if passing is None and len(layout.groups) == 1:  # one group's actuators alone
+            group, outputs = layout.groups[0]
+            return group.solve(*[outputs(array) if array else () for array in point]).actuators
+        out = [list(passing(array)) if passing is not None and array else []
+               for array in point]
+        for group, outputs in layout.groups:
+            found = group.solve(*[outputs(array) if array else () for array in point]).actuators
+            for target, array in zip(out, found):
                 target += array
-        return JointPoint(*(tuple(array) for array in out))
+        return JointPoint(*map(tuple, out))
 
 
 @dataclass(frozen=True)
 class _Layout:
-    """How a point for one list of names is converted: out names, groups, places."""
+    """
+    How a point for one list of names is converted.
+
+    Its out names, the groups commanded (their numbers) and, prepared once, the getter of the
+    joints passed through (None: none) and per group its output joints' getter.
+    """
 
     names: tuple[str, ...]
     commanded: tuple[int, ...]
-    passing: tuple[int, ...]
-    outputs: tuple[tuple[int, ...], ...]
+    passing: Callable[[Sequence[float]], tuple[float, ...]] | None
+    groups: tuple[tuple[CommandGroup, Callable[[Sequence[float]], tuple[float, ...]]], ...]
 
 
 def _at_point(refusal: CommandRefused, number: int) -> CommandRefused:

@@ -53,7 +53,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.loops.equations import LoopEquations, RowKind
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
 from linkage_kinematics.loops.structure import (
@@ -196,21 +196,39 @@ def _command_structures(tree: KinematicTree, group: ClosureGroup, structure: Gro
     return structures, None
 
 
-@dataclass(frozen=True)
 class Linearization:
     """
     The transmission at one pose, both directions' square systems (module docstring).
 
     ``ratio``: M = ∂m/∂o (actuators × outputs); the orientation (sign of det) and conditioning
     κ₁ of A (actuators known) and A' (outputs known). An orientation that changes between two
-    poses of a motion means it crossed a singular configuration of that direction.
+    poses of a motion means it crossed a singular configuration of that direction. One is made
+    per commanded point, where a relay of positions needs the orientations and conditionings
+    alone: M is worked out when first asked for, from the Jacobian and A'⁻¹ kept (a slotted
+    class rather than a frozen dataclass for that; ``Transmission.linearize`` makes them).
     """
 
-    ratio: tuple[tuple[float, ...], ...]
-    measured_orientation: int
-    measured_conditioning: float
-    command_orientation: int
-    command_conditioning: float
+    __slots__ = ('measured_orientation', 'measured_conditioning', 'command_orientation',
+                 'command_conditioning', '_ratio', '_factors')
+
+    def __init__(self, measured_orientation: int, measured_conditioning: float,
+                 command_orientation: int, command_conditioning: float,
+                 factors: tuple[Transmission, list[list[float]], list[list[float]]]) -> None:
+        """``factors``: the transmission, its Jacobian's rows J and A'⁻¹ (empty: singular)."""
+        self.measured_orientation = measured_orientation
+        self.measured_conditioning = measured_conditioning
+        self.command_orientation = command_orientation
+        self.command_conditioning = command_conditioning
+        self._ratio: tuple[tuple[float, ...], ...] | None = None
+        self._factors = factors
+
+    @property
+    def ratio(self) -> tuple[tuple[float, ...], ...]:
+        """Return M = ∂m/∂o (inf throughout where A' is exactly singular)."""
+        if self._ratio is None:
+            transmission, jacobian, inverse_matrix = self._factors
+            self._ratio = transmission.ratio_from(jacobian, inverse_matrix)
+        return self._ratio
 
 
 class Transmission:
@@ -248,6 +266,9 @@ class Transmission:
                               for i in columns]
         local = [float(values[i]) for i in columns]
         self._rows = independent_rows(scaled_jacobian(equations, tree, local, size))
+        # asked of the equations' Jacobian, which then skips the closures' rows left out (a
+        # planar pin's two angle rows: the knee's are a third of its linearization)
+        self._row_set = frozenset(self._rows)
         row_scale = [1.0 / size if equations.row_kinds[row] is RowKind.LENGTH else 1.0
                      for row in self._rows]
         # U: every column but the actuators; U': every column but the outputs
@@ -279,8 +300,11 @@ class Transmission:
         sources = (known, solved)
         return [sources[source][place] for source, place in self._sources]
 
-    def _jacobian(self, local: Sequence[float]) -> list[list[float]]:
-        jacobian = self.equations.jacobian(self.equations.evaluate(local))
+    def _jacobian(self, local: Sequence[float],
+                  evaluation: Evaluation | None = None) -> list[list[float]]:
+        if evaluation is None:
+            evaluation = self.equations.evaluate(local)
+        jacobian = self.equations.jacobian(evaluation, rows=self._row_set)
         return [jacobian[row] for row in self._rows]
 
     def _ratio(self, jacobian: Sequence[Sequence[float]],
@@ -324,15 +348,25 @@ class Transmission:
         return mechanical_advantage(self.actuators, self.outputs,
                                     self.ratio(self.local(known, solved)))
 
-    def linearize(self, local: Sequence[float]) -> Linearization:
-        """Return both directions' systems at a pose (over ``columns``), singular or not."""
-        jacobian = self._jacobian(local)
+    def linearize(self, local: Sequence[float],
+                  evaluation: Evaluation | None = None) -> Linearization:
+        """
+        Return both directions' systems at a pose (over ``columns``), singular or not.
+
+        ``evaluation``: ``equations``' at ``local``, where the caller posed them already.
+        """
+        jacobian = self._jacobian(local, evaluation)
         inverse_matrix, det, conditioning = self._command.factor(jacobian)
         _, measured_det, measured_conditioning = self._measured.factor(jacobian)
-        ratio = (self._ratio(jacobian, inverse_matrix) if inverse_matrix
-                 else tuple((math.inf,) * len(self.outputs) for _ in self.actuators))
-        return Linearization(ratio, _sign(measured_det), measured_conditioning, _sign(det),
-                             conditioning)
+        return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
+                             conditioning, (self, jacobian, inverse_matrix))
+
+    def ratio_from(self, jacobian: Sequence[Sequence[float]],
+                   inverse_matrix: Sequence[Sequence[float]]) -> tuple[tuple[float, ...], ...]:
+        """Return M from ``linearize``'s J and A'⁻¹ (inf throughout without an inverse)."""
+        if not inverse_matrix:
+            return tuple((math.inf,) * len(self.outputs) for _ in self.actuators)
+        return self._ratio(jacobian, inverse_matrix)
 
 
 class _Square:

@@ -28,10 +28,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 import enum
-import operator
 
 from linkage_kinematics.loops.closures import ClosureError
-from linkage_kinematics.loops.command import CommandRefusal, CommandRefused, JointPoint
+from linkage_kinematics.loops.command import CommandRefusal, CommandRefused, getter, JointPoint
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
 from linkage_kinematics.loops.newton import PlanError
@@ -167,10 +166,8 @@ class Relay:
                              f'commands.joints {list(settings.joints)} are relayed to, '
                              f'{list(converted)}, in some order')
         self.controller_joints = tuple(order)
-        places = [converted.index(name) for name in order]
         # the converted arrays in controller order: one C call per message
-        self._order = (operator.itemgetter(*places) if len(places) > 1
-                       else lambda values: (values[places[0]],))
+        self._order = getter([converted.index(name) for name in order])
         self._field = {CommandInterface.POSITION: 0, CommandInterface.VELOCITY: 1,
                        CommandInterface.EFFORT: 3}[self.interface]
 
