@@ -29,7 +29,6 @@ import sys
 import time
 from typing import Any
 
-from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from linkage_kinematics.bag.errors import LogFolderError
 from linkage_kinematics.bag.metadata import BagMetadata, package_version
@@ -385,11 +384,9 @@ class CommandNode(Node):
             problem=self._problem or self.recording_error,
             log_file=None if recorder is None else str(recorder.bag_path),
             log_size=None if recorder is None else recorder.size_bytes))
-        message = messages.diagnostic_array(
-            Time(sec=now // 1_000_000_000, nanosec=now % 1_000_000_000),
-            f'{self.get_name()}: {status.task}', status.hardware_id, bytes([status.level]),
-            status.message, status.values)
-        data = encode_cdr(message)
+        data = messages.diagnostics_message(now, [messages.DiagnosticEntry(
+            f'{self.get_name()}: {status.task}', status.hardware_id, status.level,
+            status.message, status.values)])
         self._diagnostics.publish(data)
         self._log(self._diagnostics.topic_name, data, now)
 
