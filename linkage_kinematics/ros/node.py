@@ -13,8 +13,8 @@ values into a frozen RunConfiguration; one source gives the states, with this no
 node's timer), ``measured_source`` over ``measured.MeasuredFollower`` (the driver joint of each
 ``measured_joint_states`` message) or ``loop_source`` over ``loops.follower`` (every loop of a
 lab's URDF); ``run.diagnostics`` says what ``/diagnostics`` reports;
-``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
-documented in docs/parameters.md.
+``ros.outputs`` publishes and logs; ``ros.process`` runs its process. Topics, parameters,
+diagnostics and exit statuses are documented in docs/parameters.md.
 """
 
 from __future__ import annotations
