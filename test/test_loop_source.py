@@ -56,7 +56,7 @@ class FakeOutputs:
         self.joint_states: list[tuple] = []
         self.logged: list[str] = []
 
-    def publish_joint_states(self, names, positions, velocities, stamp_ns) -> None:
+    def publish_joint_states(self, names, positions, velocities, stamp_ns, efforts=()) -> None:
         self.joint_states.append((stamp_ns, dict(zip(names, positions))))
 
     def record_input(self, data: bytes, stamp_ns: int) -> None:
