@@ -2,18 +2,22 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-cpu_affinity, and when the node's threads wake.
+cpu_affinity, and when the nodes' threads wake.
 
 The node's threads on one CPU and its bag writer process on the others, set at start-up and at run
-time; a CPU the process may not use is refused naming the parameter. The node's timed waits end
-on time (1 ns of timer slack, which the executor's timer thread inherits).
+time; a CPU the process may not use is refused naming the parameter. The timed waits of both
+nodes' processes (ros.process) end on time (1 ns of timer slack, which the executor's timer
+thread inherits); the command relay's threads on its CPU too.
 """
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
+import signal
+import sys
 
+from diagnostic_msgs.msg import DiagnosticArray
 from node_process import (
     bag_writer_pid,
     get_parameter,
@@ -26,6 +30,7 @@ from node_process import (
 import pytest
 from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
+from test_command_relay import KNEE
 
 AVAILABLE = os.sched_getaffinity(0)
 NODE_CPU = max(AVAILABLE)
@@ -82,6 +87,34 @@ def test_the_node_runs_on_its_cpu_and_its_bag_writer_on_the_others(
     assert (f'running on CPU {NODE_CPU}; the bag writer on CPU '
             f"{', '.join(map(str, sorted(WRITER_CPUS)))}") in log
     assert 'no longer pinned to a CPU' in log
+
+
+def test_the_command_relay_runs_on_its_cpu_and_wakes_on_time(
+    nodes: NodeProcesses, tmp_path: Path
+) -> None:
+    output = tmp_path / 'relay.log'
+    with ros_context(nodes.domain_id) as context:
+        listener = Listener('cpu_affinity_tester', context)
+        listener.subscribe('/diagnostics', DiagnosticArray)
+        process = nodes.start(
+            {'robot_description': KNEE, 'loops.measured_joints': ['knee_motor'],
+             'loops.output_joints': ['knee_output'], 'cpu_affinity': NODE_CPU,
+             'log.folder': str(tmp_path / 'bags')},
+            output, executable=[sys.executable, '-m', 'linkage_kinematics.ros.command_node'])
+        try:
+            # its status comes from the diagnostics timer, on the executor's threads
+            assert listener.spin_until(lambda: len(listener.received['/diagnostics']) > 1), (
+                output.read_text())
+            node_threads = thread_cpus(process.pid)
+            assert len(node_threads) > 3
+            assert all(cpus == {NODE_CPU} for cpus in node_threads.values()), node_threads
+            assert all(cpus == WRITER_CPUS
+                       for cpus in thread_cpus(bag_writer_pid(process.pid)).values())
+            assert Path(f'/proc/{process.pid}/timerslack_ns').read_text() == '1\n'
+        finally:
+            listener.destroy()
+        assert nodes.interrupt(process, signal.SIGTERM) == 0, output.read_text()
+    assert 'bag finalized: ' in output.read_text()
 
 
 @pytest.mark.parametrize('value', [NOT_AVAILABLE, -2, 1024, '0'])

@@ -6,7 +6,7 @@ linkage_node's executor: what it must deliver besides ticks.
 
 On wall time the node spins on rclpy.experimental.EventsExecutor, which dispatches timers from
 C++ and takes timers and services from the node when they change; on simulated time on rclpy's
-default executor (see node.main). Other modules cover parameter changes (test_node_parameters.py,
+default executor (see ros.process). Other modules cover parameter changes (test_node_parameters.py,
 test_node_bad_input.py), signals (test_recording_faults.py) and long runs on simulated time
 (test_node_long_runs.py). This one covers what they do not: the list/describe parameter
 services, and the state timer re-created at run time (rate_hz changed), on wall time and on

@@ -5,7 +5,8 @@
 linkage_node's parameters.
 
 Validation as pure functions, rejection at start-up (one line naming the parameter, exit status 2,
-nothing written) and at run time over the parameter services.
+nothing written) and at run time over the parameter services; the lists of names of both nodes
+string arrays, also when empty.
 """
 
 from __future__ import annotations
@@ -19,7 +20,9 @@ from linkage_kinematics.kinematics.geometry import FourBar, preset
 from linkage_kinematics.kinematics.solver import solve
 from linkage_kinematics.model.joints import Link
 from linkage_kinematics.model.urdf import urdf_text
+from linkage_kinematics.ros.command_node import CommandNode
 from linkage_kinematics.ros.messages import DISK_ID, PIN_A_ID
+from linkage_kinematics.ros.node import LinkageNode
 from linkage_kinematics.ros.parameters import parameter_descriptor
 from linkage_kinematics.run.configuration import build_configuration
 from linkage_kinematics.run.parameter_specs import (
@@ -27,6 +30,7 @@ from linkage_kinematics.run.parameter_specs import (
     PARAMETER_NAMES,
     parameter_specs,
     ParameterSpec,
+    RELAY_SPECS,
     unknown_parameters,
 )
 from linkage_kinematics.run.parameter_values import ConfigurationError, parameter_value
@@ -40,6 +44,7 @@ from node_process import (
     set_parameter,
 )
 import pytest
+import rclpy
 from rclpy.parameter import Parameter, parameter_value_to_python
 from rclpy.parameter_client import AsyncParameterClient
 from sensor_msgs.msg import JointState
@@ -467,3 +472,33 @@ def test_parameters_keep_their_types_show_their_ranges_and_unchanged_sets_change
             listener.destroy()
     log = output.read_text()
     assert log.count('parameters changed') == 1 and 'parameters changed: rate_hz=60.0' in log
+
+
+@pytest.mark.parametrize(('node_type', 'specs', 'given'), [
+    (LinkageNode, {spec.name: spec for spec in parameter_specs('paper')}, {}),
+    # the relay needs its output joints: the description, from the topic, comes later
+    (CommandNode, RELAY_SPECS, {'loops.output_joints': 'knee_output'})])
+def test_an_empty_list_of_names_is_an_empty_string_array(
+    domain_id, tmp_path, node_type, specs, given,
+):
+    """By default (rclpy: a byte array), from `-p NAME:=[]` and from a file (rcl: no value)."""
+    lists = [name for name, spec in specs.items() if spec.kind is Kind.TEXTS and name not in given]
+    # `[]` as `ros2 param dump` writes it, for each node's first list
+    parameters = tmp_path / 'parameters.yaml'
+    parameters.write_text(f'/**:\n  ros__parameters:\n    {lists[0]}: []\n')
+    context = rclpy.Context()
+    rclpy.init(context=context, domain_id=domain_id, args=[
+        '--ros-args', '--params-file', str(parameters), '-p', f'{lists[1]}:=[]',
+        '-p', 'log.enabled:=false',
+        *(argument for name, value in given.items() for argument in ('-p', f'{name}:=[{value}]'))])
+    try:
+        node = node_type(context=context)
+        try:
+            for name in lists:
+                parameter = node.get_parameter(name)
+                assert (parameter.type_, parameter.value) == (Parameter.Type.STRING_ARRAY, []), (
+                    name)
+        finally:
+            node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)

@@ -183,8 +183,9 @@ def test_the_loop_parameters_are_validated_naming_them() -> None:
     with pytest.raises(ConfigurationError, match='^loops: robot_description .* needs source '
                                                  'measured, got source drive_law'):
         configuration(source='drive_law')
-    with pytest.raises(ConfigurationError, match='^loops.measured_joints: is used only with '
-                                                 'loops robot_description'):
+    with pytest.raises(ConfigurationError, match=r'^loops.measured_joints: is used only with '
+                                                 r'loops robot_description \(and source '
+                                                 r'measured\), got loops parameters$'):
         configuration(loops='parameters', **{'loops.measured_joints': ['a']})
 
 

@@ -23,8 +23,6 @@ command direction") and docs/parameters.md ("linkage_command_node") document it.
 from __future__ import annotations
 
 import json
-import re
-import signal
 import sys
 import time
 from typing import Any
@@ -51,6 +49,7 @@ from linkage_kinematics.ros.parameters import (
     keep_declared_types,
     parameter_values,
 )
+from linkage_kinematics.ros.process import run_node
 from linkage_kinematics.run.configuration import build_relay_configuration
 from linkage_kinematics.run.parameter_specs import (
     CommandInterface,
@@ -76,14 +75,9 @@ from linkage_kinematics.shared.command_cdr import (
     encode_joint_trajectory,
     TrajectoryPoint,
 )
-import rclpy
 from rclpy.duration import Duration
-from rclpy.executors import Executor, SingleThreadedExecutor
-from rclpy.experimental import EventsExecutor
-from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.signals import SignalHandlerOptions
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
@@ -111,6 +105,8 @@ class CommandNode(Node):
     given as a parameter that cannot be relayed (or a log that cannot be written), before
     anything is published.
     """
+
+    exit_code: ExitCode | None = None  # process.ProcessNode: only SIGINT or SIGTERM ends a relay
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(RELAY_NODE_NAME, **node_options)
@@ -393,53 +389,9 @@ class CommandNode(Node):
 # --- process ------------------------------------------------------------------------------
 
 
-def _report_start_up_failure(text: str) -> None:
-    """Say why the node cannot start: to its logger and plainly to stderr, one line."""
-    get_logger(RELAY_NODE_NAME).fatal(text)
-    print(f'{RELAY_NODE_NAME}: {text}', file=sys.stderr, flush=True)
-
-
 def main(args: list[str] | None = None) -> int:
     """Run the relay until SIGINT or SIGTERM; return the exit status (2: it could not start)."""
-    try:
-        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    except RuntimeError as error:  # rclpy's RCLError: ROS arguments rcl cannot use
-        _report_start_up_failure('cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
-        return ExitCode.CONFIGURATION
-    received: list[int] = []
-
-    def request_stop(signal_number: int, _frame: object) -> None:
-        received.append(signal_number)
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
-    try:
-        try:
-            node = CommandNode()
-        except ConfigurationError as error:
-            _report_start_up_failure(f'invalid parameter {error}')
-            return ExitCode.CONFIGURATION
-        except StartupError as error:
-            _report_start_up_failure(str(error))
-            return ExitCode.CONFIGURATION
-        # As linkage_node: the events executor dispatches from C++ (half the CPU at 1 kHz),
-        # rclpy's default one on simulated time; spin_once so that the signals are seen.
-        if node.get_parameter('use_sim_time').value:
-            executor: Executor = SingleThreadedExecutor()
-        else:
-            executor = EventsExecutor()
-        executor.add_node(node)
-        try:
-            while not received:
-                executor.spin_once(timeout_sec=0.1)
-        finally:
-            node.flush()
-            log_closed = node.close_log()
-            executor.remove_node(node)
-            node.destroy_node()
-        return ExitCode.OK if log_closed else ExitCode.FAILED
-    finally:
-        rclpy.try_shutdown()
+    return run_node(RELAY_NODE_NAME, CommandNode, args)
 
 
 if __name__ == '__main__':

@@ -13,33 +13,29 @@ values into a frozen RunConfiguration; one source gives the states, with this no
 node's timer), ``measured_source`` over ``measured.MeasuredFollower`` (the driver joint of each
 ``measured_joint_states`` message) or ``loop_source`` over ``loops.follower`` (every loop of a
 lab's URDF); ``run.diagnostics`` says what ``/diagnostics`` reports;
-``ros.outputs`` publishes and logs. Topics, parameters, diagnostics and exit statuses are
-documented in docs/parameters.md.
+``ros.outputs`` publishes and logs; ``ros.process`` runs its process. Topics, parameters,
+diagnostics and exit statuses are documented in docs/parameters.md.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
-import ctypes
-import gc
-import re
-import signal
 import sys
 from typing import Any
 
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import TreeValues
 from linkage_kinematics.ros.drive_law_source import DriveLawTimer
-from linkage_kinematics.ros.exit_codes import ExitCode
 from linkage_kinematics.ros.loop_source import robot_from_parameter, RobotLoopsSubscription
 from linkage_kinematics.ros.measured_source import MeasuredSubscription
-from linkage_kinematics.ros.outputs import NodeOutputs, StartupError
+from linkage_kinematics.ros.outputs import NodeOutputs
 from linkage_kinematics.ros.parameters import (
     add_ranges,
     declare_parameters,
     keep_declared_types,
     parameter_values,
 )
+from linkage_kinematics.ros.process import run_node
 from linkage_kinematics.ros.source import RunStatus, Source
 from linkage_kinematics.run.configuration import (
     build_configuration,
@@ -55,17 +51,11 @@ from linkage_kinematics.run.parameter_specs import PARAMETER_NAMES, unknown_para
 from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.run.placement import CpuPlacement
 from rcl_interfaces.msg import SetParametersResult
-import rclpy
-from rclpy.executors import Executor, SingleThreadedExecutor
-from rclpy.experimental import EventsExecutor
-from rclpy.logging import get_logger
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.signals import SignalHandlerOptions
 from std_srvs.srv import Trigger
 
 DIAGNOSTICS_PERIOD = 1.0  # s
-PR_SET_TIMERSLACK = 29  # prctl option (linux/prctl.h)
 
 
 # --- the node ------------------------------------------------------------------------------
@@ -220,6 +210,16 @@ class LinkageNode(RunStatus, Node):
         """Have the bag writer write out what it holds (before the run's last status)."""
         self.outputs.flush_log()
 
+    # the process (process.ProcessNode): the end of the run
+
+    def flush(self, timeout: float = 1.0) -> None:
+        """Give subscribers up to ``timeout`` s in all to acknowledge what was published."""
+        self.outputs.flush(timeout)
+
+    def close_log(self) -> bool:
+        """Finalize the bag (idempotent); False, with an error logged, if that failed."""
+        return self.outputs.close_log()
+
     def forget_state(self) -> None:
         """Make the next state a motion's first: its scene and status go out before it."""
         self._state = None
@@ -299,89 +299,9 @@ class LinkageNode(RunStatus, Node):
 # --- process ------------------------------------------------------------------------------
 
 
-def _report_start_up_failure(text: str) -> None:
-    """
-    Report the one line saying why the node cannot start.
-
-    To the node's logger (console, /rosout, log file) and plainly to stderr.
-    """
-    get_logger(NODE_NAME).fatal(text)
-    print(f'{NODE_NAME}: {text}', file=sys.stderr, flush=True)
-
-
-def _wake_on_time() -> None:
-    """
-    Ask Linux to end this thread's timed waits, and those of the threads it starts, on time.
-
-    A thread's timed waits may end as much as its timer slack late (50 us by default, which
-    lets the kernel batch wake-ups); the events executor's timer thread inherits the slack of
-    the thread that starts it, and each timer tick waits on it: at 5 kHz its ticks came 90 us
-    after their deadlines at the median, 40 us with the least slack Linux takes (1 ns). Elsewhere,
-    or where prctl refuses, the waits keep their slack.
-    """
-    if sys.platform.startswith('linux'):
-        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_TIMERSLACK, 1, 0, 0, 0)
-
-
 def main(args: list[str] | None = None) -> int:
     """Run the node until it finishes, or until SIGINT or SIGTERM; return the exit status."""
-    # rclpy's own SIGINT handler would shut the context down under our feet; ours lets the
-    # loop below finalize the log first.
-    try:
-        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    except RuntimeError as error:  # rclpy's RCLError: ROS arguments rcl cannot use
-        # rcl's text, without the source locations it appends ('…, at /src/rcl/x.c:352')
-        _report_start_up_failure(
-            'cannot start ROS: ' + re.sub(r', at \S+:\d+', '', str(error)))
-        return ExitCode.CONFIGURATION
-    received: list[int] = []
-
-    def request_stop(signal_number: int, _frame: object) -> None:
-        received.append(signal_number)
-
-    signal.signal(signal.SIGINT, request_stop)
-    signal.signal(signal.SIGTERM, request_stop)
-    try:
-        try:
-            node = LinkageNode()
-        except ConfigurationError as error:
-            _report_start_up_failure(f'invalid parameter {error}')
-            return ExitCode.CONFIGURATION
-        except StartupError as error:
-            _report_start_up_failure(str(error))
-            return ExitCode.CONFIGURATION
-        # What the imports and the start-up made (some 50 000 objects: rclpy, numpy, the URDF
-        # and message modules) lives as long as the process; once frozen, the collector no
-        # longer walks it. A full collection through it stopped the node for 20-30 ms at some
-        # moment after start, a hundred ticks at 5 kHz; now it walks only what came later.
-        gc.freeze()
-        _wake_on_time()  # before the executor starts its timer thread
-        # The events executor dispatches timers and services from C++ instead of rebuilding a
-        # wait set in Python for every callback: at 1 kHz it halves the process's CPU
-        # (docs/benchmarks.md, "The node against a minimal hand-written publisher"). On
-        # simulated time rclpy 7.1.6's events executor runs a timer created at run time (a
-        # rate_hz change) twice at its first /clock step, which also shifts its schedule by a
-        # period, so there the node keeps rclpy's default executor. The events executor's
-        # spin() busy-waits without running timers; spin_once returns after each callback, and
-        # at the latest after the timeout, so the signal handlers above run and the loop sees
-        # the end of the run.
-        if node.get_parameter('use_sim_time').value:
-            executor: Executor = SingleThreadedExecutor()
-        else:
-            executor = EventsExecutor()
-        executor.add_node(node)
-        try:
-            while node.exit_code is None and not received:
-                executor.spin_once(timeout_sec=0.1)
-        finally:
-            node.outputs.flush()
-            log_closed = node.outputs.close_log()
-            executor.remove_node(node)
-            node.destroy_node()
-        exit_code = ExitCode.OK if received else node.exit_code
-        return exit_code if log_closed else ExitCode.FAILED
-    finally:
-        rclpy.try_shutdown()
+    return run_node(NODE_NAME, LinkageNode, args)
 
 
 if __name__ == '__main__':

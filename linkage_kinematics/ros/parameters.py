@@ -16,6 +16,7 @@ from typing import Any
 
 from linkage_kinematics.kinematics.geometry import GeometryError
 from linkage_kinematics.run.parameter_specs import (
+    Kind,
     PARAMETER_NAMES,
     parameter_specs,
     ParameterSpec,
@@ -96,6 +97,18 @@ def _declare(node: Node, specs: Sequence[ParameterSpec]) -> None:
     ]
     if whole_numbers:
         node.set_parameters(keep_declared_types(whole_numbers))
+    # An empty list of names is a string array: rclpy declares the default [] as a byte array
+    # (so `ros2 param describe` and `get` said "byte array"), and rcl reads an empty YAML list
+    # (`-p commands.joints:=[]`, or `[]` in a parameters file, as `ros2 param dump` writes
+    # one) as no value at all, which the node refused.
+    untyped = (Parameter.Type.BYTE_ARRAY, Parameter.Type.NOT_SET)
+    empty_lists = [
+        Parameter(spec.name, Parameter.Type.STRING_ARRAY, []) for spec in specs
+        if spec.kind is Kind.TEXTS and node.get_parameter(spec.name).type_ in untyped
+        and not node.get_parameter(spec.name).value
+    ]
+    if empty_lists:
+        node.set_parameters(empty_lists)
 
 
 def add_ranges(node: Node, specs: tuple[ParameterSpec, ...]) -> None:

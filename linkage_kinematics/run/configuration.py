@@ -304,7 +304,8 @@ def _check_loops(checked: Mapping[str, Any]) -> None:
                  'loops.output_joints', 'robot_description_closures'):
         if checked[name]:
             raise ConfigurationError(
-                name, f"is used only with loops robot_description, got loops {checked['loops']}")
+                name, 'is used only with loops robot_description (and source measured), got '
+                f"loops {checked['loops']}")
 
 
 def _motion(

@@ -100,7 +100,6 @@ def _choice(spec: ParameterSpec, value: object) -> StrEnum:
 
 
 def _texts(spec: ParameterSpec, value: object) -> list[str]:
-    # rclpy declares an empty list default as an empty byte array: both are an empty list here.
     if not isinstance(value, (list, tuple)) or not all(isinstance(item, str) for item in value):
         raise ConfigurationError(
             spec.name, f'must be a list of strings, got {describe_value(value)}')
