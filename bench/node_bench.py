@@ -175,7 +175,7 @@ def _tick_parts(logging_node: Any, quiet_node: Any, bare_publisher: Any,
     from sensor_msgs.msg import JointState
 
     config = logging_node.config
-    recorder = logging_node.outputs.recorder
+    recorder = logging_node.outputs.log.recorder
     publishers = logging_node.outputs._publishers
     clock = logging_node.get_clock()
     elapsed = [i * 1e-3 for i in range(count)]
@@ -294,7 +294,7 @@ def logging_cost(logging_node: Any, ticks: int, repetitions: int) -> str:
     from mcap.writer import Writer
 
     logged = _logged_messages(logging_node)
-    recorder = logging_node.outputs.recorder
+    recorder = logging_node.outputs.log.recorder
     per_second = 1000  # ticks: the child flushes its chunk and reports the size once a second
 
     def record() -> int:
@@ -403,7 +403,7 @@ def tick_split(quick: bool, repetitions: int,
         finally:
             for node in nodes:
                 if isinstance(node, LinkageNode):
-                    node.outputs.close_log()
+                    node.outputs.log.close()
                 node.destroy_node()
             rclpy.try_shutdown()
     stop(listener)

@@ -28,8 +28,7 @@ SCRIPT = """
 import gc
 import sys
 from linkage_kinematics.ros.exit_codes import ExitCode
-from linkage_kinematics.ros.outputs import StartupError
-from linkage_kinematics.ros.process import run_node
+from linkage_kinematics.ros.process import run_node, StartupError
 from rclpy.node import Node
 
 ending, log_closes = sys.argv[1], sys.argv[2] == 'closes'

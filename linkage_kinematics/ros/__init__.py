@@ -10,7 +10,7 @@ the executor, the exit status), ``parameters`` (declaring both nodes' parameters
 them), ``source`` (what a source is, and what it may ask of the node), one module per source:
 ``drive_law_source`` (the drive law on a timer), ``measured_source`` (the four-bar's measured
 driver) and ``loop_source`` (a lab's URDF's loops), with ``measured_input`` (the input both
-measured sources share: ~/pause, ~/resume, ~/reset, freshness), ``outputs`` (the publishers and
-the bag, the topics and QoS both nodes share), ``messages`` (each message built one way) and
-``exit_codes`` (both nodes' exit statuses).
+measured sources share: ~/pause, ~/resume, ~/reset, freshness), ``outputs`` (linkage_node's
+publishers, the topics and QoS both nodes share), ``node_log`` (either node's bag),
+``messages`` (each message built one way) and ``exit_codes`` (both nodes' exit statuses).
 """

@@ -22,18 +22,16 @@ command direction") and docs/parameters.md ("linkage_command_node") document it.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from typing import Any
 
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.bag.errors import LogFolderError
-from linkage_kinematics.bag.metadata import BagMetadata, package_version
-from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.bag.recorder import Topic
 from linkage_kinematics.loops.command import CommandRefused, JointPoint
 from linkage_kinematics.ros import messages
 from linkage_kinematics.ros.exit_codes import ExitCode
+from linkage_kinematics.ros.node_log import NodeLog
 from linkage_kinematics.ros.outputs import (
     CLOSURES_TOPIC,
     DATA_QOS,
@@ -41,7 +39,6 @@ from linkage_kinematics.ros.outputs import (
     MEASURED_TOPIC,
     ROBOT_DESCRIPTION_QOS,
     ROBOT_DESCRIPTION_TOPIC,
-    StartupError,
 )
 from linkage_kinematics.ros.parameters import (
     add_ranges,
@@ -49,7 +46,7 @@ from linkage_kinematics.ros.parameters import (
     keep_declared_types,
     parameter_values,
 )
-from linkage_kinematics.ros.process import run_node
+from linkage_kinematics.ros.process import run_node, StartupError
 from linkage_kinematics.run.configuration import build_relay_configuration
 from linkage_kinematics.run.parameter_specs import (
     CommandInterface,
@@ -57,7 +54,6 @@ from linkage_kinematics.run.parameter_specs import (
     RELAY_SPECS,
     unknown_parameters,
 )
-from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.run.placement import CpuPlacement
 from linkage_kinematics.run.relay import (
     MessageKind,
@@ -97,6 +93,24 @@ DIAGNOSTICS_PERIOD = 1.0  # s
 REFUSAL_STATUS_NS = 100_000_000  # a refusal's status at once, at most this often
 
 
+def _logged_topics(node: CommandNode) -> list[Topic]:
+    """Return every topic ``node`` reads or writes (what its bag holds)."""
+    topics = node.topics
+    return [
+        (topics['trajectory in'], JointTrajectory, COMMAND_INPUT_QOS, None),
+        (topics['commands in'], Float64MultiArray, COMMAND_INPUT_QOS, None),
+        *([(topics['measured'], JointState, MEASURED_QOS, None)] if node.measures_pose
+          else []),
+        (topics['trajectory out'], JointTrajectory, COMMAND_OUTPUT_QOS, None),
+        (topics['commands out'], Float64MultiArray, COMMAND_OUTPUT_QOS, None),
+        # the latest status starts every file of a split bag
+        (topics['diagnostics'], DiagnosticArray, DATA_QOS, True),
+        (topics['description'], String, ROBOT_DESCRIPTION_QOS, None),
+        *([(topics['closures'], String, ROBOT_DESCRIPTION_QOS, None)]
+          if node.config.loops.robot_description_closures else []),
+    ]
+
+
 class CommandNode(Node):
     """
     The command relay (module docstring; docs/following_loops.md, "The command direction").
@@ -134,7 +148,7 @@ class CommandNode(Node):
         self._record = RelayRecord()
         self._problem: str | None = None
         self._status_ns = 0
-        self._measured = config.commands.interface is not CommandInterface.POSITION
+        self.measures_pose = config.commands.interface is not CommandInterface.POSITION
         self._joint_states = JointStateDecoder()
         self._array_encoder: FixedShapeEncoder | None = None
         resolve = self.resolve_topic_name
@@ -143,7 +157,7 @@ class CommandNode(Node):
             'trajectory out': resolve(TRAJECTORY_OUTPUT),
             'commands out': resolve(COMMANDS_OUTPUT), 'measured': resolve(MEASURED_TOPIC),
             'description': resolve(ROBOT_DESCRIPTION_TOPIC),
-            'closures': resolve(CLOSURES_TOPIC)}
+            'closures': resolve(CLOSURES_TOPIC), 'diagnostics': resolve('/diagnostics')}
         self._description_from = ('parameter robot_description' if relay is not None
                                   else f'topic {self.topics["description"]}')
         self._trajectory_out = self.create_publisher(JointTrajectory, TRAJECTORY_OUTPUT,
@@ -151,10 +165,8 @@ class CommandNode(Node):
         self._commands_out = self.create_publisher(Float64MultiArray, COMMANDS_OUTPUT,
                                                    COMMAND_OUTPUT_QOS)
         self._diagnostics = self.create_publisher(DiagnosticArray, '/diagnostics', DATA_QOS)
-        self.recorder = self._open_recorder() if config.logging.enabled else None
-        self.recording_error: str | None = None
-        if self.recorder is not None:
-            self.get_logger().info(f'recording to {self.recorder.bag_path}')
+        self.log = NodeLog(self, config.logging, _logged_topics(self), self.parameter_values(),
+                           self._placement.bag_writer_cpus)
         if relay is None:
             self.create_subscription(String, ROBOT_DESCRIPTION_TOPIC, self._on_description,
                                      ROBOT_DESCRIPTION_QOS)
@@ -164,14 +176,14 @@ class CommandNode(Node):
                                  COMMAND_INPUT_QOS, raw=True)
         self.create_subscription(Float64MultiArray, COMMANDS_INPUT, self._on_commands,
                                  COMMAND_INPUT_QOS, raw=True)
-        if self._measured:
+        if self.measures_pose:
             self.create_subscription(JointState, MEASURED_TOPIC, self._on_measured,
                                      MEASURED_QOS, raw=True)
         self.get_logger().info(
             f'relaying {self.topics["trajectory in"]} to {self.topics["trajectory out"]} and '
             f'{self.topics["commands in"]} ({config.commands.interface.value} of '
             f'{", ".join(config.commands.joints)}) to {self.topics["commands out"]}'
-            + (f', at the pose measured on {self.topics["measured"]}' if self._measured
+            + (f', at the pose measured on {self.topics["measured"]}' if self.measures_pose
                else ''))
         self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
         self.publish_diagnostics()
@@ -186,57 +198,9 @@ class CommandNode(Node):
 
     # the log
 
-    def _open_recorder(self) -> Recorder:
-        """Return a recorder of every topic the relay reads or writes, before anything is."""
-        config, topics = self.config, self.topics
-        recorded = [
-            (topics['trajectory in'], JointTrajectory, COMMAND_INPUT_QOS, None),
-            (topics['commands in'], Float64MultiArray, COMMAND_INPUT_QOS, None),
-            *([(topics['measured'], JointState, MEASURED_QOS, None)] if self._measured
-              else []),
-            (topics['trajectory out'], JointTrajectory, COMMAND_OUTPUT_QOS, None),
-            (topics['commands out'], Float64MultiArray, COMMAND_OUTPUT_QOS, None),
-            # the latest status starts every file of a split bag
-            (self._diagnostics.topic_name, DiagnosticArray, DATA_QOS, True),
-            (topics['description'], String, ROBOT_DESCRIPTION_QOS, None),
-            *([(topics['closures'], String, ROBOT_DESCRIPTION_QOS, None)]
-              if config.loops.robot_description_closures else []),
-        ]
-        metadata = {'parameters': json.dumps(self.parameter_values(), sort_keys=True),
-                    'package_version': package_version()}
-        try:
-            return Recorder(config.logging.folder, topics=recorded, metadata=metadata,
-                            cpus=self._placement.bag_writer_cpus,
-                            max_bag_size=config.logging.max_bag_size,
-                            max_bag_duration=config.logging.max_bag_duration)
-        except LogFolderError as error:
-            raise ConfigurationError('log.folder', str(error)) from None
-        except OSError as error:  # every BagError
-            raise StartupError(f'cannot record: {error}') from None
-
-    def _log(self, topic: str, data: bytes, now_ns: int) -> None:
-        if self.recorder is None or self.recording_error is not None:
-            return
-        try:
-            self.recorder.record(topic, data, now_ns)
-        except OSError as error:
-            # the commands keep flowing; diagnostics report the lost log
-            self.recording_error = f'recording stopped: {error}'
-            self.get_logger().error(self.recording_error)
-
     def close_log(self) -> bool:
         """Finalize the bag (idempotent); False, with an error logged, if that failed."""
-        if self.recorder is None:
-            return True
-        try:
-            self.recorder.close()
-        except OSError as error:
-            self.get_logger().error(f'could not finalize the log: {error}')
-            return False
-        bag = self.recorder.bag_path
-        self.get_logger().info(f'bag finalized: {bag}, {BagMetadata.read(bag).message_count} '
-                               'messages')
-        return True
+        return self.log.close()
 
     def flush(self, timeout: float = 1.0) -> None:
         """Give subscribers up to ``timeout`` s in all to acknowledge what was published."""
@@ -253,10 +217,10 @@ class CommandNode(Node):
         self._array_encoder = FixedShapeEncoder(
             Float64MultiArray(data=[0.0] * len(relay.controller_joints)), ['data'])
         now = self.now_ns()
-        self._log(self.topics['description'], encode_cdr(String(data=urdf)), now)
+        self.log.record(self.topics['description'], encode_cdr(String(data=urdf)), now)
         closures = self.config.loops.robot_description_closures
         if closures:
-            self._log(self.topics['closures'], encode_cdr(String(data=closures)), now)
+            self.log.record(self.topics['closures'], encode_cdr(String(data=closures)), now)
         logger = self.get_logger()
         logger.info(f'relaying commands in the output joints of robot {relay.robot_name!r} to '
                     f'its actuators {", ".join(relay.controller_joints)}')
@@ -291,7 +255,7 @@ class CommandNode(Node):
 
     def _on_commands(self, data: bytes) -> None:
         now = self.now_ns()
-        self._log(self.topics['commands in'], data, now)
+        self.log.record(self.topics['commands in'], data, now)
         relay = self._relay
         if relay is None:
             self._refuse(MessageKind.COMMANDS, RelayRefused(
@@ -312,11 +276,11 @@ class CommandNode(Node):
         out = self._array_encoder.encode(converted)
         self._record.relay(MessageKind.COMMANDS, 1, time.perf_counter_ns() - started)
         self._commands_out.publish(out)
-        self._log(self.topics['commands out'], out, now)
+        self.log.record(self.topics['commands out'], out, now)
 
     def _on_trajectory(self, data: bytes) -> None:
         now = self.now_ns()
-        self._log(self.topics['trajectory in'], data, now)
+        self.log.record(self.topics['trajectory in'], data, now)
         relay = self._relay
         if relay is None:
             self._refuse(MessageKind.TRAJECTORY, RelayRefused(
@@ -344,11 +308,11 @@ class CommandNode(Node):
              for point, before in zip(points, given)])
         self._record.relay(MessageKind.TRAJECTORY, len(points), time.perf_counter_ns() - started)
         self._trajectory_out.publish(out)
-        self._log(self.topics['trajectory out'], out, now)
+        self.log.record(self.topics['trajectory out'], out, now)
 
     def _on_measured(self, data: bytes) -> None:
         now = self.now_ns()
-        self._log(self.topics['measured'], data, now)
+        self.log.record(self.topics['measured'], data, now)
         relay = self._relay
         if relay is None or relay.pose is None:
             return
@@ -364,7 +328,7 @@ class CommandNode(Node):
         """Publish (and log) the relay's status now."""
         now = self.now_ns()
         self._status_ns = now
-        relay, recorder = self._relay, self.recorder
+        relay, recorder = self._relay, self.log.recorder
         config = self.config
         status = relay_status(self._record, RelayView(
             robot_name=None if relay is None else relay.robot_name,
@@ -377,13 +341,13 @@ class CommandNode(Node):
             outputs=(self.topics['trajectory out'], self.topics['commands out']),
             pose_age=(None if relay is None or relay.pose is None
                       else relay.pose.age(now)),
-            measures_pose=self._measured,
-            problem=self._problem or self.recording_error,
+            measures_pose=self.measures_pose,
+            problem=self._problem or self.log.error,
             log_file=None if recorder is None else str(recorder.bag_path),
             log_size=None if recorder is None else recorder.size_bytes))
         data = messages.statuses_message(now, self.get_name(), (status,))
         self._diagnostics.publish(data)
-        self._log(self._diagnostics.topic_name, data, now)
+        self.log.record(self._diagnostics.topic_name, data, now)
 
 
 # --- process ------------------------------------------------------------------------------

@@ -41,8 +41,8 @@ from linkage_kinematics.ros.outputs import (
     NodeOutputs,
     ROBOT_DESCRIPTION_QOS,
     ROBOT_DESCRIPTION_TOPIC,
-    StartupError,
 )
+from linkage_kinematics.ros.process import StartupError
 from linkage_kinematics.ros.source import SourceHost
 from linkage_kinematics.run.configuration import RunConfiguration
 from linkage_kinematics.run.control import ServiceAnswer

@@ -98,8 +98,6 @@ class LinkageNode(RunStatus, Node):
         robot = robot_from_parameter(config) if loops else None
         self.outputs = NodeOutputs(self, config, self.parameter_values(),
                                    self._placement.bag_writer_cpus)
-        if self.outputs.recorder is not None:
-            self.get_logger().info(f'recording to {self.outputs.recorder.bag_path}')
         self._marker_timer = self.create_timer(1.0 / config.outputs.display_rate_hz,
                                                self.publish_markers)
         self._diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.publish_diagnostics)
@@ -160,8 +158,8 @@ class LinkageNode(RunStatus, Node):
                                                    self.publish_markers)
         if new.logging.cpu_affinity != old.logging.cpu_affinity:
             self._place(new.logging.cpu_affinity)
-            if self.outputs.recorder is not None:
-                self.outputs.recorder.run_writer_on(
+            if self.outputs.log.recorder is not None:
+                self.outputs.log.recorder.run_writer_on(
                     self._placement.bag_writer_cpus or self._placement.available)
         if new.joints.lab != old.joints.lab:
             self.publish_description()  # the lab's names, axes and offsets
@@ -208,7 +206,7 @@ class LinkageNode(RunStatus, Node):
 
     def flush_log(self) -> None:
         """Have the bag writer write out what it holds (before the run's last status)."""
-        self.outputs.flush_log()
+        self.outputs.log.flush()
 
     # the process (process.ProcessNode): the end of the run
 
@@ -218,7 +216,7 @@ class LinkageNode(RunStatus, Node):
 
     def close_log(self) -> bool:
         """Finalize the bag (idempotent); False, with an error logged, if that failed."""
-        return self.outputs.close_log()
+        return self.outputs.log.close()
 
     def forget_state(self) -> None:
         """Make the next state a motion's first: its scene and status go out before it."""
@@ -278,7 +276,7 @@ class LinkageNode(RunStatus, Node):
             at_ns = self._state_ns if fresh else now_ns
         self._rate_meter.update(now_ns)
         self._status_schedule.sent(at_ns)
-        recorder = self.outputs.recorder
+        recorder = self.outputs.log.recorder
         inputs = StatusInputs(
             config=self.config,
             run_state=self.control.state,
@@ -288,7 +286,7 @@ class LinkageNode(RunStatus, Node):
             missed_deadlines=self._source.missed_deadlines,
             log_file=None if recorder is None else str(recorder.bag_path),
             log_size=None if recorder is None else recorder.size_bytes,
-            problem=event or self.problem or self.outputs.recording_error,
+            problem=event or self.problem or self.outputs.log.error,
             health=self._source.health,
             now_ns=now_ns,
         )

@@ -13,22 +13,19 @@ what the bag holds.
 from __future__ import annotations
 
 from collections.abc import Sequence
-import json
 import time
 from typing import Any, NamedTuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from linkage_kinematics.bag.errors import LogFolderError
-from linkage_kinematics.bag.metadata import BagMetadata, package_version
-from linkage_kinematics.bag.recorder import Recorder
+from linkage_kinematics.bag.recorder import Topic
 from linkage_kinematics.kinematics.geometry import FourBar
 from linkage_kinematics.kinematics.solver import LinkageState
 from linkage_kinematics.model.joints import JointMap, JointStream, TreeValues
 from linkage_kinematics.model.urdf import node_description
 from linkage_kinematics.ros import messages
+from linkage_kinematics.ros.node_log import NodeLog
 from linkage_kinematics.run.configuration import LoopsSource, RunConfiguration, SourceKind
 from linkage_kinematics.run.diagnostics import Status
-from linkage_kinematics.run.parameter_values import ConfigurationError
 from linkage_kinematics.shared.cdr import encode_cdr
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -60,10 +57,6 @@ ROBOT_DESCRIPTION_TOPIC = 'robot_description'
 # The closure file's text, logged beside the description (latched as it is), never published:
 # the parameter robot_description_closures holds it.
 CLOSURES_TOPIC = 'robot_description_closures'
-
-
-class StartupError(Exception):
-    """The node cannot start for a reason other than a parameter; the message names it."""
 
 
 class Publishers(NamedTuple):
@@ -99,8 +92,8 @@ class NodeOutputs:
 
     Relative names resolve under the node's namespace (as joint_state_publisher's and
     robot_state_publisher's do); /diagnostics is absolute, diagnostic_updater's convention.
-    Construction raises ConfigurationError naming log.folder if the log cannot be written,
-    StartupError for any other reason (e.g. a message definition not found), before any folder.
+    Construction raises as ``NodeLog`` does where the log cannot be opened, before anything is
+    published.
     """
 
     def __init__(self, node: Node, config: RunConfiguration, parameter_values: dict[str, Any],
@@ -124,7 +117,6 @@ class NodeOutputs:
         self.input_topic = node.resolve_topic_name(MEASURED_TOPIC)
         self.description_topic = node.resolve_topic_name(ROBOT_DESCRIPTION_TOPIC)
         self.closures_topic = node.resolve_topic_name(CLOSURES_TOPIC)
-        self.recording_error: str | None = None
         self._described: tuple[FourBar, JointMap] | None = None
         self._prepared_for: RunConfiguration | None = None
         self._encoded: FourBar | None = None
@@ -134,16 +126,11 @@ class NodeOutputs:
         self._loop_effort_encoder: messages.JointStateEffortEncoder | None = None
         # frame_id and frame_prefix are read-only: one frame for the node's life.
         self._frame_id = config.outputs.frame_prefix + config.outputs.frame_id
-        self.recorder = (self._open_recorder(parameter_values, bag_writer_cpus)
-                         if config.logging.enabled else None)
+        self.log = NodeLog(node, config.logging, self._logged_topics(), parameter_values,
+                           bag_writer_cpus)
 
-    def _open_recorder(self, parameter_values: dict[str, Any],
-                       cpus: set[int] | None) -> Recorder:
-        """Return a recorder for every topic, before anything is published."""
-        metadata = {
-            'parameters': json.dumps(parameter_values, sort_keys=True),
-            'package_version': package_version(),
-        }
+    def _logged_topics(self) -> list[Topic]:
+        """Return every topic the bag holds: those published, TF, and the loops' inputs."""
         # The latest status starts every file of a split bag, as the latched URDF does.
         topics = [
             (publisher.topic_name, publisher.msg_type, publisher.qos_profile,
@@ -155,31 +142,12 @@ class NodeOutputs:
                    (TF_TOPIC, messages.TFMessage, TF_QOS, None)]
         if self.config.loops.source is LoopsSource.ROBOT_DESCRIPTION:
             topics += _loops_topics(self, self._publishers.joint_states.topic_name)
-        try:
-            return Recorder(
-                self.config.logging.folder, topics=topics, metadata=metadata, cpus=cpus,
-                max_bag_size=self.config.logging.max_bag_size,
-                max_bag_duration=self.config.logging.max_bag_duration,
-            )
-        except LogFolderError as error:
-            raise ConfigurationError('log.folder', str(error)) from None
-        except OSError as error:  # every BagError
-            raise StartupError(f'cannot record: {error}') from None
+        return topics
 
     def send(self, publisher: Publisher, data: bytes, log_time_ns: int) -> None:
         """Publish bytes encoded as ``encode_cdr`` does, and log the same bytes."""
         publisher.publish(data)
-        self._record(publisher.topic_name, data, log_time_ns)
-
-    def _record(self, topic: str, data: bytes, log_time_ns: int) -> None:
-        if self.recorder is None or self.recording_error is not None:
-            return
-        try:
-            self.recorder.record(topic, data, log_time_ns)
-        except OSError as error:
-            # The data keep flowing; diagnostics report the lost log.
-            self.recording_error = f'recording stopped: {error}'
-            self._node.get_logger().error(self.recording_error)
+        self.log.record(publisher.topic_name, data, log_time_ns)
 
     def _prepare(self) -> None:
         """Prepare the encoders of the per-state messages for the geometry and joints."""
@@ -215,7 +183,7 @@ class NodeOutputs:
                                                    velocities[published]), stamp_ns)
         if self._robot_transforms is not None:
             # What robot_state_publisher makes of the driver and the passive joints, bag only.
-            self._record(TF_TOPIC, self._robot_transforms.message(
+            self.log.record(TF_TOPIC, self._robot_transforms.message(
                 dict(zip(self._joints.tree_names, positions)), stamp_ns), stamp_ns)
         self.send(self._publishers.state,
                   self._state_encoder.encode(state, stamp_ns, motion_time), stamp_ns)
@@ -241,10 +209,10 @@ class NodeOutputs:
                       encode_cdr(String(data=description.text)), stamp_ns)
         # robot_state_publisher's TF, also where a lab runs it on its own URDF: the node's URDF
         # has the lab's joints
-        if self.recorder is not None:
+        if self.log.recorder is not None:
             self._robot_transforms = tf = messages.RobotStateTransforms(
                 description.tree, config.outputs.frame_prefix)
-            self._record(TF_STATIC_TOPIC, tf.static_message(stamp_ns), stamp_ns)
+            self.log.record(TF_STATIC_TOPIC, tf.static_message(stamp_ns), stamp_ns)
 
     # loops robot_description: the lab's description, its closed loops and their input
 
@@ -272,16 +240,16 @@ class NodeOutputs:
 
     def record_input(self, data: bytes, stamp_ns: int) -> None:
         """Log one input message's bytes as received, at its stamp."""
-        self._record(self.input_topic, data, stamp_ns)
+        self.log.record(self.input_topic, data, stamp_ns)
 
     def record_robot(self, urdf: str, closures: str, transforms: messages.RobotStateTransforms,
                      stamp_ns: int) -> None:
         """Log a lab's description, closure file ('': none) and /tf_static (/tf: record_tf)."""
         self._robot_transforms = transforms
-        self._record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
+        self.log.record(self.description_topic, encode_cdr(String(data=urdf)), stamp_ns)
         if closures:
-            self._record(self.closures_topic, encode_cdr(String(data=closures)), stamp_ns)
-        self._record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
+            self.log.record(self.closures_topic, encode_cdr(String(data=closures)), stamp_ns)
+        self.log.record(TF_STATIC_TOPIC, transforms.static_message(stamp_ns), stamp_ns)
 
     def record_tf(self, positions: Sequence[float], stamp_ns: int) -> None:
         """
@@ -289,28 +257,14 @@ class NodeOutputs:
 
         The positions of the recorded robot's ``driven_joints``, in that order.
         """
-        if self.recorder is not None and self._robot_transforms is not None:
-            self._record(TF_TOPIC, self._robot_transforms.tree_message(positions, stamp_ns),
-                         stamp_ns)
+        if self.log.recorder is not None and self._robot_transforms is not None:
+            self.log.record(TF_TOPIC, self._robot_transforms.tree_message(positions, stamp_ns),
+                            stamp_ns)
 
     def publish_statuses(self, stamp_ns: int, statuses: tuple[Status, ...]) -> None:
         """Publish several statuses in one array, each named '<node>: <task>'."""
         self.send(self._publishers.diagnostics,
                   messages.statuses_message(stamp_ns, self._node_name, statuses), stamp_ns)
-
-    def flush_log(self) -> None:
-        """
-        Have the bag writer write out what it holds before the run's last status.
-
-        So that its log size is the bag's.
-        """
-        if self.recorder is None or self.recording_error is not None:
-            return
-        try:
-            self.recorder.flush()
-        except OSError as error:
-            self.recording_error = f'recording stopped: {error}'
-            self._node.get_logger().error(self.recording_error)
 
     def flush(self, timeout: float = 1.0) -> None:
         """
@@ -321,18 +275,3 @@ class NodeOutputs:
         deadline = time.monotonic() + timeout
         for publisher in self._publishers.present():
             publisher.wait_for_all_acked(Duration(seconds=max(deadline - time.monotonic(), 0.0)))
-
-    def close_log(self) -> bool:
-        """Finalize the bag (idempotent); False, with an error logged, if that failed."""
-        if self.recorder is None:
-            return True
-        logger = self._node.get_logger()
-        try:
-            self.recorder.close()
-        except OSError as error:
-            logger.error(f'could not finalize the log: {error}')
-            return False
-        bag = self.recorder.bag_path
-        count = BagMetadata.read(bag).message_count
-        logger.info(f'bag finalized: {bag}, {count} messages')
-        return True

@@ -20,7 +20,6 @@ import sys
 from typing import Protocol
 
 from linkage_kinematics.ros.exit_codes import ExitCode
-from linkage_kinematics.ros.outputs import StartupError
 from linkage_kinematics.run.parameter_values import ConfigurationError
 import rclpy
 from rclpy.executors import Executor, SingleThreadedExecutor
@@ -29,6 +28,10 @@ from rclpy.logging import get_logger
 from rclpy.signals import SignalHandlerOptions
 
 PR_SET_TIMERSLACK = 29  # prctl option (linux/prctl.h)
+
+
+class StartupError(Exception):
+    """The node cannot start for a reason other than a parameter; the message names it."""
 
 
 class ProcessNode(Protocol):
