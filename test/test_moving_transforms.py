@@ -20,6 +20,8 @@ import math
 import random
 import struct
 
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
 from linkage_kinematics.kinematics.geometry import preset
 from linkage_kinematics.model.joints import Driver, JointMap, JointMapping
 from linkage_kinematics.model.robot_transforms import (
@@ -85,6 +87,61 @@ MIMIC_URDF = """<?xml version="1.0"?>
   </joint>
 </robot>
 """
+# Revolute joints without an origin rotation along +x, +z and +y (a mimic): the short form;
+# along −y and −x (a negative zero in its axis), and along +z and +x with origin rotations that
+# hold negative zeros (rpy of negative zeros): the product, since the signs of its zeros follow
+# those of sin(q/2) and cos(q/2); one off the axes, one with an rpy origin and a prismatic
+# joint: the product; all in one joint state.
+AXES_URDF = """<?xml version="1.0"?>
+<robot name="axes">
+  <link name="base"/><link name="l1"/><link name="l2"/><link name="l3"/><link name="l4"/>
+  <link name="l5"/><link name="l6"/><link name="l7"/><link name="l8"/><link name="l9"/>
+  <link name="l10"/>
+  <joint name="j1_x" type="revolute">
+    <parent link="base"/><child link="l1"/><origin xyz="0.1 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/>
+  </joint>
+  <joint name="j2_minus_y" type="continuous">
+    <parent link="l1"/><child link="l2"/><origin xyz="0 0.2 0" rpy="0 0 0"/>
+    <axis xyz="0 -2 0"/>
+  </joint>
+  <joint name="j3_z" type="continuous">
+    <parent link="l2"/><child link="l3"/><origin xyz="0 0 -0.3"/><axis xyz="0 0 1"/>
+  </joint>
+  <joint name="j4_minus_x" type="continuous">
+    <parent link="l3"/><child link="l4"/><axis xyz="-1 -0 0"/>
+  </joint>
+  <joint name="j5_z_negative_zero_rpy" type="continuous">
+    <parent link="l4"/><child link="l5"/><origin xyz="0.1 0.1 0" rpy="0 0 -0"/>
+    <axis xyz="0 0 1"/>
+  </joint>
+  <joint name="j6_x_negative_zero_rpy" type="continuous">
+    <parent link="l5"/><child link="l6"/><origin rpy="-0 -0 -0"/><axis xyz="1 0 0"/>
+  </joint>
+  <joint name="j7_skew" type="continuous">
+    <parent link="l6"/><child link="l7"/><axis xyz="0 1 1"/>
+  </joint>
+  <joint name="j8_rpy" type="continuous">
+    <parent link="l7"/><child link="l8"/><origin rpy="0 0 1.5707963267948966"/>
+    <axis xyz="0 1 0"/>
+  </joint>
+  <joint name="j9_slide" type="prismatic">
+    <parent link="l8"/><child link="l9"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <joint name="j10_mimic" type="continuous">
+    <parent link="l9"/><child link="l10"/><axis xyz="0 1 0"/>
+    <mimic joint="j3_z" multiplier="-1" offset="0"/>
+  </joint>
+</robot>
+"""
+AXES_NAMES = ['j1_x', 'j2_minus_y', 'j3_z', 'j4_minus_x', 'j5_z_negative_zero_rpy',
+              'j6_x_negative_zero_rpy', 'j7_skew', 'j8_rpy', 'j9_slide']
+# Positions whose half-angle has each sign of sin(q/2) and cos(q/2): zeros of both signs, the
+# smallest subnormal (its half rounds to +0.0), small and large angles in all four quadrants,
+# ±π and ±2π (a sine of a few ulp, a cosine near ±1), a huge angle; and NaN.
+SIGN_CASES = [0.0, -0.0, 5e-324, -5e-324, 1e-300, -1e-300, 1.0, -1.0, 4.0, -4.0, 7.0, -7.0,
+              10.0, -10.0, math.pi, -math.pi, 2 * math.pi, -2 * math.pi, 1e22, -1e22, math.nan]
 LAB_JOINTS = JointMap(JointMapping('wheel', -1, 0.25), JointMapping('link_2', 1, -1.5),
                       JointMapping('a_rocker', -1, 4.0))
 
@@ -212,3 +269,56 @@ def test_the_whole_trees_tf_is_the_generic_one(urdf: str) -> None:
     for positions in random_positions(robot, names, random.Random(5)):
         assert tf.tree_message([positions[name] for name in names], STAMP_NS) == encode_cdr(
             messages.tf_message(reference_transforms(robot, positions), STAMP_NS)), positions
+
+
+def assert_same_bits_as_the_product(urdf: str, positions: dict[str, float]) -> None:
+    """
+    Check ``moving``'s transforms at ``positions`` against the product, bit for bit.
+
+    NaN included (``bits`` packs its sign and payload); a position the sine refuses (±inf)
+    raises ValueError both ways.
+    """
+    robot = RobotTransforms(read_urdf(urdf))
+    try:
+        expected = reference_transforms(robot, positions)
+    except ValueError:
+        with pytest.raises(ValueError):
+            moving_transforms(robot, positions)
+        return
+    assert bits(moving_transforms(robot, positions)) == bits(expected), positions
+
+
+def test_joints_along_a_frame_axis_take_the_short_form() -> None:
+    """Which joints of AXES_URDF the sign cases below test the short form on, and why not all."""
+    robot = RobotTransforms(read_urdf(AXES_URDF))
+    moving = robot.moving(AXES_NAMES)
+    # white box: slots of the joints computed as ±sin(q/2) + 0.0 and cos(q/2)
+    assert [slot for slot, *_ in moving._axis_turns] == [9, 0, 2]  # j10_mimic, j1_x, j3_z
+    assert len(moving._others) == 7
+    # along −y, at sin(q/2) < 0 and cos(q/2) < 0 the product's x is −0.0 (+0.0 at other
+    # signs): no fixed zero to copy
+    rotations = {transform.child_frame: transform.rotation
+                 for transform in reference_transforms(robot, dict.fromkeys(AXES_NAMES, -4.0))}
+    assert math.copysign(1.0, rotations['l2'][0]) == -1.0
+    assert math.copysign(1.0, rotations['l3'][0]) == 1.0
+
+
+@pytest.mark.parametrize('position', SIGN_CASES)
+def test_every_sign_case_gives_the_products_bits(position: float) -> None:
+    positions = dict.fromkeys(AXES_NAMES, position)
+    assert_same_bits_as_the_product(AXES_URDF, positions)
+    # one joint at the sign case, the others ordinary: a NaN in any slot takes the product
+    for name in AXES_NAMES:
+        assert_same_bits_as_the_product(AXES_URDF, {**dict.fromkeys(AXES_NAMES, 0.7),
+                                                    name: position})
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.one_of(st.floats(), st.sampled_from(SIGN_CASES)),
+                min_size=len(AXES_NAMES), max_size=len(AXES_NAMES)))
+@example([math.inf] + [0.0] * (len(AXES_NAMES) - 1))
+@example([0.0] * (len(AXES_NAMES) - 1) + [math.inf])
+@example([math.inf, -math.inf] + [0.0] * (len(AXES_NAMES) - 2))
+def test_any_positions_give_the_products_bits(positions: list[float]) -> None:
+    """Any floats: ±0, subnormals, huge, NaN, ±inf (revolute: ValueError; the slide: ±inf)."""
+    assert_same_bits_as_the_product(AXES_URDF, dict(zip(AXES_NAMES, positions)))

@@ -131,6 +131,22 @@ class MovingTransforms:
     its unit axis, and for a prismatic joint the axis turned by the origin (the direction it
     slides in its parent's frame); so a state costs only the motion's terms: per revolute joint
     one sine, one cosine and one quaternion product, per prismatic joint three products.
+
+    Most revolute joints of a URDF have no rotation in their origin and an axis along one of
+    their frame's axes. Then the product origin · (a·sin(q/2), cos(q/2)) has in w cos(q/2)
+    minus zeros, in the axis's component ±sin(q/2) plus zeros, and in the other two only
+    zeros (each term a zero times sin(q/2) or cos(q/2)): a product and a sum, not sixteen
+    products and twelve sums. Adding zeros leaves a nonzero number as it is (and cos(q/2) of a
+    finite q is never zero), and the sign of a sum of zeros depends only on the signs of
+    sin(q/2) and cos(q/2). So each such joint is checked here against the product itself at
+    a sine of either sign and a zero of either sign and a cosine of either sign: the two
+    other components must be the same zeros at every sign (along a negative axis, or after
+    an origin rotation with negative zeros, their signs follow the sine's and the cosine's,
+    and the joint keeps the product), the axis's component ±sin(q/2) + 0.0 (a zero sine gives
+    +0.0) and w cos(q/2), to the bit. Then every transform is the product's, bit for bit, for
+    every finite position; a joint state with a NaN (which the product spreads to every
+    component) takes the product throughout, and an infinite angle raises ValueError
+    (``math.sin``) either way.
     """
 
     def __init__(
@@ -145,6 +161,26 @@ class MovingTransforms:
         # (revolute, slot, origin translation xyz, origin rotation xyzw, axis xyz; for a
         # prismatic joint the axis in the parent's frame)
         self._joints = joints
+        # The values that do not move, with each revolute joint along a frame axis as its slot,
+        # the place of its axis component, the axis's sign and the place of w; every other
+        # joint (``joints``' entry) computed by the product and put at its place.
+        self._fixed: list[float] = []
+        axis_turns, others, places = [], [], []
+        for joint in joints:
+            revolute, slot, tx, ty, tz = joint[:5]
+            place = len(self._fixed)
+            turn = _axis_turn(joint) if revolute else None
+            if turn is None:
+                self._fixed += joint[2:9]
+                others.append(joint)
+                places.append(place)
+            else:
+                component, sign, rotation = turn
+                self._fixed += (tx, ty, tz, *rotation)
+                axis_turns.append((slot, place + 3 + component, sign, place + 6))
+        self._axis_turns = tuple(axis_turns)
+        self._others = tuple(others)
+        self._other_places = tuple(places)
 
     def values(self, positions: Iterable[float]) -> tuple[float, ...]:
         """
@@ -156,21 +192,81 @@ class MovingTransforms:
         slots = list(positions)
         for source, multiplier, offset in self._mimics:
             slots.append(multiplier * slots[source] + offset)
-        values: list[float] = []
-        for revolute, slot, tx, ty, tz, x, y, z, w, ax, ay, az in self._joints:
-            position = slots[slot]
-            if revolute:
-                half = 0.5 * position
-                sine = math.sin(half)
-                mx, my, mz, mw = ax * sine, ay * sine, az * sine, math.cos(half)
-                # origin · (a·sin(q/2), cos(q/2)): quaternion_product's terms in its order,
-                # written out (a call per joint costs more than its arithmetic)
-                values += (tx, ty, tz,
-                           w * mx + x * mw + y * mz - z * my,
-                           w * my - x * mz + y * mw + z * mx,
-                           w * mz + x * my - y * mx + z * mw,
-                           w * mw - x * mx - y * my - z * mz)
-            else:
-                values += (tx + ax * position, ty + ay * position, tz + az * position,
-                           x, y, z, w)
+        if not self._axis_turns:
+            return _product_values(self._joints, slots)
+        # sum() only to find a NaN: finite floats and infinities of one sign never sum to NaN
+        # (nor does 3.12's compensation make one), so a NaN total means a NaN or infinities of
+        # both signs, and the product decides
+        total = sum(slots)
+        if total != total:
+            return _product_values(self._joints, slots)
+        values = self._fixed[:]
+        sin, cos = math.sin, math.cos
+        for slot, component, sign, last in self._axis_turns:
+            half = 0.5 * slots[slot]
+            values[component] = sign * sin(half) + 0.0
+            values[last] = cos(half)
+        if self._others:
+            others = _product_values(self._others, slots)
+            for start, place in zip(range(0, len(others), 7), self._other_places):
+                values[place:place + 7] = others[start:start + 7]
         return tuple(values)
+
+
+def _product_values(joints: Iterable[tuple[Any, ...]], slots: Sequence[float]
+                    ) -> tuple[float, ...]:
+    """Return ``MovingTransforms.values`` of ``joints`` at ``slots``, by the product per joint."""
+    values: list[float] = []
+    for revolute, slot, tx, ty, tz, x, y, z, w, ax, ay, az in joints:
+        position = slots[slot]
+        if revolute:
+            half = 0.5 * position
+            sine = math.sin(half)
+            mx, my, mz, mw = ax * sine, ay * sine, az * sine, math.cos(half)
+            # origin · (a·sin(q/2), cos(q/2)): quaternion_product's terms in its order,
+            # written out (a call per joint costs more than its arithmetic)
+            values += (tx, ty, tz,
+                       w * mx + x * mw + y * mz - z * my,
+                       w * my - x * mz + y * mw + z * mx,
+                       w * mz + x * my - y * mx + z * mw,
+                       w * mw - x * mx - y * my - z * mz)
+        else:
+            values += (tx + ax * position, ty + ay * position, tz + az * position,
+                       x, y, z, w)
+    return tuple(values)
+
+
+# sin(q/2) of either sign and zero of either sign, cos(q/2) of either sign: the signs on which
+# the zeros of the product depend
+_SIGNS = tuple((sine, cosine) for sine in (0.25, -0.25, 0.0, -0.0) for cosine in (0.5, -0.5))
+
+
+def _axis_turn(joint: tuple[Any, ...]) -> tuple[int, float, tuple[float, ...]] | None:
+    """
+    Return a revolute joint's axis component (0–2), its sign and its fixed rotation, or None.
+
+    The fixed rotation: the product's components, with its axis component and w as 0. None
+    unless the origin has no rotation, the axis is along a frame axis and the product gives the
+    same zeros in the other two components, ±sin(q/2) + 0.0 in the axis component and cos(q/2)
+    in w at every sign of ``_SIGNS`` (``MovingTransforms``).
+    """
+    origin, axis = joint[5:9], joint[9:]
+    moving = [index for index, component in enumerate(axis) if component != 0.0]
+    # an origin without rotation: every term of the product but one per component is a zero
+    if origin != (0.0, 0.0, 0.0, 1.0) or len(moving) != 1 or abs(axis[moving[0]]) != 1.0:
+        return None
+    component, sign = moving[0], axis[moving[0]]
+    ax, ay, az = axis
+    fixed: list[float] | None = None
+    for sine, cosine in _SIGNS:
+        product = quaternion_product(origin, (ax * sine, ay * sine, az * sine, cosine))
+        expected = list(product)
+        expected[component], expected[3] = sign * sine + 0.0, cosine
+        if [value.hex() for value in product] != [value.hex() for value in expected]:
+            return None
+        rotation = [*product[:component], 0.0, *product[component + 1:3], 0.0]
+        if fixed is None:
+            fixed = rotation
+        elif [value.hex() for value in rotation] != [value.hex() for value in fixed]:
+            return None
+    return component, sign, tuple(fixed)
