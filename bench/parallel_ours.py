@@ -31,7 +31,8 @@ from dataclasses import dataclass
 import math
 
 from linkage_kinematics.loops.encodings import read_closures
-from linkage_kinematics.loops.newton import GroupSolver, plan_group, PlannedGroup, SampleRefused
+from linkage_kinematics.loops.newton import GroupSolver, plan_group, PlannedGroup
+from linkage_kinematics.loops.refusals import SampleRefused
 from linkage_kinematics.loops.structure import closure_groups, ClosureGroup
 from linkage_kinematics.loops.tree import KinematicTree
 from linkage_kinematics.model.urdf_reader import read_urdf

@@ -27,7 +27,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent / 'test'))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import closure_robots  # noqa: E402
-from linkage_kinematics.loops.newton import SampleRefused  # noqa: E402
+from linkage_kinematics.loops.refusals import SampleRefused  # noqa: E402
 from linkage_kinematics.loops.structure import GroupKind  # noqa: E402
 from mpmath import mp, mpf  # noqa: E402
 from test_closure_newton import errors, known_at, MOTIONS, planned_for, stretched  # noqa: E402

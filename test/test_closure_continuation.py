@@ -17,7 +17,8 @@ from __future__ import annotations
 from pathlib import Path
 import sys
 
-from linkage_kinematics.loops.newton import plan_group, Refusal, SampleRefused
+from linkage_kinematics.loops.newton import plan_group
+from linkage_kinematics.loops.refusals import Refusal, SampleRefused
 import pytest
 
 # the bench's modules, as bench/run.py imports them

@@ -19,12 +19,8 @@ import sys
 
 from closure_reference import Reference
 import closure_robots
-from linkage_kinematics.loops.newton import (
-    CONDITION_LIMIT,
-    plan_group,
-    Refusal,
-    SampleRefused,
-)
+from linkage_kinematics.loops.newton import plan_group
+from linkage_kinematics.loops.refusals import CONDITION_LIMIT, Refusal, SampleRefused
 from linkage_kinematics.loops.structure import GroupKind
 from mpmath import mp, mpf
 import pytest

@@ -20,7 +20,8 @@ import tempfile
 from closure_reference import Reference
 import closure_robots
 from linkage_kinematics.loops.closures import ClosureKind, JointOverride
-from linkage_kinematics.loops.equations import LoopEquations, universal_rod
+from linkage_kinematics.loops.equations import LoopEquations
+from linkage_kinematics.loops.rods import universal_rod
 from linkage_kinematics.loops.spatial import (
     axis_rotation,
     log_rate_matrix,

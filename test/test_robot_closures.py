@@ -31,8 +31,8 @@ from linkage_kinematics.loops.follower import (
     RobotLoopsFollower,
 )
 from linkage_kinematics.loops.intake import DropReason, LOOPS_DROPS
-from linkage_kinematics.loops.newton import Refusal
 from linkage_kinematics.loops.plan import find_loops, read_loops
+from linkage_kinematics.loops.refusals import Refusal
 from linkage_kinematics.loops.solver import LoopSolver
 from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.model.urdf_reader import read_urdf

@@ -39,7 +39,6 @@ from linkage_kinematics.loops.assembly import ClosureGap
 from linkage_kinematics.loops.closures import ClosureError, ClosureSide
 from linkage_kinematics.loops.command import CommandGroup
 from linkage_kinematics.loops.description import LoopError
-from linkage_kinematics.loops.newton import PlanError, Refusal
 from linkage_kinematics.loops.plan import (
     find_loops,
     GroupPlan,
@@ -49,6 +48,7 @@ from linkage_kinematics.loops.plan import (
 )
 from linkage_kinematics.loops.planar import Loop, LoopJoint
 from linkage_kinematics.loops.reach import reach
+from linkage_kinematics.loops.refusals import PlanError, Refusal
 from linkage_kinematics.loops.robot_transmission import GroupTransmission, plan_transmissions
 from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.loops.transmission import TransmissionError, TransmissionSingular

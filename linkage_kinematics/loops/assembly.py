@@ -23,7 +23,7 @@ method that converges from far and then polished to rounding:
 The held coordinates (``fixed``) stay at the start: the known joints at the first sample's
 values for the node; none for the checker, which looks for the nearest closed pose of the whole
 group. A ``seed`` (joint name → value) replaces the start of those unknown joints: it picks
-another assembly where several are near (module newton.py keeps it by continuation). Plan time:
+another assembly where several are near (continuation.py keeps it per sample). Plan time:
 numpy. Pure: no ROS.
 """
 

@@ -5,7 +5,7 @@
 Closed forms of the spatial mechanisms that have them, in plain floats.
 
 * ``TurnChain.pointing``: the two angles of a universal joint that point a rod at a target (the
-  angles of a rod reduced to a distance, equations.Rod): the component of the rod along the
+  angles of a rod reduced to a distance, rods.Rod): the component of the rod along the
   first axis is kept by the first turn, so the second angle solves a·cos θ₂ + b·sin θ₂ = c,
   and the first turns the rod onto the target about the first axis.
 * ``TurnChain.ball``: the three angles of a ball written as three turns that make a given

@@ -59,8 +59,8 @@ from typing import NamedTuple
 
 from linkage_kinematics.loops.command_parts import command_part, TransmissionLegs
 from linkage_kinematics.loops.equations import Evaluation
-from linkage_kinematics.loops.newton import CONDITION_LIMIT, PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.planar import Loop
+from linkage_kinematics.loops.refusals import CONDITION_LIMIT, PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.structure import GroupKind
 from linkage_kinematics.loops.transmission import actuator_efforts, Linearization, Transmission
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind

@@ -31,16 +31,12 @@ import math
 from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
 from linkage_kinematics.loops.assembly import Assembly
 from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
+from linkage_kinematics.loops.derivatives import Derivatives
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations
-from linkage_kinematics.loops.newton import (
-    Derivatives,
-    GroupSolver,
-    PlanError,
-    Refusal,
-    SampleRefused,
-)
+from linkage_kinematics.loops.newton import GroupSolver
 from linkage_kinematics.loops.plan import RobotLoops
 from linkage_kinematics.loops.planar import Loop
+from linkage_kinematics.loops.refusals import PlanError, Refusal, SampleRefused
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.loops.structure import (
     classify,

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 from linkage_kinematics.kinematics.planar_loop import JointKind, known_joint_range
 from linkage_kinematics.loops.intake import DropReason, Estimate, Intake
-from linkage_kinematics.loops.newton import Refusal
 from linkage_kinematics.loops.plan import LoopPlan, RobotLoops
+from linkage_kinematics.loops.refusals import Refusal
 from linkage_kinematics.loops.robot_transmission import OutputEfforts, plan_transmissions
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.loops.transmission import TransmissionSingular

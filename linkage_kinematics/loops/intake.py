@@ -36,9 +36,10 @@ class DropReason(StrEnum):
     Where the two measured modes word a reason each its own way, each has its member: the
     four-bar's ``NO_DRIVER`` and ``DRIVER_UNREACHABLE``, the loops' ``NO_JOINT`` and
     ``JOINTS_UNREACHABLE``. A closure group of the general closure refuses a sample for one of
-    three reasons (``newton.Refusal``), each its own member: ``NO_ASSEMBLY``, ``ASSEMBLY_JUMP``,
-    ``SINGULAR``. ``FOUR_BAR_DROPS`` and ``LOOPS_DROPS`` are the reasons each mode counts, in
-    the order its diagnostics list them (the groups' last, after those bags already hold).
+    three reasons (``refusals.Refusal``), each its own member: ``NO_ASSEMBLY``,
+    ``ASSEMBLY_JUMP``, ``SINGULAR``. ``FOUR_BAR_DROPS`` and ``LOOPS_DROPS`` are the reasons
+    each mode counts, in the order its diagnostics list them (the groups' last, after those
+    bags already hold).
     """
 
     NO_DESCRIPTION = 'before the robot description was closed'

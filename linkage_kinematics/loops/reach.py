@@ -10,7 +10,7 @@ known joint's interval on the assembly's branch with the other known joints held
 assembled values, found by continuation from the assembly both ways with the group's own
 solver, in steps of at most ``STEP`` (rad, or ``STEP`` of the group's size for a slide), each
 step that is refused retried four times shorter, until a step of ``RESOLUTION`` of that is
-still refused. Each end says why it ends (``newton.Refusal``: no assembly reaches further, a
+still refused. Each end says why it ends (``refusals.Refusal``: no assembly reaches further, a
 singular configuration, the answer would jump to another assembly); a turn that goes round
 whole without a refusal is a full turn. The checker prints it for groups of one and two known
 joints. Plan time: a few hundred solves per joint. Pure: no ROS.
@@ -21,7 +21,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 import math
 
-from linkage_kinematics.loops.newton import GroupSolver, PlannedGroup, Refusal, SampleRefused
+from linkage_kinematics.loops.newton import GroupSolver, PlannedGroup
+from linkage_kinematics.loops.refusals import Refusal, SampleRefused
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind
 
 STEP = math.radians(1.0)

@@ -13,7 +13,7 @@ unknowns and six rows where a distance is one row):
   joint of two, or a ball of three: Gepetto's ``_rev0``–``_rev2`` and the closure file's
   SPHERICAL and UJOINT overrides), carrying the side's frame, the two points apart: the two
   links welded are one rod between the two points, and the weld is the distance between
-  them, |x − P| = L (one row; equations.Distance). The joints follow from the rod's
+  them, |x − P| = L (one row; rods.Distance). The joints follow from the rod's
   direction (``WeldRod``): a universal end points the rod (closed_forms.TurnChain.pointing),
   the rod's rotation is then known and the ball at the other end turns to it
   (closed_forms.TurnChain.ball). Two balls leave the rod free to spin about its line: rewritten
@@ -54,7 +54,8 @@ import math
 
 from linkage_kinematics.loops.closed_forms import OutOfReach, TurnChain
 from linkage_kinematics.loops.closures import Closure, ClosureKind, ClosureSide
-from linkage_kinematics.loops.equations import Distance, Evaluation, LoopEquations
+from linkage_kinematics.loops.equations import Evaluation, LoopEquations
+from linkage_kinematics.loops.rods import Distance
 from linkage_kinematics.loops.spatial import (
     add,
     apply,

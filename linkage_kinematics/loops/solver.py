@@ -11,7 +11,7 @@ continuous across turns; then each group of the general closure (``GroupStep``),
 the motion's first sample nearest its zero-pose assembly with the measured joints held there,
 and continued from sample to sample by its ``newton.GroupSolver``. A sample that cannot be
 closed is a ``LoopSampleError`` naming the loop or group (and, for a group, its
-``newton.Refusal``). Pure: no ROS graph.
+``refusals.Refusal``). Pure: no ROS graph.
 """
 
 from __future__ import annotations
@@ -29,14 +29,9 @@ from linkage_kinematics.kinematics.planar_loop import (
 )
 from linkage_kinematics.kinematics.solver import unwrap_near
 from linkage_kinematics.loops.assembly import Assembly, AssemblyError
-from linkage_kinematics.loops.newton import (
-    GroupSolver,
-    GroupState,
-    plan_group,
-    Refusal,
-    SampleRefused,
-)
+from linkage_kinematics.loops.newton import GroupSolver, GroupState, plan_group
 from linkage_kinematics.loops.plan import GroupPlan, LoopPlan
+from linkage_kinematics.loops.refusals import Refusal, SampleRefused
 from linkage_kinematics.loops.tree import KinematicTree
 
 

@@ -19,7 +19,7 @@ Closure groups, their degrees of freedom, idle freedoms, and whether known joint
   space of J_U, the known coordinates held) and move no joint origin, closure-frame origin or
   link origin of the robot: a rod with a ball at each end spinning about itself, a link between
   two collinear pins. They are no reason to refuse; Newton holds them with the linear equations
-  N_refᵀ·(q_U − q_U,ref) = 0 (newton.py). A null motion that moves anything else leaves the
+  N_refᵀ·(q_U − q_U,ref) = 0 (square_system.py). A null motion that moves anything else leaves the
   group under-determined.
 * **Determinacy.** The known coordinates determine the group when they are independent
   (rank J_U = rank J: every motion of them can be followed) and every null motion of J_U is
@@ -37,7 +37,8 @@ from dataclasses import dataclass
 import enum
 
 from linkage_kinematics.loops.closures import Closure, ClosureKind
-from linkage_kinematics.loops.equations import LoopEquations, Rod, RowKind, universal_rod
+from linkage_kinematics.loops.equations import LoopEquations, RowKind
+from linkage_kinematics.loops.rods import Rod, universal_rod
 from linkage_kinematics.loops.spatial import apply, cross, norm, subtract
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind, unit_axis
 import numpy as np

@@ -55,7 +55,8 @@ import math
 
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
-from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
+from linkage_kinematics.loops.refusals import CONDITION_LIMIT
+from linkage_kinematics.loops.square_system import independent_rows
 from linkage_kinematics.loops.structure import (
     analyse,
     closure_groups,

@@ -33,8 +33,8 @@ from linkage_kinematics.loops.closures import ClosureError
 from linkage_kinematics.loops.command import CommandRefusal, CommandRefused, getter, JointPoint
 from linkage_kinematics.loops.description import LoopError
 from linkage_kinematics.loops.follower import LoopSample, RobotLoopsFollower
-from linkage_kinematics.loops.newton import PlanError
 from linkage_kinematics.loops.plan import read_loops, RobotLoops
+from linkage_kinematics.loops.refusals import PlanError
 from linkage_kinematics.loops.robot_command import plan_command, RobotCommand
 from linkage_kinematics.loops.transmission import TransmissionError
 from linkage_kinematics.model.urdf_reader import read_urdf, UrdfError
