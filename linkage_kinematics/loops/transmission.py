@@ -257,6 +257,8 @@ class Transmission:
             rods = {name: rod for name, rod in rods.items()
                     if name not in {c.name for c in subgroup.closures} or name in kept}
         self.equations = equations = LoopEquations(tree, group.closures, rods)
+        # what the equations were made of, for their batched twin (``batch_equations``)
+        self.closures, self.rods = group.closures, rods
         columns = equations.coordinates
         names = [tree.coordinates[i].name for i in columns]
         self._actuator_columns = [names.index(name) for name in self.actuators]
