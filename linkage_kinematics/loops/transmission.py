@@ -52,7 +52,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 import math
+from typing import NamedTuple
 
+from linkage_kinematics.loops.batch_equations import BatchEquations
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
@@ -231,6 +233,21 @@ class Linearization:
         return self._ratio
 
 
+class BatchLinearization(NamedTuple):
+    """
+    ``Linearization`` at many poses (``Transmission.linearize_many``), arrays over the poses.
+
+    Orientations as ±1 (0 where singular); ``ratio`` (N, actuators, outputs), inf where A' is
+    exactly singular.
+    """
+
+    measured_orientation: np.ndarray
+    measured_conditioning: np.ndarray
+    command_orientation: np.ndarray
+    command_conditioning: np.ndarray
+    ratio: np.ndarray
+
+
 class Transmission:
     """
     One group's transmission between actuators and output joints (module docstring).
@@ -296,6 +313,8 @@ class Transmission:
                          else (1, solved.index(name)) for name in names]
         self._output_places = [solved.index(name) for name in self.outputs]
         self.columns = tuple(names)
+        self._tree = tree
+        self._batch: BatchEquations | None = None  # made when a trajectory first needs it
 
     def local(self, known: Sequence[float], solved: Sequence[float]) -> list[float]:
         """Return the pose over ``columns`` from the actuators' and the solved joints' values."""
@@ -363,6 +382,30 @@ class Transmission:
         return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
                              conditioning, (self, jacobian, inverse_matrix))
 
+    def linearize_many(self, local: np.ndarray) -> BatchLinearization | None:
+        """
+        Return ``linearize`` at every row of ``local`` (N, columns), or None if not batched.
+
+        None where the equations have no batched twin (``BatchEquations.supports``: a weld, a
+        stretched rod). A one- or two-unknown system (the planar loops, the ankle's legs) is
+        solved by the same formulas as ``linear``'s, so M agrees with ``linearize``'s bit for
+        bit but for the Jacobian's few ulps.
+        """
+        if self._batch is None:
+            self._batch = BatchEquations(self._tree, self.closures, self.rods,
+                                         self.equations.coordinates)
+        if not self._batch.supports:
+            return None
+        jacobian = self._batch.jacobian(local)[:, self._rows, :]
+        inverse_matrix, det, conditioning = self._command.factor_many(jacobian)
+        _, measured_det, measured_conditioning = self._measured.factor_many(jacobian)
+        # M = −(A'⁻¹ rows of the actuators)·J_R,o; two terms at most add as fsum would
+        lines = inverse_matrix[:, self._actuator_places, :len(self._rows)]
+        ratio = -np.einsum('nak,nko->nao', lines, jacobian[:, :, self._output_columns])
+        ratio[det == 0.0] = math.inf
+        return BatchLinearization(np.sign(measured_det), measured_conditioning, np.sign(det),
+                                  conditioning, ratio)
+
     def ratio_from(self, jacobian: Sequence[Sequence[float]],
                    inverse_matrix: Sequence[Sequence[float]]) -> tuple[tuple[float, ...], ...]:
         """Return M from ``linearize``'s J and A'⁻¹ (inf throughout without an inverse)."""
@@ -408,6 +451,44 @@ class _Square:
                                (abs(q) / s0 + abs(v) / s1) / r1)
             return inverse_matrix, det, norm * norm_inverse
         return inverse_matrix, det, condition(matrix, inverse_matrix, rows, scales)
+
+    def factor_many(self, jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return ``factor`` at every pose: A⁻¹ (N, n, n), det A and κ₁ (N,); inf where singular.
+
+        One and two unknowns by ``linear``'s own formulas (the same bits from the same J).
+        """
+        count, size = jacobian.shape[0], len(self.columns)
+        matrix = np.empty((count, size, size))
+        matrix[:, :jacobian.shape[1], :] = jacobian[:, :, self.columns]
+        if self.idle:
+            matrix[:, jacobian.shape[1]:, :] = self.idle
+        with np.errstate(divide='ignore', invalid='ignore'):
+            if size == 1:
+                det = matrix[:, 0, 0]
+                inverse_matrix = 1.0 / matrix
+            elif size == 2:
+                a, b, c, d = (matrix[:, 0, 0], matrix[:, 0, 1], matrix[:, 1, 0],
+                              matrix[:, 1, 1])
+                det = a * d - b * c
+                inverse_matrix = np.stack([np.stack([d / det, -b / det], axis=1),
+                                           np.stack([-c / det, a / det], axis=1)], axis=1)
+            else:
+                det = np.linalg.det(matrix)
+                inverse_matrix = np.linalg.inv(np.where((det == 0.0)[:, None, None],
+                                                        np.eye(size), matrix))
+            rows = np.array(self.row_scale)[:, None]
+            scales = np.array(self.column_scale)
+            if size == 1:
+                conditioning = np.ones(count)
+            else:
+                # κ₁ of diag(rows)·A·diag(scales): the largest column sums of it and its inverse
+                norm = np.max(np.sum(np.abs(matrix) * rows * scales, axis=1), axis=1)
+                norm_inverse = np.max(np.sum(np.abs(inverse_matrix) / scales[:, None] / rows.T,
+                                             axis=1), axis=1)
+                conditioning = norm * norm_inverse
+        conditioning[det == 0.0] = math.inf
+        return inverse_matrix, det, conditioning
 
 
 def _sign(value: float) -> int:
