@@ -68,6 +68,15 @@ class _Closure:
     pin: tuple[Vector, Vector, Vector] = (ZERO, ZERO, ZERO)
 
 
+@dataclass(frozen=True)
+class BatchEvaluation:
+    """The frames (per base, per moving frame) and each closure's two points, N rows."""
+
+    count: int
+    frames: dict[int, dict[int, tuple]]
+    points: list[tuple[_Batch, _Batch]]
+
+
 class BatchEquations:
     """The Jacobian of ``LoopEquations(tree, closures, rods)`` at many points (module doc)."""
 
@@ -152,20 +161,46 @@ class BatchEquations:
             frames[base] = posed
         return frames
 
-    def jacobian(self, values: np.ndarray) -> np.ndarray:
-        """Return ∂(residual)/∂(coordinates) at every row of ``values`` (N, width): (N, rows, width)."""
-        count = values.shape[0]
+    def evaluate(self, values: np.ndarray) -> BatchEvaluation:
+        """Return the frames and every closure's two points at each row of ``values``."""
         frames = self._frames(values)
-        result = np.zeros((count, self._rows, self.width))
-        row = 0
+        points = []
         for closure in self._closures:
             posed = frames[closure.base]
-            points = []
+            pair = []
             for side in closure.sides:
                 r, p, _, _ = posed[side.frame]
                 shift = apply(r, side.point)
-                points.append((p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]))
-            p_a, p_b = points
+                pair.append((p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]))
+            points.append((pair[0], pair[1]))
+        return BatchEvaluation(values.shape[0], frames, points)
+
+    def point(self, closure: int, side: int, evaluation: BatchEvaluation) -> _Batch:
+        """
+        Return a closure side's point in its loop's base frame, per row.
+
+        As ``LoopEquations.point``: for a distance, side 0 is the ball x, side 1 the centre P.
+        """
+        found = self._closures[closure]
+        if found.kind is None and found.center == 0:
+            side = 1 - side
+        return evaluation.points[closure][side]
+
+    def step_axis(self, step: int, evaluation: BatchEvaluation) -> tuple[_Batch, _Batch]:
+        """Return a tree step's world axis ω and joint origin o in its base frame, per row."""
+        for posed in evaluation.frames.values():
+            if step + 1 in posed:
+                _, _, w, o = posed[step + 1]
+                return w, o
+        raise KeyError(f'step {step} moves none of the closures')
+
+    def jacobian(self, evaluation: BatchEvaluation) -> np.ndarray:
+        """Return ∂(residual)/∂(coordinates) at each evaluated row: (N, rows, width)."""
+        frames = evaluation.frames
+        result = np.zeros((evaluation.count, self._rows, self.width))
+        row = 0
+        for closure, (p_a, p_b) in zip(self._closures, evaluation.points):
+            posed = frames[closure.base]
             if closure.kind is None:
                 length = closure.length
                 d = ((p_a[0] - p_b[0]) / length, (p_a[1] - p_b[1]) / length,

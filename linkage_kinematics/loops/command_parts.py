@@ -30,7 +30,8 @@ import math
 
 from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
 from linkage_kinematics.loops.assembly import Assembly
-from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
+from linkage_kinematics.loops.batch_equations import BatchEquations
+from linkage_kinematics.loops.closed_forms import crank_to_sphere_many, LegPositions, OutOfReach
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations
 from linkage_kinematics.loops.newton import (
     Derivatives,
@@ -50,6 +51,7 @@ from linkage_kinematics.loops.structure import (
     reducible_rods,
 )
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind
+import numpy as np
 
 # A planar chain's closed form must reproduce the assembled pose to this (rad, or m ÷ size).
 SAME_POSE = 1e-9
@@ -256,6 +258,41 @@ class TransmissionLegs:
                 local[place] = last + math.remainder(local[place] - last, 2.0 * math.pi)
             values[columns[place]] = local[place]
         return self.equations.evaluate(local, evaluation, self.cranks)
+
+    def positions_many(self, local: np.ndarray, batch: BatchEquations) -> int | None:
+        """
+        Write every crank into each row of ``local`` (N × the equations' columns), batched.
+
+        Each row's cranks start at the same pose, the last accepted point's (``positions``
+        solves each leg from where its crank is; the closed form gives the same crank from any
+        start); each turning crank is then kept within π of the row before's, from the first
+        row's start, as ``positions`` keeps it. Return None, or the first row no assembly
+        reaches. A sliding crank is not batched here: ``supports`` says so.
+        """
+        evaluation = batch.evaluate(local)
+        first: int | None = None
+        for leg, found in self.legs:
+            axis, origin = batch.step_axis(found.step, evaluation)
+            change = crank_to_sphere_many(origin, axis, batch.point(found.closure, 1, evaluation),
+                                          batch.point(found.closure, 0, evaluation),
+                                          found.length, found.branch)
+            unreached = np.flatnonzero(np.isnan(change))
+            if unreached.size:
+                first = int(unreached[0]) if first is None else min(first, int(unreached[0]))
+                continue
+            place = found.column
+            cranks = (local[:, place] + change / found.multiplier).tolist()
+            last = float(local[0, place])
+            remainder, turn = math.remainder, 2.0 * math.pi
+            for row, value in enumerate(cranks):
+                last = cranks[row] = last + remainder(value - last, turn)
+            local[:, place] = cranks
+        return first
+
+    @property
+    def supports(self) -> bool:
+        """Return whether ``positions_many`` can batch these legs: every crank turns."""
+        return all(found.turn for _, found in self.legs)
 
 
 def _turned(value: float, near: float, tree: KinematicTree, column: int) -> float:

@@ -36,6 +36,7 @@ from linkage_kinematics.loops.command import (
     getter,
     JointPoint,
 )
+from linkage_kinematics.loops.command_batch import convert_many
 from linkage_kinematics.loops.plan import RobotLoops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.loops.structure import analyse
@@ -44,6 +45,7 @@ from linkage_kinematics.loops.transmission import (
     Transmission,
     TransmissionError,
 )
+import numpy as np
 
 # lists of names whose conversion is kept
 LAYOUTS = 64
@@ -175,6 +177,10 @@ class RobotCommand:
             except CommandRefused as refusal:
                 raise _at_point(refusal, number) from None
         states = [self.groups[number].state() for number in layout.commanded]
+        batched = self._batched(layout, points) if len(points) > 1 else None
+        if batched is not None:
+            return batched
+        self._restore(layout, states)
         converted = []
         for number, point in enumerate(points):
             try:
@@ -183,6 +189,39 @@ class RobotCommand:
                 self._restore(layout, states)
                 raise _at_point(refusal, number) from None
         return tuple(converted)
+
+    def _batched(self, layout: _Layout,
+                 points: Sequence[JointPoint]) -> tuple[JointPoint, ...] | None:
+        """
+        Return every point converted by ``command_batch``, or None: the per-point path then.
+
+        None where a point carries accelerations, where velocities or efforts are given for
+        some points only, or where any group's batch declines (a point it would not decide as
+        the per-point path does); the groups may then have moved (the caller restores them).
+        """
+        if any(point.accelerations for point in points):
+            return None
+        given = []
+        for field in (1, 3):  # velocities, efforts: on every point or on none
+            count = sum(1 for point in points if point[field])
+            if count not in (0, len(points)):
+                return None
+            given.append(count > 0)
+        columns: list[list[list[float]]] = [[list(layout.passing(array)) if array else []
+                                             for array in point] for point in points] \
+            if layout.passing is not None else [[[], [], [], []] for _ in points]
+        for group, outputs in layout.groups:
+            arrays = [np.array([outputs(point[field]) for point in points])
+                      if field == 0 or given[field // 2] else None for field in (0, 1, 3)]
+            found = convert_many(group, *arrays)
+            if found is None:
+                return None
+            for field, array in ((0, found.positions), (1, found.velocities),
+                                 (3, found.efforts)):
+                if array is not None:
+                    for out, row in zip(columns, array.tolist()):
+                        out[field] += row
+        return tuple(JointPoint(*map(tuple, point)) for point in columns)
 
     def _restore(self, layout: _Layout, states: Sequence[CommandState]) -> None:
         """Put the groups a point moved back where they were."""

@@ -54,7 +54,7 @@ from dataclasses import dataclass
 import math
 from typing import NamedTuple
 
-from linkage_kinematics.loops.batch_equations import BatchEquations
+from linkage_kinematics.loops.batch_equations import BatchEquations, BatchEvaluation
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, independent_rows
@@ -382,21 +382,32 @@ class Transmission:
         return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
                              conditioning, (self, jacobian, inverse_matrix))
 
-    def linearize_many(self, local: np.ndarray) -> BatchLinearization | None:
+    @property
+    def batch(self) -> BatchEquations:
+        """Return the equations' batched twin (``batch_equations``), made when first asked."""
+        if self._batch is None:
+            self._batch = BatchEquations(self._tree, self.closures, self.rods,
+                                         self.equations.coordinates)
+        return self._batch
+
+    def linearize_many(self, local: np.ndarray,
+                       evaluation: BatchEvaluation | None = None) -> BatchLinearization | None:
         """
         Return ``linearize`` at every row of ``local`` (N, columns), or None if not batched.
+
+        ``evaluation``: ``batch``'s at ``local``, where the caller evaluated it already.
 
         None where the equations have no batched twin (``BatchEquations.supports``: a weld, a
         stretched rod). A one- or two-unknown system (the planar loops, the ankle's legs) is
         solved by the same formulas as ``linear``'s, so M agrees with ``linearize``'s bit for
         bit but for the Jacobian's few ulps.
         """
-        if self._batch is None:
-            self._batch = BatchEquations(self._tree, self.closures, self.rods,
-                                         self.equations.coordinates)
-        if not self._batch.supports:
+        batch = self.batch
+        if not batch.supports:
             return None
-        jacobian = self._batch.jacobian(local)[:, self._rows, :]
+        if evaluation is None:
+            evaluation = batch.evaluate(local)
+        jacobian = batch.jacobian(evaluation)[:, self._rows, :]
         inverse_matrix, det, conditioning = self._command.factor_many(jacobian)
         _, measured_det, measured_conditioning = self._measured.factor_many(jacobian)
         # M = −(A'⁻¹ rows of the actuators)·J_R,o; two terms at most add as fsum would
