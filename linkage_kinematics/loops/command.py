@@ -182,7 +182,7 @@ class CommandGroup:
         self.passive = tuple(name for name in transmission.solved if name not in self.outputs)
         self.parts = [(command_part(tree, subgroup, structure, values, planar_loops),
                        [self.outputs.index(name) for name in structure.known])
-                       for subgroup, structure in transmission.command_groups]
+                      for subgroup, structure in transmission.command_groups]
         index = tree.index
         self.output_columns = [index[name] for name in self.outputs]
         self.actuator_columns = [index[name] for name in self.actuators]
@@ -210,7 +210,7 @@ class CommandGroup:
                 joint is None or joint.joint_type is not JointType.REVOLUTE
                 or coordinate.name != coordinate.joint)
             self.steps.append((transmission.size if coordinate.kind is MotionKind.SLIDE
-                                else 1.0, wraps))
+                               else 1.0, wraps))
         self.limits = [Limits(None, None, None) if name not in joints else Limits(
             joints[name].position_limits, joints[name].velocity_limit,
             joints[name].effort_limit) for name in self.actuators]

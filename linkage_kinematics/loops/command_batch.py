@@ -48,9 +48,7 @@ MARGIN = 1e-9
 
 
 class GroupArrays(NamedTuple):
-    """
-    One group's actuators at N points: positions (N, actuators), velocities and efforts or None.
-    """
+    """One group's actuators at N points: positions (N, actuators), velocities, efforts."""
 
     positions: np.ndarray
     velocities: np.ndarray | None
