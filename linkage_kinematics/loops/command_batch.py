@@ -7,30 +7,32 @@ A trajectory's points converted for one command group at once (numpy), beside th
 ``command.CommandGroup.solve`` converts one point in plain floats, some tens of µs a group: what
 a 1 kHz forward command needs. A ``JointTrajectory`` of a thousand points would take tens of ms
 that way; issue 30 asks for it within its first point's ``time_from_start``. ``convert_many``
-does the lean path's work for every point at once:
+does the lean path's work for every point at once, from the last accepted point through the
+intermediate points to the first (as ``solve`` makes them) and on through the points:
 
-* the first point by ``CommandGroup.solve`` itself (from the last accepted point it may need
-  intermediate points, and it is where a new trajectory's continuation starts);
-* the others' positions: the ankle's cranks in closed form over all points at once
-  (``TransmissionLegs.positions_many``), any other part point by point in order (its own closed
-  form or Newton, continued as on the per-point path);
-* every point's transmission at once (``Transmission.linearize_many``): orientations,
+* positions: the ankle's cranks in closed form over all rows at once
+  (``TransmissionLegs.positions_many``), a planar chain's joints likewise
+  (``PlanarPart.positions_many``: the four-bar's closed form over arrays, its branch continued),
+  any other part row by row in order (Newton, continued as on the per-point path);
+* every row's transmission at once (``Transmission.linearize_many``): orientations,
   conditionings and M, then velocities ṁ = M·q̇_o and efforts τ_m = M⁻ᵀ·τ_o (one or two
   outputs: ``linear``'s formulas, the same bits from the same M).
 
-**Refusals are the per-point path's.** The batch refuses nothing itself: where any point would
+**Refusals are the per-point path's.** The batch refuses nothing itself: where any row would
 be refused (no assembly, an orientation changed, a conditioning at or near the limit, an
-actuator at or near its ``<limit>``, efforts not finite), where two points are farther apart than
-``command.SUBSTEP`` (intermediate points), where accelerations are asked (their rate term is the
-full path's) or where the transmission has no batched twin, it returns None with the group's
-state as it was, and the caller converts the trajectory point by point: the same refusal, the
-same point number, the same detail. Near a bound means within ``MARGIN`` (relative) of it: the
+actuator at or near its ``<limit>``, efforts not finite), where two points are farther apart
+than ``command.SUBSTEP`` (the per-point path would put intermediate points between them), where
+the transmission has no batched twin or a planar loop's branch flips with whole turns, it
+returns None with the group's state as it was, and the caller converts the trajectory point by
+point: the same refusal, the same point number, the same detail. Accelerations (the rate term
+of the full path) are not batched yet: ``RobotCommand`` converts those point by point. Near a bound means within ``MARGIN`` (relative) of it: the
 batch's answers differ from the per-point path's by a few ulps, and a point that one would
 refuse must never pass the other. Pure: no ROS.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 import math
 from typing import NamedTuple
 
@@ -40,6 +42,7 @@ from linkage_kinematics.loops.command import (
     CommandState,
     SUBSTEP,
 )
+from linkage_kinematics.loops.command_parts import PlanarPart
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, SampleRefused
 import numpy as np
 
@@ -78,16 +81,17 @@ def _convert(group: CommandGroup, positions: np.ndarray, velocities: np.ndarray 
              efforts: np.ndarray | None) -> GroupArrays | None:
     """``convert_many``'s work; None (or a refusal raised) for the per-point path."""
     transmission = group.transmission
-    if not _close_enough(group, positions) or not transmission.batch.supports:
+    if not transmission.batch.supports:
         return None
-    first = group.solve(positions[0].tolist(),
-                        velocities[0].tolist() if velocities is not None else (), (),
-                        efforts[0].tolist() if efforts is not None else ())
     state = group.state()
-    count = positions.shape[0]
-    values = np.tile(np.array(state.values), (count, 1))
-    values[:, group.output_columns] = positions
-    values[0] = state.values
+    # rows: the last accepted point, the intermediate points to the first, then the points
+    last = np.array([state.values[column] for column in group.output_columns])
+    targets = np.vstack([last, _intermediate(group, last, positions[0]), positions])
+    if not _close_enough(group, targets):
+        return None
+    skip = targets.shape[0] - positions.shape[0]
+    values = np.tile(np.array(state.values), (targets.shape[0], 1))
+    values[:, group.output_columns] = targets
     local = values[:, group.columns]
     if group.legs is not None:
         if not group.legs.supports or group.legs.positions_many(local, transmission.batch) \
@@ -95,7 +99,11 @@ def _convert(group: CommandGroup, positions: np.ndarray, velocities: np.ndarray 
             return None
         values[:, group.columns] = local
     else:
-        _positions_in_turn(group, values)
+        if not all(isinstance(part, PlanarPart) and part.positions_many(values)
+                   for part, _ in group.parts):
+            _positions_in_turn(group, values)
+        else:
+            _keep_turns(values, group.lean_turns)
         local = values[:, group.columns]
     linearization = transmission.linearize_many(local)
     if linearization is None or not (
@@ -104,24 +112,35 @@ def _convert(group: CommandGroup, positions: np.ndarray, velocities: np.ndarray 
             and np.all(linearization.measured_conditioning <= CONDITION_LIMIT * (1 - MARGIN))
             and np.all(linearization.command_conditioning <= CONDITION_LIMIT * (1 - MARGIN))):
         return None
-    ratio = linearization.ratio
-    found = GroupArrays(values[:, group.actuator_columns],
+    actuators = values[:, group.actuator_columns]
+    ratio = linearization.ratio[skip:]
+    found = GroupArrays(actuators[skip:],
                         _products(ratio, velocities) if velocities is not None else None,
                         _efforts(ratio, efforts) if efforts is not None else None)
-    if not _within_limits(group, found):
+    # every intermediate point's actuators are checked too (a transmission need not be monotonic)
+    if not (_within_limits(group, GroupArrays(actuators[1:skip], None, None))
+            and _within_limits(group, found)):
         return None
-    # the first point as the per-point path gave it (its intermediate points decided it)
-    found.positions[0] = first.actuators.positions
-    if found.velocities is not None:
-        found.velocities[0] = first.actuators.velocities
-    if found.efforts is not None:
-        found.efforts[0] = first.actuators.efforts
     group.restore(CommandState(tuple(values[-1].tolist()), state.orientations))
     return found
 
 
+def _intermediate(group: CommandGroup, last: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """
+    Return the intermediate points from ``last`` to ``target`` (k, outputs), as ``solve`` does.
+
+    On the straight line between them, a continuous output joint the short way.
+    """
+    changes = [math.remainder(t - v, 2.0 * math.pi) if wraps else t - v
+               for (_, wraps), t, v in zip(group.steps, target.tolist(), last.tolist())]
+    steps = max(1, math.ceil(max(abs(c) / scale for c, (scale, _)
+                                 in zip(changes, group.steps)) / SUBSTEP))
+    return np.array([[b + step / steps * c for b, c in zip(last.tolist(), changes)]
+                     for step in range(1, steps)]).reshape(-1, len(changes))
+
+
 def _close_enough(group: CommandGroup, positions: np.ndarray) -> bool:
-    """Return whether every point after the first is within ``SUBSTEP`` of the one before."""
+    """Return whether every row after the first is within ``SUBSTEP`` of the one before."""
     changes = np.diff(positions, axis=0)
     for place, (scale, wraps) in enumerate(group.steps):
         change = changes[:, place]
@@ -146,6 +165,15 @@ def _positions_in_turn(group: CommandGroup, values: np.ndarray) -> None:
             current[column] = last[column] + remainder(current[column] - last[column], turn)
         values[row] = current
         last = current
+
+
+def _keep_turns(values: np.ndarray, columns: Sequence[int]) -> None:
+    """Keep each turn in ``columns`` within π of the row before, as ``CommandGroup`` keeps it."""
+    turn = 2.0 * math.pi
+    for column in columns:
+        angles = values[:, column]
+        jumps = np.round((angles[:-1] - angles[1:]) / turn)
+        values[1:, column] = angles[1:] + turn * np.cumsum(jumps)
 
 
 def _products(ratio: np.ndarray, rates: np.ndarray) -> np.ndarray:

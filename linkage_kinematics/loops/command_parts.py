@@ -193,6 +193,21 @@ class PlanarPart:
         """Return the solved joints' accelerations at the last ``solve``."""
         return self.derivatives.accelerations(rates, accelerations)
 
+    def positions_many(self, values: np.ndarray) -> bool:
+        """
+        Write the solved joints into every row of ``values`` (N × the whole tree), batched.
+
+        The first row the last accepted point, where the closed form is. False where the rows
+        must be solved one by one (``LoopSolver.positions_many``).
+        """
+        found = self.solver.positions_many([values[:, c] for c in self.known])
+        if found is None:
+            return False
+        by_name = dict(zip(self.plan.passive, found))
+        for name, column in zip(self.names, self.columns):
+            values[:, column] = by_name[name]
+        return True
+
     def restore(self, values: Sequence[float]) -> None:
         """Start the closed form afresh and take it to the known joints' ``values``."""
         self.solver = LoopSolver(self.plan)
