@@ -25,9 +25,10 @@ than ``command.SUBSTEP`` (the per-point path would put intermediate points betwe
 the transmission has no batched twin or a planar loop's branch flips with whole turns, it
 returns None with the group's state as it was, and the caller converts the trajectory point by
 point: the same refusal, the same point number, the same detail. Accelerations (the rate term
-of the full path) are not batched yet: ``RobotCommand`` converts those point by point. Near a bound means within ``MARGIN`` (relative) of it: the
-batch's answers differ from the per-point path's by a few ulps, and a point that one would
-refuse must never pass the other. Pure: no ROS.
+of the full path) are not batched yet: ``RobotCommand`` converts those point by point. Near a
+bound means within ``MARGIN`` (relative) of it: the batch's answers differ from the per-point
+path's by a few ulps, and a point that one would refuse must never pass the other. Pure: no
+ROS.
 """
 
 from __future__ import annotations
