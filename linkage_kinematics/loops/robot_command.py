@@ -15,7 +15,9 @@ output joints given in part, a name given twice, an array neither empty nor one 
 joint, accelerations without velocities, loop outputs without positions; and NaN or inf
 anywhere (``NOT_FINITE``). A trajectory's points are converted in order, continuing from the
 last accepted point, and refused whole, naming the first point refused: the groups are then as
-before it. A forward command is a trajectory of one point.
+before it. A forward command is a trajectory of one point. A trajectory of many is converted
+at once (``command_batch``, numpy) where it can be, with the same answers to a few ulps and
+the same refusals (it declines whatever it would not decide as the per-point path does).
 
 ``plan_command`` builds one from a robot description's loops as the loops node plans them (the
 same measured joints, branches and assemblies), each group's output joints from
