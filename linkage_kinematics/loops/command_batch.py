@@ -37,12 +37,7 @@ from collections.abc import Sequence
 import math
 from typing import NamedTuple
 
-from linkage_kinematics.loops.command import (
-    CommandGroup,
-    CommandRefused,
-    CommandState,
-    SUBSTEP,
-)
+from linkage_kinematics.loops.command import CommandGroup, CommandState, SUBSTEP
 from linkage_kinematics.loops.command_parts import PlanarPart
 from linkage_kinematics.loops.newton import CONDITION_LIMIT, SampleRefused
 import numpy as np
@@ -71,7 +66,7 @@ def convert_many(group: CommandGroup, positions: np.ndarray, velocities: np.ndar
     before = group.state()
     try:
         result = _convert(group, positions, velocities, efforts)
-    except (CommandRefused, SampleRefused):
+    except (SampleRefused, np.linalg.LinAlgError):  # refused, or M singular: decided per point
         result = None
     if result is None:
         group.restore(before)
@@ -80,7 +75,7 @@ def convert_many(group: CommandGroup, positions: np.ndarray, velocities: np.ndar
 
 def _convert(group: CommandGroup, positions: np.ndarray, velocities: np.ndarray | None,
              efforts: np.ndarray | None) -> GroupArrays | None:
-    """``convert_many``'s work; None (or a refusal raised) for the per-point path."""
+    """``convert_many``'s work; None (or SampleRefused raised) for the per-point path."""
     transmission = group.transmission
     if not transmission.batch.supports:
         return None
@@ -95,8 +90,7 @@ def _convert(group: CommandGroup, positions: np.ndarray, velocities: np.ndarray 
     values[:, group.output_columns] = targets
     local = values[:, group.columns]
     if group.legs is not None:
-        if not group.legs.supports or group.legs.positions_many(local, transmission.batch) \
-                is not None:
+        if not (group.legs.supports and group.legs.positions_many(local, transmission.batch)):
             return None
         values[:, group.columns] = local
     else:

@@ -274,35 +274,32 @@ class TransmissionLegs:
             values[columns[place]] = local[place]
         return self.equations.evaluate(local, evaluation, self.cranks)
 
-    def positions_many(self, local: np.ndarray, batch: BatchEquations) -> int | None:
+    def positions_many(self, local: np.ndarray, batch: BatchEquations) -> bool:
         """
         Write every crank into each row of ``local`` (N × the equations' columns), batched.
 
         Each row's cranks start at the same pose, the last accepted point's (``positions``
         solves each leg from where its crank is; the closed form gives the same crank from any
         start); each turning crank is then kept within π of the row before's, from the first
-        row's start, as ``positions`` keeps it. Return None, or the first row no assembly
-        reaches. A sliding crank is not batched here: ``supports`` says so.
+        row's start, as ``positions`` keeps it. False where some row is out of reach (the
+        per-point path names it). A sliding crank is not batched here: ``supports`` says so.
         """
         evaluation = batch.evaluate(local)
-        first: int | None = None
-        for leg, found in self.legs:
+        remainder, turn = math.remainder, 2.0 * math.pi
+        for _, found in self.legs:
             axis, origin = batch.step_axis(found.step, evaluation)
             change = crank_to_sphere_many(origin, axis, batch.point(found.closure, 1, evaluation),
                                           batch.point(found.closure, 0, evaluation),
                                           found.length, found.branch)
-            unreached = np.flatnonzero(np.isnan(change))
-            if unreached.size:
-                first = int(unreached[0]) if first is None else min(first, int(unreached[0]))
-                continue
+            if np.isnan(change).any():
+                return False
             place = found.column
             cranks = (local[:, place] + change / found.multiplier).tolist()
             last = float(local[0, place])
-            remainder, turn = math.remainder, 2.0 * math.pi
             for row, value in enumerate(cranks):
                 last = cranks[row] = last + remainder(value - last, turn)
             local[:, place] = cranks
-        return first
+        return True
 
     @property
     def supports(self) -> bool:
