@@ -125,6 +125,14 @@ class BatchEquations:
             else:
                 self._closures.append(_Closure(ClosureKind.BALL, loop.base,
                                                (sides[0], sides[1])))
+        # per turning step: R₀ and its Rodrigues parts R₀K, R₀K², entry by entry
+        self._turns = {}
+        for number in {step for steps in self._steps.values() for step in steps}:
+            step = tree.steps[number]
+            if step.kind is MotionKind.TURN:
+                k1, k2 = rodrigues_parts(step.axis)
+                self._turns[number] = (step.origin.rotation, multiply(step.origin.rotation, k1),
+                                       multiply(step.origin.rotation, k2))
         self._rows = sum(1 if c.kind is None else 5 if c.kind is ClosureKind.PIN else 3
                          for c in self._closures)
 
@@ -146,16 +154,16 @@ class BatchEquations:
                 o = (pp[0] + shift[0], pp[1] + shift[1], pp[2] + shift[2])
                 value = step.multiplier * values[:, self._column[step.coordinate]] + step.offset
                 w = apply(rp, apply(step.origin.rotation, step.axis))
+                # below the base the parent's rotation is the identity: the child's is its own
+                at_base = step.parent == base
                 if step.kind is MotionKind.TURN:
-                    k1, k2 = rodrigues_parts(step.axis)
-                    b = multiply(step.origin.rotation, k1)
-                    d = multiply(step.origin.rotation, k2)
                     s, t = np.sin(value), 1.0 - np.cos(value)
-                    turned = tuple(r + s * bi + t * di
-                                   for r, bi, di in zip(step.origin.rotation, b, d))
-                    posed[number + 1] = (multiply(rp, turned), o, w, o)
+                    turned = tuple(_turned_entry(r, s, bi, t, di)
+                                   for r, bi, di in zip(*self._turns[number]))
+                    posed[number + 1] = (turned if at_base else multiply(rp, turned), o, w, o)
                 else:
-                    posed[number + 1] = (multiply(rp, step.origin.rotation),
+                    posed[number + 1] = (step.origin.rotation if at_base
+                                         else multiply(rp, step.origin.rotation),
                                          (o[0] + value * w[0], o[1] + value * w[1],
                                           o[2] + value * w[2]), w, o)
             frames[base] = posed
@@ -249,3 +257,13 @@ class BatchEquations:
                                                              + w[2] * n1[2])
             row += 5 if pin else 3
         return result
+
+
+def _turned_entry(r: float, s: np.ndarray, b: float, t: np.ndarray, d: float) -> _Batch:
+    """Return r + s·b + t·d, its zero terms left out (the same bits: adding 0 changes none)."""
+    entry = r
+    if b:
+        entry = entry + s * b
+    if d:
+        entry = entry + t * d
+    return entry
