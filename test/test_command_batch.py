@@ -11,8 +11,10 @@ from the last), the batch taken (not declined) for every group, and the state af
 per-point path's (the next command gives the same). A trajectory the per-point path refuses is
 refused whole with the same reason, point number and detail, the state as before: ramps out of
 reach, past a singular configuration, past an actuator's limit, with NaN or a short array late
-in the trajectory. The 50-digit checks stay test_command.py's (the batch's answers are the
-per-point path's to 1e-14).
+in the trajectory. Under it, the batched closure Jacobian and transmission (orientations,
+conditionings, M) are the per-sample ones within 1e-14 at poses around each robot's assembly.
+The 50-digit checks stay test_command.py's (the batch's answers are the per-point path's to
+1e-14).
 """
 
 from __future__ import annotations
@@ -138,3 +140,30 @@ def test_a_refused_trajectory_is_refused_as_point_by_point(robot, points, reason
         assert found == _per_point_refusal(single.robot, names, points)
         assert found[0] is reason
     assert [command.state() for command in batched.commands] == before
+
+
+@pytest.mark.parametrize('robot', list(MOTIONS))
+def test_the_batched_jacobian_and_transmission_are_the_per_sample_ones(robot):
+    rng = np.random.default_rng(30)
+    for command in transmission_robots.build(robot).commands:
+        transmission = command.transmission
+        equations = transmission.equations
+        start = np.array([command.state().values[i] for i in equations.coordinates])
+        poses = start + 0.05 * rng.standard_normal((40, len(start)))
+        batch = transmission.batch
+        assert batch.supports
+        jacobians = batch.jacobian(batch.evaluate(poses))
+        many = transmission.linearize_many(poses)
+        for row, pose in enumerate(poses.tolist()):
+            exact = np.array(equations.jacobian(equations.evaluate(pose)))
+            assert np.max(np.abs(jacobians[row] - exact)) <= TOLERANCE * np.max(np.abs(exact))
+            one = transmission.linearize(pose)
+            assert (one.measured_orientation, one.command_orientation) == (
+                many.measured_orientation[row], many.command_orientation[row])
+            for found, exact_value in ((many.measured_conditioning[row],
+                                        one.measured_conditioning),
+                                       (many.command_conditioning[row],
+                                        one.command_conditioning)):
+                assert abs(found - exact_value) <= TOLERANCE * exact_value
+            ratio = np.array(one.ratio)
+            assert np.max(np.abs(many.ratio[row] - ratio)) <= TOLERANCE * np.max(np.abs(ratio))
