@@ -478,21 +478,26 @@ class _Square:
             if size == 1:
                 det = matrix[:, 0, 0]
                 inverse_matrix = 1.0 / matrix
+                conditioning = np.ones(count)
             elif size == 2:
                 a, b, c, d = (matrix[:, 0, 0], matrix[:, 0, 1], matrix[:, 1, 0],
                               matrix[:, 1, 1])
                 det = a * d - b * c
-                inverse_matrix = np.stack([np.stack([d / det, -b / det], axis=1),
-                                           np.stack([-c / det, a / det], axis=1)], axis=1)
+                inverse_matrix = np.empty((count, 2, 2))
+                p, q, u, v = d / det, -b / det, -c / det, a / det
+                inverse_matrix[:, 0, 0], inverse_matrix[:, 0, 1] = p, q
+                inverse_matrix[:, 1, 0], inverse_matrix[:, 1, 1] = u, v
+                # ``factor``'s own κ₁ of a 2×2, term by term
+                (r0, r1), (s0, s1) = self.row_scale, self.column_scale
+                a, b, c, d, p, q, u, v = map(np.abs, (a, b, c, d, p, q, u, v))
+                conditioning = (np.maximum((a * r0 + c * r1) * s0, (b * r0 + d * r1) * s1)
+                                * np.maximum((p / s0 + u / s1) / r0, (q / s0 + v / s1) / r1))
             else:
                 det = np.linalg.det(matrix)
                 inverse_matrix = np.linalg.inv(np.where((det == 0.0)[:, None, None],
                                                         np.eye(size), matrix))
-            rows = np.array(self.row_scale)[:, None]
-            scales = np.array(self.column_scale)
-            if size == 1:
-                conditioning = np.ones(count)
-            else:
+                rows = np.array(self.row_scale)[:, None]
+                scales = np.array(self.column_scale)
                 # κ₁ of diag(rows)·A·diag(scales): the largest column sums of it and its inverse
                 norm = np.max(np.sum(np.abs(matrix) * rows * scales, axis=1), axis=1)
                 norm_inverse = np.max(np.sum(np.abs(inverse_matrix) / scales[:, None] / rows.T,
