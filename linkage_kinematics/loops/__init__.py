@@ -18,7 +18,8 @@ Pure (numpy, urdf_parser_py, lxml, PyYAML; no ROS); every description comes in p
   sample);
 - the general closure: ``tree`` (the kinematic tree: coordinates, overrides, mimics),
   ``frames`` (its moving frames per sample), ``spatial`` (rigid motions in plain floats),
-  ``equations`` (the closures' residuals, exact Jacobian and its rate), ``linear`` (small LU
+  ``equations`` (the closures' residuals, exact Jacobian and its rate), ``batch_equations``
+  (the same Jacobian at many configurations at once, numpy), ``linear`` (small LU
   factors), ``structure`` (groups, degrees of freedom, idle freedoms, determinacy),
   ``reduction`` (welded rods and collinear pins rewritten smaller), ``assembly`` (the assembled
   pose nearest a start), ``newton`` (a group closed per sample: Newton to rounding, its
@@ -29,8 +30,8 @@ Pure (numpy, urdf_parser_py, lxml, PyYAML; no ROS); every description comes in p
   ∂m/∂o, efforts), ``robot_transmission`` (a robot's, with names: the output joints' efforts),
   ``transmission_range`` (the mechanical advantage over the reachable range, for the checker),
   ``command`` (a group's command direction, its refusals), ``command_parts`` (one command group
-  by its method) and ``robot_command`` (a robot's command direction, with names: what the relay
-  converts);
+  by its method), ``command_batch`` (a trajectory's points for one group at once, numpy) and
+  ``robot_command`` (a robot's command direction, with names: what the relay converts);
 - following: ``intake`` (the one sample intake of both measured modes, and the one set of
   reasons a message is dropped for) and ``follower`` (a JointState in, every passive loop joint
   out, or why the message was dropped).
