@@ -47,7 +47,7 @@ from linkage_kinematics.bag.reader import iter_messages
 from linkage_kinematics.loops.command import JointPoint
 from linkage_kinematics.run.configuration import build_relay_configuration
 from linkage_kinematics.run.parameter_specs import relay_parameter_specs
-from linkage_kinematics.run.relay import read_relay
+from linkage_kinematics.run.relay import read_relay, Relay
 from linkage_kinematics.shared.cdr import encode_cdr, FixedShapeEncoder
 from linkage_kinematics.shared.command_cdr import (
     decode_float64_array,
@@ -88,7 +88,8 @@ def parameters() -> dict[str, object]:
     }
 
 
-def _relay():
+def relay_for_biped() -> Relay:
+    """Return the relay (``run.relay.Relay``) of the biped with the bench's parameters."""
     values = {spec.name: spec.default for spec in relay_parameter_specs()}
     values.update(parameters())
     return read_relay(values['robot_description'], build_relay_configuration(values))
@@ -108,8 +109,9 @@ def _swing(fraction: float, place: int) -> tuple[float, float, float]:
             -amplitude * turn * turn * math.sin(angle))
 
 
-def _trajectory_bytes(rates: bool) -> bytes:
-    """Return a 1000-point trajectory at 100 Hz over one swing of every joint, as bytes."""
+def trajectory_points(velocities: bool, accelerations: bool
+                      ) -> tuple[list[str], list[TrajectoryPoint]]:
+    """Return a 1000-point trajectory at 100 Hz over one swing of every joint: names, points."""
     count = len(JOINTS) * len(biped_bench.SIDES)
     points = []
     for index in range(TRAJECTORY_POINTS):
@@ -117,9 +119,16 @@ def _trajectory_bytes(rates: bool) -> bytes:
         sec, nanosec = divmod((index + 1) * TRAJECTORY_PERIOD_NS, 1_000_000_000)
         points.append(TrajectoryPoint(
             tuple(value for value, _, _ in motion),
-            tuple(rate for _, rate, _ in motion) if rates else (),
-            tuple(change for _, _, change in motion) if rates else (), (), sec, nanosec))
-    return encode_joint_trajectory(0, 0, '', parameters()['commands.joints'], points)
+            tuple(rate for _, rate, _ in motion) if velocities else (),
+            tuple(change for _, _, change in motion) if accelerations else (), (), sec,
+            nanosec))
+    return list(parameters()['commands.joints']), points
+
+
+def _trajectory_bytes(velocities: bool, accelerations: bool) -> bytes:
+    """Return ``trajectory_points`` as a JointTrajectory's bytes."""
+    names, points = trajectory_points(velocities, accelerations)
+    return encode_joint_trajectory(0, 0, '', names, points)
 
 
 def path_run(quick: bool, repetitions: int) -> str:
@@ -128,7 +137,7 @@ def path_run(quick: bool, repetitions: int) -> str:
     commands = [encode_cdr(Float64MultiArray(data=[_swing(step * 1e-4, place)[0]
                                                    for place in range(12)]))
                 for step in range(1000)]
-    relay = _relay()
+    relay = relay_for_biped()
     encoder = FixedShapeEncoder(Float64MultiArray(data=[0.0] * 12), ['data'])
     ratios = [JOINTS[name.split('_', 1)[1]][1] for name in parameters()['commands.joints']]
 
@@ -158,9 +167,9 @@ def path_run(quick: bool, repetitions: int) -> str:
              f'{hand_ns * 1e-3:.0f} µs', '', '']]
     first_point_ms = TRAJECTORY_PERIOD_NS * 1e-6
     verdicts = []
-    for label, with_rates in (('positions, velocities, accelerations', True),
-                              ('positions', False)):
-        data = _trajectory_bytes(with_rates)
+    for label, rates in (('positions, velocities, accelerations', (True, True)),
+                         ('positions, velocities', (True, False)), ('positions', (False, False))):
+        data = _trajectory_bytes(*rates)
         totals = []
         for _ in range(max(1, repetitions // (2 if quick else 1))):
             relay.command.reset()

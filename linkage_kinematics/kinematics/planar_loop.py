@@ -33,6 +33,7 @@ import operator
 
 from linkage_kinematics.kinematics.continuation import check_branch, continued_branch
 from linkage_kinematics.kinematics.decimal_arithmetic import DIGITS
+from linkage_kinematics.kinematics.drive import DriveLaw
 from linkage_kinematics.kinematics.geometry import (
     FourBar,
     from_exact,
@@ -42,7 +43,8 @@ from linkage_kinematics.kinematics.geometry import (
     wrap_angle,
 )
 from linkage_kinematics.kinematics.prismatic_loop import PrismaticLoop
-from linkage_kinematics.kinematics.solver import DeadPointError, solve_at_rates
+from linkage_kinematics.kinematics.solver import DeadPointError, solve_at_rates, solve_many
+import numpy as np
 
 __all__ = [
     'branch_of', 'continued_branch_of', 'driven_loop', 'DrivenLoop', 'joint_points', 'JointKind',
@@ -245,11 +247,41 @@ class DrivenLoop:
                             wrap_angle(-rocker))),
             in_joint_order((rate, omega_ab - rate, omega_bc - omega_ab, -omega_bc)), branch)
 
+    def positions_many(self, values: np.ndarray, branch: int) -> tuple[np.ndarray, ...] | None:
+        """
+        Return ``solve``'s coordinates at many values of the known joint, a motion's points.
+
+        ``branch``: the branch at ``values[0]``; each point's by ``continued_branch`` from
+        there (a motion's branch depends on where it is, not on how it got there). The same
+        closed form over arrays (``solver.solve_many``), so the same angles to a few ulps.
+        None where any point is refused (out of reach, at a dead point) or the loop is
+        prismatic: the caller then solves point by point, which names the refusal.
+        """
+        if self._prismatic is not None:
+            return None
+        branches = np.asarray(continued_branch(self._linkage, float(values[0]), branch, values))
+        try:
+            state = solve_many(self._linkage, values, DriveLaw(0.0), branches)
+        except (DeadPointError, UnreachableError):
+            return None
+        turn = self._turn
+        coupler = state.gamma + turn - self._coupler_angle
+        rocker = -state.beta + turn - self._rocker_angle
+        return self._in_joint_order((values, _wrap_many(coupler - values),
+                                     _wrap_many(rocker - coupler), _wrap_many(-rocker)))
+
     def continued_branch(self, value_from: float, branch: int, value_to: float) -> int:
         """Return the branch at ``value_to`` as ``continued_branch_of`` does for this loop."""
         if self._prismatic is not None:
             return self._prismatic.continued_branch(value_from, branch, value_to)
         return int(continued_branch(self._linkage, value_from, branch, value_to))
+
+
+def _wrap_many(angles: np.ndarray) -> np.ndarray:
+    """Return ``wrap_angle`` of each angle: to (−π, π]."""
+    turn = 2.0 * math.pi
+    wrapped = angles - turn * np.round(angles / turn)
+    return np.where(wrapped <= -math.pi, wrapped + turn, wrapped)
 
 
 @lru_cache(maxsize=_CACHE_SIZE)

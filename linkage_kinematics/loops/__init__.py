@@ -18,25 +18,25 @@ Pure (numpy, urdf_parser_py, lxml, PyYAML; no ROS); every description comes in p
   sample);
 - the general closure: ``tree`` (the kinematic tree: coordinates, overrides, mimics),
   ``frames`` (its moving frames per sample), ``spatial`` (rigid motions in plain floats),
-  ``equations`` (the closures' residuals, exact Jacobian and its rate), ``rods`` (a rod
-  written as one distance: a universal joint's rod found in the tree, or any ``Distance``),
-  ``linear`` (small LU factors), ``structure`` (groups, degrees of freedom, idle freedoms,
-  determinacy), ``reduction`` (welded rods and collinear pins rewritten smaller), ``assembly``
-  (the assembled pose nearest a start), ``square_system`` (the square system Newton solves:
-  independent rows, idle rows, scales, residual bounds), ``continuation`` (Newton to rounding,
-  continued from the last solution in predicted substeps), ``refusals`` (why a group refuses
-  a sample or a plan, and the conditioning limit), ``newton`` (a group closed per sample: a
-  closed form or the continuation, velocities, refusals), ``derivatives`` (on request: the
-  sensitivity, accelerations, the distance to a singular configuration), ``closed_forms``
-  (the planar five-bar, a crank–rod–ball leg's inverse, the delta's three spheres, a
-  universal joint's and a ball's angles) and ``reach`` (each known joint's reach, for the
-  checker);
+  ``equations`` (the closures' residuals, exact Jacobian and its rate), ``batch_equations``
+  (the same Jacobian at many configurations at once, numpy), ``rods`` (a rod written as one
+  distance: a universal joint's rod found in the tree, or any ``Distance``), ``linear`` (small
+  LU factors), ``structure`` (groups, degrees of freedom, idle freedoms, determinacy),
+  ``reduction`` (welded rods and collinear pins rewritten smaller), ``assembly`` (the assembled
+  pose nearest a start), ``square_system`` (the square system Newton solves: independent rows,
+  idle rows, scales, residual bounds), ``continuation`` (Newton to rounding, continued from the
+  last solution in predicted substeps), ``refusals`` (why a group refuses a sample or a plan,
+  and the conditioning limit), ``newton`` (a group closed per sample: a closed form or the
+  continuation, velocities, refusals), ``derivatives`` (on request: the sensitivity,
+  accelerations, the distance to a singular configuration), ``closed_forms`` (the planar
+  five-bar, a crank–rod–ball leg's inverse, the delta's three spheres, a universal joint's and
+  a ball's angles) and ``reach`` (each known joint's reach, for the checker);
 - the transmission: ``transmission`` (a group between its actuators and output joints: M =
   ∂m/∂o, efforts), ``robot_transmission`` (a robot's, with names: the output joints' efforts),
   ``transmission_range`` (the mechanical advantage over the reachable range, for the checker),
   ``command`` (a group's command direction, its refusals), ``command_parts`` (one command group
-  by its method) and ``robot_command`` (a robot's command direction, with names: what the relay
-  converts);
+  by its method), ``command_batch`` (a trajectory's points for one group at once, numpy) and
+  ``robot_command`` (a robot's command direction, with names: what the relay converts);
 - following: ``intake`` (the one sample intake of both measured modes, and the one set of
   reasons a message is dropped for) and ``follower`` (a JointState in, every passive loop joint
   out, or why the message was dropped).

@@ -49,6 +49,7 @@ from linkage_kinematics.loops.spatial import (
 )
 from linkage_kinematics.loops.structure import ClosureGroup, five_bar_cycle, five_bar_pair
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind
+import numpy as np
 
 # How far beyond ±1 rounding may push the cosine of a reachable angle: a target farther out
 # than this is out of reach (the caller refuses the sample).
@@ -173,6 +174,27 @@ def crank_to_sphere(origin: Vector, axis: Vector, point: Vector, center: Vector,
     b = 2.0 * dot(g, normal)
     c = dot(g, g) + dot(radial, radial) - radius * radius
     return math.atan2(b, a) + branch * _acos(c / math.hypot(a, b))
+
+
+def crank_to_sphere_many(origin: tuple, axis: tuple, point: tuple, center: tuple,
+                         radius: float, branch: int) -> np.ndarray:
+    """
+    Return ``crank_to_sphere`` at many poses: each vector a tuple of arrays over them.
+
+    The same formulas; NaN where no turn reaches the sphere (the caller refuses those).
+    """
+    v = subtract(point, origin)
+    along = scale(dot(axis, v), axis)
+    radial = subtract(v, along)
+    normal = cross(axis, v)
+    g = subtract(center, add(origin, along))
+    a = 2.0 * dot(g, radial)
+    b = 2.0 * dot(g, normal)
+    c = dot(g, g) + dot(radial, radial) - radius * radius
+    with np.errstate(divide='ignore', invalid='ignore'):
+        ratio = c / np.hypot(a, b)
+    ratio = np.where(np.abs(ratio) > 1.0 + COSINE_SLACK, np.nan, np.clip(ratio, -1.0, 1.0))
+    return np.arctan2(b, a) + branch * np.arccos(ratio)
 
 
 def slide_to_sphere(point: Vector, axis: Vector, center: Vector, radius: float,

@@ -15,7 +15,7 @@ ankle's two legs are two groups then, each solved alone by ``command_parts``):
   Jacobian at the solution (``transmission.Transmission.linearize``, which the refusals below
   need anyway): the power balance τ_mᵀ·ṁ = τ_oᵀ·q̇_o holds to rounding with one M;
 * **accelerations** with the Jacobian's rate term, q̈_U = −A⁻¹·(J_o·q̈_o + J̇·q̇)
-  (``newton.Derivatives``), and the passive joints' velocities from the solvers, where asked
+  (``derivatives.Derivatives``), and the passive joints' velocities from the solvers, where asked
   (``passive=True`` or accelerations given: the full path). Otherwise only what the
   transmission's equations need is solved (the lean path: a leg's crank without its rod's
   angles), which is what a relay to the actuators sends.
@@ -33,7 +33,7 @@ as it was (every group restored to its last accepted point), never NaN:
 
 * ``UNREACHABLE``: no assembly reaches the output joints (or a point between);
 * ``SINGULAR``: the conditioning of either direction's system (``transmission.Linearization``)
-  above ``newton.CONDITION_LIMIT`` (the answer would lose 1e-3), or its orientation (the sign of
+  above ``refusals.CONDITION_LIMIT`` (the answer would lose 1e-3), or its orientation (the sign of
   its determinant) changed since the last accepted point: the motion crossed a singular
   configuration, where the node's measured direction would refuse the samples or jump to
   another assembly (a change point of a planar loop too: the general transmission is singular
@@ -134,7 +134,9 @@ class CommandState(NamedTuple):
     orientations: tuple[int, int]
 
 
-class _Limits(NamedTuple):
+class Limits(NamedTuple):
+    """An actuator's URDF <limit>: position range, velocity and effort bounds (None: none)."""
+
     position: tuple[float, float] | None
     velocity: float | None
     effort: float | None
@@ -162,6 +164,12 @@ class CommandGroup:
     coordinates) and, for the planar closed forms, the robot's planar ``Loop``s
     (``plan.find_loops``; those of other groups are ignored). PlanError (one line) where the
     assembled pose is a singular configuration of either direction.
+
+    What ``command_batch`` converts a trajectory with, prepared once: ``parts`` (each command
+    group's part and its outputs' places), ``legs`` (the ankle's ``TransmissionLegs``, or None),
+    the tree columns of the ``output_columns``, ``actuator_columns``, the transmission's
+    ``columns`` and the ``lean_turns``; per output its ``steps`` (scale, short way) and per
+    actuator its ``limits``.
     """
 
     def __init__(self, tree: KinematicTree, transmission: Transmission,
@@ -172,41 +180,41 @@ class CommandGroup:
         self.actuators = transmission.actuators
         self.outputs = transmission.outputs
         self.passive = tuple(name for name in transmission.solved if name not in self.outputs)
-        self._parts = [(command_part(tree, subgroup, structure, values, planar_loops),
-                        [self.outputs.index(name) for name in structure.known])
-                       for subgroup, structure in transmission.command_groups]
+        self.parts = [(command_part(tree, subgroup, structure, values, planar_loops),
+                       [self.outputs.index(name) for name in structure.known])
+                      for subgroup, structure in transmission.command_groups]
         index = tree.index
-        self._outputs = [index[name] for name in self.outputs]
-        self._actuators = [index[name] for name in self.actuators]
+        self.output_columns = [index[name] for name in self.outputs]
+        self.actuator_columns = [index[name] for name in self.actuators]
         self._passive = [index[name] for name in self.passive]
-        self._columns = [index[name] for name in transmission.columns]
+        self.columns = [index[name] for name in transmission.columns]
         self._turns = [index[name] for name in transmission.solved
                        if tree.coordinates[index[name]].kind is MotionKind.TURN]
         # the turns the lean path writes (the others keep their last value exactly)
-        lean = {column for part, _ in self._parts for column in part.lean_columns}
-        self._lean_turns = [column for column in self._turns if column in lean]
+        lean = {column for part, _ in self.parts for column in part.lean_columns}
+        self.lean_turns = [column for column in self._turns if column in lean]
         # the ankle's lean path (command_parts.TransmissionLegs), None for other groups
-        self._legs = TransmissionLegs.of([part for part, _ in self._parts],
-                                         transmission.equations, self._columns)
+        self.legs = TransmissionLegs.of([part for part, _ in self.parts],
+                                        transmission.equations, self.columns)
         # whole-tree values → a tuple of some of them, in one C call per point
-        self._get_actuators = getter(self._actuators)
+        self._get_actuators = getter(self.actuator_columns)
         self._get_passive = getter(self._passive)
-        self._get_columns = getter(self._columns)
-        self._get_outputs = getter(self._outputs)
+        self._get_columns = getter(self.columns)
+        self._get_outputs = getter(self.output_columns)
         joints = {joint.name: joint for joint in tree.joint_above.values()}
-        self._steps = []  # per output: its scale, and whether it goes the short way
+        self.steps = []  # per output: its scale, and whether it goes the short way
         for name in self.outputs:
             coordinate = tree.coordinates[index[name]]
             joint = joints.get(coordinate.joint)
             wraps = coordinate.kind is MotionKind.TURN and (
                 joint is None or joint.joint_type is not JointType.REVOLUTE
                 or coordinate.name != coordinate.joint)
-            self._steps.append((transmission.size if coordinate.kind is MotionKind.SLIDE
-                                else 1.0, wraps))
-        self._limits = [_Limits(None, None, None) if name not in joints else _Limits(
+            self.steps.append((transmission.size if coordinate.kind is MotionKind.SLIDE
+                               else 1.0, wraps))
+        self.limits = [Limits(None, None, None) if name not in joints else Limits(
             joints[name].position_limits, joints[name].velocity_limit,
             joints[name].effort_limit) for name in self.actuators]
-        linearization = transmission.linearize([values[i] for i in self._columns])
+        linearization = transmission.linearize([values[i] for i in self.columns])
         if linearization.command_orientation == 0 or linearization.measured_orientation == 0:
             raise PlanError(f'group {self.name}: the assembled pose is a singular '
                             'configuration of the transmission')
@@ -217,7 +225,7 @@ class CommandGroup:
     @property
     def kinds(self) -> tuple[GroupKind, ...]:
         """Return how each group the outputs make is solved (``transmission.command_groups``)."""
-        return tuple(part.kind for part, _ in self._parts)
+        return tuple(part.kind for part, _ in self.parts)
 
     def reset(self) -> None:
         """Start again from the assembled pose."""
@@ -237,7 +245,7 @@ class CommandGroup:
 
     def restore(self, state: CommandState) -> None:
         """Put every solver back at a state ``state`` returned."""
-        for part, _ in self._parts:
+        for part, _ in self.parts:
             part.restore(state.values)
         self._state = state
 
@@ -263,9 +271,9 @@ class CommandGroup:
         before = self._state
         last = self._get_outputs(before.values)
         changes = [math.remainder(target - value, 2.0 * math.pi) if wraps else target - value
-                   for (_, wraps), target, value in zip(self._steps, positions, last)]
+                   for (_, wraps), target, value in zip(self.steps, positions, last)]
         steps = max(1, math.ceil(max(abs(c) / scale for c, (scale, _)
-                                     in zip(changes, self._steps)) / SUBSTEP))
+                                     in zip(changes, self.steps)) / SUBSTEP))
         try:
             for step in range(1, steps):
                 fraction = step / steps
@@ -281,15 +289,15 @@ class CommandGroup:
                      ) -> tuple[list[float], list[float]]:
         """Solve every part into ``values``; return the rates and accelerations (full path)."""
         if not full:
-            for part, _ in self._parts:
+            for part, _ in self.parts:
                 part.positions(values)
             return [], []
         rates = [0.0] * len(values)
         found_accelerations = [0.0] * len(values)
         given = velocities or (0.0,) * len(self.outputs)
-        for column, rate in zip(self._outputs, given):
+        for column, rate in zip(self.output_columns, given):
             rates[column] = rate
-        for part, places in self._parts:
+        for part, places in self.parts:
             known_rates = [given[p] for p in places]
             found, speeds = part.solve(values, known_rates)
             for column, value, speed in zip(part.columns, found, speeds):
@@ -306,12 +314,12 @@ class CommandGroup:
         """Solve one point from the last; on success it becomes the last accepted one."""
         last = self._state
         values = list(last.values)
-        for column, value in zip(self._outputs, positions):
+        for column, value in zip(self.output_columns, positions):
             values[column] = value
         evaluation: Evaluation | None = None  # the legs give the equations posed
         try:
-            if self._legs is not None and not full:
-                evaluation = self._legs.positions(values, last.values)
+            if self.legs is not None and not full:
+                evaluation = self.legs.positions(values, last.values)
                 rates, found_accelerations = [], []
             else:
                 rates, found_accelerations = self._solve_parts(values, velocities,
@@ -324,7 +332,7 @@ class CommandGroup:
                       else f'group {self.name}, {refusal}')
             raise CommandRefused(reason, detail) from None
         remainder, turn = math.remainder, 2.0 * math.pi
-        for column in self._turns if full else self._lean_turns:
+        for column in self._turns if full else self.lean_turns:
             before = last.values[column]
             values[column] = before + remainder(values[column] - before, turn)
         linearization = self.transmission.linearize(self._get_columns(values), evaluation)
@@ -370,7 +378,7 @@ class CommandGroup:
         return found
 
     def _check_limits(self, actuators: JointPoint) -> None:
-        for place, (name, limits) in enumerate(zip(self.actuators, self._limits)):
+        for place, (name, limits) in enumerate(zip(self.actuators, self.limits)):
             position = actuators.positions[place]
             if limits.position is not None and not (
                     limits.position[0] <= position <= limits.position[1]):

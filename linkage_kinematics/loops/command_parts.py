@@ -19,8 +19,8 @@ One command group (a group the output joints known make) solved by the method it
 Each part: ``positions`` (the lean path: at least the joints the transmission's equations
 need, written into a whole-tree value list; ``lean_columns`` are those it writes),
 ``solve`` (every solved joint's position and velocity), ``accelerations``
-(``newton.Derivatives``, after ``solve``), ``restore`` (back to a pose). Each raises
-``newton.SampleRefused``. Pure: no ROS.
+(``derivatives.Derivatives``, after ``solve``), ``restore`` (back to a pose). Each raises
+``refusals.SampleRefused``. Pure: no ROS.
 """
 
 from __future__ import annotations
@@ -30,7 +30,8 @@ import math
 
 from linkage_kinematics.kinematics.planar_loop import branch_of, driven_loop
 from linkage_kinematics.loops.assembly import Assembly
-from linkage_kinematics.loops.closed_forms import LegPositions, OutOfReach
+from linkage_kinematics.loops.batch_equations import BatchEquations
+from linkage_kinematics.loops.closed_forms import crank_to_sphere_many, LegPositions, OutOfReach
 from linkage_kinematics.loops.derivatives import Derivatives
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations
 from linkage_kinematics.loops.newton import GroupSolver
@@ -46,6 +47,7 @@ from linkage_kinematics.loops.structure import (
     reducible_rods,
 )
 from linkage_kinematics.loops.tree import KinematicTree, MotionKind
+import numpy as np
 
 # A planar chain's closed form must reproduce the assembled pose to this (rad, or m ÷ size).
 SAME_POSE = 1e-9
@@ -187,6 +189,21 @@ class PlanarPart:
         """Return the solved joints' accelerations at the last ``solve``."""
         return self.derivatives.accelerations(rates, accelerations)
 
+    def positions_many(self, values: np.ndarray) -> bool:
+        """
+        Write the solved joints into every row of ``values`` (N × the whole tree), batched.
+
+        The first row the last accepted point, where the closed form is. False where the rows
+        must be solved one by one (``LoopSolver.positions_many``).
+        """
+        found = self.solver.positions_many([values[:, c] for c in self.known])
+        if found is None:
+            return False
+        by_name = dict(zip(self.plan.passive, found))
+        for name, column in zip(self.names, self.columns):
+            values[:, column] = by_name[name]
+        return True
+
     def restore(self, values: Sequence[float]) -> None:
         """Start the closed form afresh and take it to the known joints' ``values``."""
         self.solver = LoopSolver(self.plan)
@@ -252,6 +269,38 @@ class TransmissionLegs:
                 local[place] = last + math.remainder(local[place] - last, 2.0 * math.pi)
             values[columns[place]] = local[place]
         return self.equations.evaluate(local, evaluation, self.cranks)
+
+    def positions_many(self, local: np.ndarray, batch: BatchEquations) -> bool:
+        """
+        Write every crank into each row of ``local`` (N × the equations' columns), batched.
+
+        Each row's cranks start at the same pose, the last accepted point's (``positions``
+        solves each leg from where its crank is; the closed form gives the same crank from any
+        start); each turning crank is then kept within π of the row before's, from the first
+        row's start, as ``positions`` keeps it. False where some row is out of reach (the
+        per-point path names it). A sliding crank is not batched here: ``supports`` says so.
+        """
+        evaluation = batch.evaluate(local)
+        remainder, turn = math.remainder, 2.0 * math.pi
+        for _, found in self.legs:
+            axis, origin = batch.step_axis(found.step, evaluation)
+            change = crank_to_sphere_many(origin, axis, batch.point(found.closure, 1, evaluation),
+                                          batch.point(found.closure, 0, evaluation),
+                                          found.length, found.branch)
+            if np.isnan(change).any():
+                return False
+            place = found.column
+            cranks = (local[:, place] + change / found.multiplier).tolist()
+            last = float(local[0, place])
+            for row, value in enumerate(cranks):
+                last = cranks[row] = last + remainder(value - last, turn)
+            local[:, place] = cranks
+        return True
+
+    @property
+    def supports(self) -> bool:
+        """Return whether ``positions_many`` can batch these legs: every crank turns."""
+        return all(found.turn for _, found in self.legs)
 
 
 def _turned(value: float, near: float, tree: KinematicTree, column: int) -> float:

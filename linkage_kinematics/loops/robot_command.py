@@ -15,7 +15,9 @@ output joints given in part, a name given twice, an array neither empty nor one 
 joint, accelerations without velocities, loop outputs without positions; and NaN or inf
 anywhere (``NOT_FINITE``). A trajectory's points are converted in order, continuing from the
 last accepted point, and refused whole, naming the first point refused: the groups are then as
-before it. A forward command is a trajectory of one point.
+before it. A forward command is a trajectory of one point. A trajectory of many is converted
+at once (``command_batch``, numpy) where it can be, with the same answers to a few ulps and
+the same refusals (it declines whatever it would not decide as the per-point path does).
 
 ``plan_command`` builds one from a robot description's loops as the loops node plans them (the
 same measured joints, branches and assemblies), each group's output joints from
@@ -36,6 +38,7 @@ from linkage_kinematics.loops.command import (
     getter,
     JointPoint,
 )
+from linkage_kinematics.loops.command_batch import convert_many
 from linkage_kinematics.loops.plan import RobotLoops
 from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
 from linkage_kinematics.loops.structure import analyse
@@ -44,6 +47,7 @@ from linkage_kinematics.loops.transmission import (
     Transmission,
     TransmissionError,
 )
+import numpy as np
 
 # lists of names whose conversion is kept
 LAYOUTS = 64
@@ -120,13 +124,16 @@ class RobotCommand:
         if problems:
             return CommandRefused(CommandRefusal.JOINTS, '; '.join(problems))
         commanded = tuple(sorted(given))
+        passing_places = [names.index(name) for name in passing]
+        output_places = tuple([names.index(name) for name in self.groups[number].outputs]
+                              for number in commanded)
         return _Layout(
             tuple(passing) + tuple(name for number in commanded
                                    for name in self.groups[number].actuators),
-            commanded, getter([names.index(name) for name in passing]) if passing else None,
-            tuple((self.groups[number],
-                   getter([names.index(name) for name in self.groups[number].outputs]))
-                  for number in commanded))
+            commanded, getter(passing_places) if passing else None,
+            tuple((self.groups[number], getter(places))
+                  for number, places in zip(commanded, output_places)),
+            passing_places, output_places)
 
     def _check(self, names: Sequence[str], point: JointPoint, commanded: bool) -> None:
         for what, array in (('positions', point.positions), ('velocities', point.velocities),
@@ -166,15 +173,23 @@ class RobotCommand:
         Return every point converted, in order, for ``self.names(names)``.
 
         CommandRefused whole, naming the first point refused (0-based); the groups' states are
-        then as before the trajectory.
+        then as before the trajectory. Converted at once where ``command_batch`` can, else
+        point by point: the same answers to a few ulps, the same refusals.
         """
         layout = self._layout(names)
-        for number, point in enumerate(points):
+        stacked = _stacked(len(names), points)
+        # every point's arrays alike and finite: the first point's check is every point's
+        for number, point in enumerate(points[:1] if stacked is not None else points):
             try:
                 self._check(names, point, bool(layout.commanded))
             except CommandRefused as refusal:
                 raise _at_point(refusal, number) from None
         states = [self.groups[number].state() for number in layout.commanded]
+        if stacked is not None and stacked[2] is None and len(points) > 1:
+            batched = self._batched(layout, stacked, len(points))
+            if batched is not None:
+                return batched
+            self._restore(layout, states)
         converted = []
         for number, point in enumerate(points):
             try:
@@ -183,6 +198,30 @@ class RobotCommand:
                 self._restore(layout, states)
                 raise _at_point(refusal, number) from None
         return tuple(converted)
+
+    def _batched(self, layout: _Layout, stacked: Sequence[np.ndarray | None],
+                 count: int) -> tuple[JointPoint, ...] | None:
+        """
+        Return every point converted by ``command_batch``, or None: the per-point path then.
+
+        ``stacked``: ``_stacked``'s arrays, without accelerations (their rate term is the
+        per-point path's). None where any group's batch declines (a point it would not decide
+        as the per-point path does); the groups may then have moved (the caller restores them).
+        """
+        out: list[list[np.ndarray]] = [[array[:, layout.passing_places]]
+                                       if array is not None else [] for array in stacked]
+        for (group, _), places in zip(layout.groups, layout.output_places):
+            found = convert_many(group, *(array[:, places] if array is not None else None
+                                          for array in (stacked[0], stacked[1], stacked[3])))
+            if found is None:
+                return None
+            for field, array in ((0, found.positions), (1, found.velocities),
+                                 (3, found.efforts)):
+                if array is not None:
+                    out[field].append(array)
+        fields = [list(map(tuple, np.hstack(arrays).tolist())) if arrays else [()] * count
+                  for arrays in out]
+        return tuple(map(JointPoint, *fields))
 
     def _restore(self, layout: _Layout, states: Sequence[CommandState]) -> None:
         """Put the groups a point moved back where they were."""
@@ -218,6 +257,36 @@ class _Layout:
     commanded: tuple[int, ...]
     passing: Callable[[Sequence[float]], tuple[float, ...]] | None
     groups: tuple[tuple[CommandGroup, Callable[[Sequence[float]], tuple[float, ...]]], ...]
+    # the same places as lists, for a trajectory's arrays (``RobotCommand._batched``)
+    passing_places: list[int]
+    output_places: tuple[list[int], ...]
+
+
+def _stacked(width: int, points: Sequence[JointPoint]) -> list[np.ndarray | None] | None:
+    """
+    Return each of the points' arrays stacked (N, width), None where no point has it.
+
+    None for all where a field is on some points only, of another length, or not finite: the
+    points are then checked (and converted) one by one.
+    """
+    if not points:
+        return None
+    fields: list[np.ndarray | None] = []
+    for field in range(4):
+        arrays = [point[field] for point in points]
+        if not arrays[0]:
+            if any(arrays):
+                return None
+            fields.append(None)
+            continue
+        try:
+            array = np.array(arrays, dtype=float)
+        except ValueError:  # of unequal lengths
+            return None
+        if array.shape != (len(points), width) or not np.isfinite(array).all():
+            return None
+        fields.append(array)
+    return fields
 
 
 def _at_point(refusal: CommandRefused, number: int) -> CommandRefused:

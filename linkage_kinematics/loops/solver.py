@@ -33,6 +33,7 @@ from linkage_kinematics.loops.newton import GroupSolver, GroupState, plan_group
 from linkage_kinematics.loops.plan import GroupPlan, LoopPlan
 from linkage_kinematics.loops.refusals import Refusal, SampleRefused
 from linkage_kinematics.loops.tree import KinematicTree
+import numpy as np
 
 
 class LoopSampleError(ValueError):
@@ -205,6 +206,36 @@ class LoopSolver:
         # the passive joints' are appended to the lists: the caller's stay as they are
         return self._close(list(values), list(rates))
 
+    def positions_many(self, values: Sequence[np.ndarray]) -> list[np.ndarray] | None:
+        """
+        Return every passive joint's positions at a motion's samples, or None: one by one then.
+
+        In ``plan.passive``'s order. ``values``: the measured joints' arrays (``plan.measured``'s
+        order), the first sample
+        the last one solved (the state stays there). Each loop's branches continued from it
+        (``DrivenLoop.positions_many``), each revolute passive joint kept within π of the
+        sample before, as ``solve`` keeps it. None with general groups, a branch that flips with
+        whole turns of its known joint, or any sample refused (``solve`` names it).
+        """
+        if self.groups:
+            return None
+        columns = list(values)
+        passive: list[np.ndarray] = []
+        for step, last_branch in zip(self._steps, self._branches):
+            _, _, _, place, sign, flips_with_turns, driven, joints = step
+            if flips_with_turns:
+                return None
+            coordinates = driven.positions_many(sign * columns[place], last_branch)
+            if coordinates is None:
+                return None
+            for passive_place, joint_sign, index, revolute in joints:
+                position = joint_sign * coordinates[index]
+                if revolute:
+                    position = _unwrapped(position, self._previous[passive_place])
+                columns.append(position)
+                passive.append(position)
+        return passive
+
     def _close(self, values: list[float], rates: list[float]
                ) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """Close the loops at the measured ``values`` and ``rates`` (checked), appended to."""
@@ -250,3 +281,13 @@ class LoopSolver:
         self._known_values, self._branches = known_values, branches
         self._previous = values[solved:]
         return tuple(self._previous), tuple(rates[solved:])
+
+
+def _unwrapped(angles: np.ndarray, start: float) -> np.ndarray:
+    """
+    Return ``angles`` moved by whole turns, each within π of the one before (the first: ``start``).
+
+    As ``unwrap_near`` moves them one by one; the whole turns are counted up exactly.
+    """
+    jumps = np.round((np.concatenate(([start], angles[:-1])) - angles) / TWO_PI)
+    return angles + TWO_PI * np.cumsum(jumps)

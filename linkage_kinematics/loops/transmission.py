@@ -30,7 +30,7 @@ of the ankle's two legs is then 2×4, A' 2×2. Plain floats on the per-sample pa
 direction's system (rows and columns dimensionless, as ``newton``'s): near a configuration
 where the outputs cannot move the actuators (a knee's output at its dead point) M and the
 efforts grow without bound. ``output_efforts`` raises ``TransmissionSingular`` where κ(A') >
-``newton.CONDITION_LIMIT`` (κ²·ε > 1e-3, the rule the closure refuses samples by).
+``refusals.CONDITION_LIMIT`` (κ²·ε > 1e-3, the rule the closure refuses samples by).
 
 **The mechanical advantage** (``MechanicalAdvantage``): M itself. One degree of freedom: the
 transmission ratio dm/do, which is also τ_o/τ_m (a cylinder's moment arm about the boom joint in
@@ -52,7 +52,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 import math
+from typing import NamedTuple
 
+from linkage_kinematics.loops.batch_equations import BatchEquations, BatchEvaluation
 from linkage_kinematics.loops.equations import Evaluation, LoopEquations, RowKind
 from linkage_kinematics.loops.linear import condition, factor
 from linkage_kinematics.loops.refusals import CONDITION_LIMIT
@@ -232,6 +234,21 @@ class Linearization:
         return self._ratio
 
 
+class BatchLinearization(NamedTuple):
+    """
+    ``Linearization`` at many poses (``Transmission.linearize_many``), arrays over the poses.
+
+    Orientations as ±1 (0 where singular); ``ratio`` (N, actuators, outputs), inf where A' is
+    exactly singular.
+    """
+
+    measured_orientation: np.ndarray
+    measured_conditioning: np.ndarray
+    command_orientation: np.ndarray
+    command_conditioning: np.ndarray
+    ratio: np.ndarray
+
+
 class Transmission:
     """
     One group's transmission between actuators and output joints (module docstring).
@@ -258,6 +275,8 @@ class Transmission:
             rods = {name: rod for name, rod in rods.items()
                     if name not in {c.name for c in subgroup.closures} or name in kept}
         self.equations = equations = LoopEquations(tree, group.closures, rods)
+        # what the equations were made of, for their batched twin (``batch_equations``)
+        self.closures, self.rods = group.closures, rods
         columns = equations.coordinates
         names = [tree.coordinates[i].name for i in columns]
         self._actuator_columns = [names.index(name) for name in self.actuators]
@@ -295,6 +314,8 @@ class Transmission:
                          else (1, solved.index(name)) for name in names]
         self._output_places = [solved.index(name) for name in self.outputs]
         self.columns = tuple(names)
+        self._tree = tree
+        self._batch: BatchEquations | None = None  # made when a trajectory first needs it
 
     def local(self, known: Sequence[float], solved: Sequence[float]) -> list[float]:
         """Return the pose over ``columns`` from the actuators' and the solved joints' values."""
@@ -362,6 +383,41 @@ class Transmission:
         return Linearization(_sign(measured_det), measured_conditioning, _sign(det),
                              conditioning, (self, jacobian, inverse_matrix))
 
+    @property
+    def batch(self) -> BatchEquations:
+        """Return the equations' batched twin (``batch_equations``), made when first asked."""
+        if self._batch is None:
+            self._batch = BatchEquations(self._tree, self.closures, self.rods,
+                                         self.equations.coordinates)
+        return self._batch
+
+    def linearize_many(self, local: np.ndarray,
+                       evaluation: BatchEvaluation | None = None) -> BatchLinearization | None:
+        """
+        Return ``linearize`` at every row of ``local`` (N, columns), or None if not batched.
+
+        ``evaluation``: ``batch``'s at ``local``, where the caller evaluated it already.
+
+        None where the equations have no batched twin (``BatchEquations.supports``: a weld, a
+        stretched rod). A one- or two-unknown system (the planar loops, the ankle's legs) is
+        solved by the same formulas as ``linear``'s, so M agrees with ``linearize``'s bit for
+        bit but for the Jacobian's few ulps.
+        """
+        batch = self.batch
+        if not batch.supports:
+            return None
+        if evaluation is None:
+            evaluation = batch.evaluate(local)
+        jacobian = batch.jacobian(evaluation)[:, self._rows, :]
+        inverse_matrix, det, conditioning = self._command.factor_many(jacobian)
+        _, measured_det, measured_conditioning = self._measured.factor_many(jacobian)
+        # M = −(A'⁻¹ rows of the actuators)·J_R,o; two terms at most add as fsum would
+        lines = inverse_matrix[:, self._actuator_places, :len(self._rows)]
+        ratio = -np.einsum('nak,nko->nao', lines, jacobian[:, :, self._output_columns])
+        ratio[det == 0.0] = math.inf
+        return BatchLinearization(np.sign(measured_det), measured_conditioning, np.sign(det),
+                                  conditioning, ratio)
+
     def ratio_from(self, jacobian: Sequence[Sequence[float]],
                    inverse_matrix: Sequence[Sequence[float]]) -> tuple[tuple[float, ...], ...]:
         """Return M from ``linearize``'s J and A'⁻¹ (inf throughout without an inverse)."""
@@ -407,6 +463,49 @@ class _Square:
                                (abs(q) / s0 + abs(v) / s1) / r1)
             return inverse_matrix, det, norm * norm_inverse
         return inverse_matrix, det, condition(matrix, inverse_matrix, rows, scales)
+
+    def factor_many(self, jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """
+        Return ``factor`` at every pose: A⁻¹ (N, n, n), det A and κ₁ (N,); inf where singular.
+
+        One and two unknowns by ``linear``'s own formulas (the same bits from the same J).
+        """
+        count, size = jacobian.shape[0], len(self.columns)
+        matrix = np.empty((count, size, size))
+        matrix[:, :jacobian.shape[1], :] = jacobian[:, :, self.columns]
+        if self.idle:
+            matrix[:, jacobian.shape[1]:, :] = self.idle
+        with np.errstate(divide='ignore', invalid='ignore'):
+            if size == 1:
+                det = matrix[:, 0, 0]
+                inverse_matrix = 1.0 / matrix
+                conditioning = np.ones(count)
+            elif size == 2:
+                a, b, c, d = (matrix[:, 0, 0], matrix[:, 0, 1], matrix[:, 1, 0],
+                              matrix[:, 1, 1])
+                det = a * d - b * c
+                inverse_matrix = np.empty((count, 2, 2))
+                p, q, u, v = d / det, -b / det, -c / det, a / det
+                inverse_matrix[:, 0, 0], inverse_matrix[:, 0, 1] = p, q
+                inverse_matrix[:, 1, 0], inverse_matrix[:, 1, 1] = u, v
+                # ``factor``'s own κ₁ of a 2×2, term by term
+                (r0, r1), (s0, s1) = self.row_scale, self.column_scale
+                a, b, c, d, p, q, u, v = map(np.abs, (a, b, c, d, p, q, u, v))
+                conditioning = (np.maximum((a * r0 + c * r1) * s0, (b * r0 + d * r1) * s1)
+                                * np.maximum((p / s0 + u / s1) / r0, (q / s0 + v / s1) / r1))
+            else:
+                det = np.linalg.det(matrix)
+                inverse_matrix = np.linalg.inv(np.where((det == 0.0)[:, None, None],
+                                                        np.eye(size), matrix))
+                rows = np.array(self.row_scale)[:, None]
+                scales = np.array(self.column_scale)
+                # κ₁ of diag(rows)·A·diag(scales): the largest column sums of it and its inverse
+                norm = np.max(np.sum(np.abs(matrix) * rows * scales, axis=1), axis=1)
+                norm_inverse = np.max(np.sum(np.abs(inverse_matrix) / scales[:, None] / rows.T,
+                                             axis=1), axis=1)
+                conditioning = norm * norm_inverse
+        conditioning[det == 0.0] = math.inf
+        return inverse_matrix, det, conditioning
 
 
 def _sign(value: float) -> int:

@@ -130,20 +130,50 @@ def decode_joint_trajectory(data: bytes) -> TrajectoryMessage:
         raise ValueError(f'JointTrajectory claims {count} points in {len(body) - offset} '
                          'bytes')
     points = []
-    duration = order + 'iI'
+    lengths: tuple[int, ...] | None = None  # the last point's array lengths
     for index in range(count):
-        arrays = []
-        for field in POINT_ARRAYS:
-            values, offset = _doubles(body, order, offset,
-                                      f'JointTrajectory points[{index}].{field}')
-            arrays.append(values)
-        offset += -offset & 3
-        if offset + 8 > len(body):
-            raise ValueError(f'JointTrajectory points[{index}] ends within its time_from_start')
-        point_sec, point_nanosec = struct.unpack_from(duration, body, offset)
-        offset += 8
-        points.append(TrajectoryPoint(*arrays, point_sec, point_nanosec))
+        # a trajectory's points are alike: read one as the last one's layout in one call, and
+        # field by field (which names what is wrong) where it is not
+        point = None if lengths is None else _point_like(body, order, offset, lengths)
+        if point is None:
+            point, end = _point(body, order, offset, index)
+            lengths = tuple(map(len, (point.positions, point.velocities, point.accelerations,
+                                      point.efforts)))
+        else:
+            end = offset + _point_format(offset & 7, lengths)[1]
+        points.append(point)
+        offset = end
     return TrajectoryMessage(sec, nanosec, frame_id, names, tuple(points))
+
+
+def _point(body: bytes, order: str, offset: int, index: int) -> tuple[TrajectoryPoint, int]:
+    """Return the point at ``offset`` read field by field, and where it ends; or ValueError."""
+    arrays = []
+    for field in POINT_ARRAYS:
+        values, offset = _doubles(body, order, offset, f'JointTrajectory points[{index}].{field}')
+        arrays.append(values)
+    offset += -offset & 3
+    if offset + 8 > len(body):
+        raise ValueError(f'JointTrajectory points[{index}] ends within its time_from_start')
+    point_sec, point_nanosec = struct.unpack_from(order + 'iI', body, offset)
+    return TrajectoryPoint(*arrays, point_sec, point_nanosec), offset + 8
+
+
+def _point_like(body: bytes, order: str, offset: int,
+                lengths: tuple[int, ...]) -> TrajectoryPoint | None:
+    """Return the point at ``offset`` if its arrays have ``lengths``, else None."""
+    code, size = _point_format(offset & 7, lengths)
+    if offset + size > len(body):
+        return None
+    fields = struct.unpack_from(order + code, body, offset)
+    arrays = []
+    place = 0
+    for length in lengths:
+        if fields[place] != length:
+            return None
+        arrays.append(fields[place + 1:place + 1 + length])
+        place += 1 + length
+    return TrajectoryPoint(*arrays, fields[place], fields[place + 1])
 
 
 @functools.cache
