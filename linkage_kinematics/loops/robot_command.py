@@ -27,7 +27,7 @@ same measured joints, branches and assemblies), each group's output joints from
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 import math
 
 from linkage_kinematics.loops.command import (
@@ -40,7 +40,7 @@ from linkage_kinematics.loops.command import (
 )
 from linkage_kinematics.loops.command_batch import convert_many
 from linkage_kinematics.loops.plan import RobotLoops
-from linkage_kinematics.loops.solver import LoopSampleError, LoopSolver
+from linkage_kinematics.loops.robot_transmission import assembled_pose
 from linkage_kinematics.loops.structure import analyse
 from linkage_kinematics.loops.transmission import (
     assign_outputs,
@@ -312,22 +312,7 @@ def plan_command(loops: RobotLoops, measured: Sequence[str], outputs: Sequence[s
     tree = plan.tree
     assigned, problems = assign_outputs(tree, [group.group for group in plan.groups], outputs)
     problems = list(problems)
-    values = [0.0] * len(tree.names)
-    for group in plan.general:
-        for index in group.group.coordinates:
-            values[index] = group.zero.assembly.values[index]
-    if plan.loops:
-        # the planar loops alone, closed in closed form at the actuators' zero values
-        planar = LoopSolver(replace(plan, groups=tuple(group for group in plan.groups
-                                                       if group.zero is None)))
-        zeros = dict.fromkeys(plan.measured, 0.0)
-        try:
-            solved, _ = planar.solve(zeros, zeros)
-        except LoopSampleError as error:
-            raise TransmissionError("the planar loops do not close at the actuators' zero "
-                                    f'values: {error}') from None
-        for name, value in solved.items():
-            values[tree.index[name]] = value
+    values = assembled_pose(plan)
     commands = []
     for group in plan.groups:
         structure = (group.zero.structure if group.zero is not None

@@ -57,9 +57,11 @@ class GroupTransmission:
     transmission: Transmission
 
 
-def _assembled(plan: LoopPlan) -> list[float]:
+def assembled_pose(plan: LoopPlan) -> list[float]:
     """
     Return the robot's assembled pose (module docstring), every coordinate of the tree.
+
+    The pose both directions' transmissions start from (``robot_command.plan_command`` too).
 
     TransmissionError where the planar loops do not close at the actuators' zero values.
     """
@@ -102,7 +104,7 @@ def plan_transmissions(plan: LoopPlan,
                  'solved but not published' for name in outputs if name in hidden]
     found = []
     try:
-        values = _assembled(plan) if any(assigned.values()) else []
+        values = assembled_pose(plan) if any(assigned.values()) else []
     except TransmissionError as error:
         raise TransmissionError('; '.join([*problems, str(error)])) from None
     for group in plan.groups:
