@@ -59,6 +59,7 @@ from linkage_kinematics.run.loop_diagnostics import LoopsHealth
 from linkage_kinematics.shared.cdr import JointStateDecoder
 from loops_bench import input_bytes
 import measured_bench
+from minimal_relay import relayed
 from rclpy.serialization import deserialize_message, serialize_message
 from sensor_msgs.msg import JointState
 from timing import interleaved_medians, markdown_table
@@ -287,16 +288,7 @@ def hand_relay_callback(received: list[bytes]) -> int:
     publish).
     """
     for data in received:
-        measured = deserialize_message(data, JointState)
-        index = measured.name.index('crank_joint')
-        angle = measured.position[index]
-        rate = measured.velocity[index] if len(measured.velocity) > index else 0.0
-        message = JointState()
-        message.header.stamp = measured.header.stamp
-        message.name = ['coupler_joint', 'rocker_joint']
-        message.position = [-0.3 * angle, 0.5 * angle]
-        message.velocity = [-0.3 * rate, 0.5 * rate]
-        serialize_message(message)
+        serialize_message(relayed(deserialize_message(data, JointState)))
     return len(received)
 
 

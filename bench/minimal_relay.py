@@ -29,17 +29,21 @@ class MinimalRelay(Node):
         self.create_subscription(JointState, '/encoder/joint_states', self._relay, 10)
 
     def _relay(self, measured: JointState) -> None:
-        if 'crank_joint' not in measured.name:
-            return
-        index = measured.name.index('crank_joint')
-        angle = measured.position[index]
-        rate = measured.velocity[index] if len(measured.velocity) > index else 0.0
-        message = JointState()
-        message.header.stamp = measured.header.stamp
-        message.name = ['coupler_joint', 'rocker_joint']
-        message.position = [-0.3 * angle, 0.5 * angle]
-        message.velocity = [-0.3 * rate, 0.5 * rate]
-        self._publisher.publish(message)
+        if 'crank_joint' in measured.name:
+            self._publisher.publish(relayed(measured))
+
+
+def relayed(measured: JointState) -> JointState:
+    """Return the coupler and rocker joints a lab's hand-written relay makes of the crank's."""
+    index = measured.name.index('crank_joint')
+    angle = measured.position[index]
+    rate = measured.velocity[index] if len(measured.velocity) > index else 0.0
+    message = JointState()
+    message.header.stamp = measured.header.stamp
+    message.name = ['coupler_joint', 'rocker_joint']
+    message.position = [-0.3 * angle, 0.5 * angle]
+    message.velocity = [-0.3 * rate, 0.5 * rate]
+    return message
 
 
 def main() -> int:

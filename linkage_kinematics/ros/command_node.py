@@ -253,13 +253,19 @@ class CommandNode(Node):
         if now_ns - self._status_ns >= REFUSAL_STATUS_NS:
             self.publish_diagnostics()
 
+    def _take_input(self, kind: MessageKind, topic: str, data: bytes,
+                    now: int) -> Relay | None:
+        """Log an input; return the relay, or None with the input refused before a description."""
+        self.log.record(self.topics[topic], data, now)
+        if self._relay is None:
+            self._refuse(kind, RelayRefused(
+                RelayRefusal.NO_DESCRIPTION, f'waiting on {self._description_from}'), now)
+        return self._relay
+
     def _on_commands(self, data: bytes) -> None:
         now = self.now_ns()
-        self.log.record(self.topics['commands in'], data, now)
-        relay = self._relay
+        relay = self._take_input(MessageKind.COMMANDS, 'commands in', data, now)
         if relay is None:
-            self._refuse(MessageKind.COMMANDS, RelayRefused(
-                RelayRefusal.NO_DESCRIPTION, f'waiting on {self._description_from}'), now)
             return
         started = time.perf_counter_ns()
         try:
@@ -280,11 +286,8 @@ class CommandNode(Node):
 
     def _on_trajectory(self, data: bytes) -> None:
         now = self.now_ns()
-        self.log.record(self.topics['trajectory in'], data, now)
-        relay = self._relay
+        relay = self._take_input(MessageKind.TRAJECTORY, 'trajectory in', data, now)
         if relay is None:
-            self._refuse(MessageKind.TRAJECTORY, RelayRefused(
-                RelayRefusal.NO_DESCRIPTION, f'waiting on {self._description_from}'), now)
             return
         started = time.perf_counter_ns()
         try:
